@@ -1,0 +1,80 @@
+#pragma once
+/// @file cost.hpp
+/// Stage and terminal costs with their first and second derivatives (paper eq. for J(x_0): the total
+/// cost l_T(x_T) + sum_t l(x_t, u_t)).
+///
+/// QuadraticCost is the cost of DESIGN.md section 8 and of the reference problem, with an optional
+/// time-varying reference (tracking):
+///
+///   l_t(x, u) = dt (0.5 e' Q e + 0.5 d' R d),   e = x - x_ref(t),  d = u - u_ref(t)
+///   l_T(x)    = 0.5 e' Qf e,                    e = x - x_ref(T)
+///
+///   l_x = dt Q e,  l_u = dt R d,  l_xx = dt Q,  l_uu = dt R,  l_ux = 0;   terminal: Qf e, Qf.
+/// Q, R and Qf are symmetric (validated); Q and Qf positive semidefinite, R positive definite is the
+/// caller's choice (the solver regularises).
+
+#include <vector>
+
+#include "gpilqg/core/types.hpp"
+
+namespace gpilqg {
+
+/// Value and derivatives of a stage cost. For a terminal cost, lu, luu and lux are left empty.
+struct CostDerivatives {
+  double value = 0.0;
+  Vector lx;   ///< n
+  Vector lu;   ///< m
+  Matrix lxx;  ///< n x n
+  Matrix luu;  ///< m x m
+  Matrix lux;  ///< m x n
+  void resize(int n, int m);
+};
+
+/// A cost over a horizon of T steps: stages t = 0..T-1 and a terminal cost at T.
+class Cost {
+ public:
+  virtual ~Cost() = default;
+  virtual int state_dim() const = 0;
+  virtual int control_dim() const = 0;
+  /// l_t(x, u); fills `derivatives` when not null.
+  virtual double stage(int t, const VectorCRef& x, const VectorCRef& u,
+                       CostDerivatives* derivatives = nullptr) const = 0;
+  /// l_T(x); fills lx and lxx of `derivatives` when not null.
+  virtual double terminal(const VectorCRef& x, CostDerivatives* derivatives = nullptr) const = 0;
+};
+
+class QuadraticCost final : public Cost {
+ public:
+  /// Regulation to a fixed goal with u_ref = 0. Throws std::invalid_argument naming the field when a
+  /// size does not match or a weight matrix is not symmetric or not finite.
+  QuadraticCost(double dt, Matrix Q, Matrix R, Matrix Qf, Vector goal);
+
+  /// Tracking of a reference: x_ref has T+1 columns (n x (T+1)), u_ref T columns (m x T).
+  static QuadraticCost tracking(double dt, Matrix Q, Matrix R, Matrix Qf, Matrix x_ref, Matrix u_ref);
+
+  int state_dim() const override { return static_cast<int>(Q_.rows()); }
+  int control_dim() const override { return static_cast<int>(R_.rows()); }
+  double stage(int t, const VectorCRef& x, const VectorCRef& u,
+               CostDerivatives* derivatives = nullptr) const override;
+  double terminal(const VectorCRef& x, CostDerivatives* derivatives = nullptr) const override;
+
+  /// The state reference at step t (the goal when regulating).
+  Eigen::Ref<const Vector> state_reference(int t) const;
+  /// The control reference at step t (zero when regulating).
+  Eigen::Ref<const Vector> control_reference(int t) const;
+
+ private:
+  QuadraticCost(double dt, Matrix Q, Matrix R, Matrix Qf, Matrix x_ref, Matrix u_ref, bool tracking);
+
+  double dt_;
+  Matrix Q_, R_, Qf_;
+  Matrix x_ref_;  ///< n x 1 (regulation) or n x (T+1) (tracking)
+  Matrix u_ref_;  ///< m x 1 (regulation) or m x T (tracking)
+  bool tracking_;
+};
+
+/// Straight-line reference from x0 to goal over T steps: x_ref(t) = x0 + (t/T)(goal - x0) for
+/// t = 0..T (n x (T+1)). The paper's quadrotor tasks track such a line.
+Matrix straight_line_reference(const VectorCRef& x0, const VectorCRef& goal, int horizon);
+
+}  // namespace gpilqg

@@ -1,0 +1,119 @@
+#pragma once
+/// @file measurements.hpp
+/// Measurement data sets (DESIGN.md section 4, a fixed contract): episodes of measured states and
+/// applied controls at a constant step, read from and written to CSV and HDF5 with full validation.
+///
+/// CSV: header `episode,t,<state names>,<control names>`, one row per time step. A row holds the
+/// state measured at time t and the control applied from t until the next row of the same episode.
+/// HDF5: /episodes/<k>/t (T), /episodes/<k>/x (T x n), /episodes/<k>/u (T x m), root attributes
+/// `system`, `state_names`, `control_names`.
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "gpilqg/core/quantity.hpp"
+#include "gpilqg/core/types.hpp"
+
+namespace gpilqg {
+
+/// One episode: T samples at a constant step.
+struct Episode {
+  long id = 0;  ///< the `episode` value of the CSV rows, or k of /episodes/<k>
+  Vector t;     ///< T times [s], strictly increasing, constant step
+  Matrix x;     ///< T x n measured states
+  Matrix u;     ///< T x m applied controls
+  int length() const { return static_cast<int>(t.size()); }
+  /// The step, (t_last - t_first) / (T - 1); 0 for a single sample.
+  double dt() const;
+};
+
+struct MeasurementSet {
+  SystemSignature system;
+  std::vector<Episode> episodes;
+  /// Total number of rows over all episodes.
+  long sample_count() const;
+};
+
+/// Bad input in a measurement file. what() reads "<file>:<line or dataset>: <problem>; expected
+/// <what was expected>", so the user can find and fix the offending entry. `location` is e.g.
+/// "line 7" (1-based, header = line 1), "/episodes/3/x" or "attribute 'system'"; it is empty only
+/// when the whole file is at fault (missing, unreadable, wrong extension), and what() then reads
+/// "<file>: <problem>; expected <...>".
+class DataError : public std::runtime_error {
+ public:
+  /// `problem` already holds the "; expected ..." part.
+  DataError(const std::filesystem::path& file, const std::string& location, const std::string& problem);
+  /// Builds the problem text as "<problem>; expected <expected>".
+  DataError(const std::filesystem::path& file, const std::string& location, const std::string& problem,
+            const std::string& expected);
+  const std::filesystem::path& file() const { return file_; }
+  const std::string& location() const { return location_; }
+
+ private:
+  std::filesystem::path file_;
+  std::string location_;
+};
+
+/// Reads and validates a CSV measurement file against `system`. Throws DataError naming the line
+/// (1-based, header = line 1) and the column for: a missing file, an empty file, a header whose
+/// names differ from the system's (listing expected and found sets), a row with the wrong number of
+/// fields, an unparsable or non-finite number, a non-integer or negative episode, an episode whose
+/// rows are not contiguous, non-increasing t, dt not constant within an episode (relative tolerance
+/// 1e-6), an episode with a single row (dt undefined), and a file with no data rows.
+/// Accepted because they carry no meaning: "\r\n" line endings, a UTF-8 byte-order mark, a missing
+/// final newline, and blank lines at the very end of the file. A blank line anywhere else is an
+/// error, and fields are never trimmed (" 0.1" and "+0.1" are unparsable). Episodes keep file order.
+MeasurementSet read_measurements_csv(const std::filesystem::path& file, const SystemSignature& system);
+
+/// Reads and validates an HDF5 measurement file: same checks, naming the dataset or attribute
+/// (e.g. "/episodes/3/x", "attribute 'state_names'"), plus missing groups, datasets or attributes,
+/// wrong shapes or types, a `system` attribute that differs from `system`, no episodes, and group
+/// names under /episodes that are not non-negative integers. String attributes may be variable- or
+/// fixed-length; datasets any floating-point type. Episodes come back ordered by k; other objects
+/// in the file are ignored.
+MeasurementSet read_measurements_hdf5(const std::filesystem::path& file, const SystemSignature& system);
+
+/// Chooses the reader by extension (case-insensitive): .csv, or .h5 / .hdf5; any other extension
+/// is a DataError.
+MeasurementSet read_measurements(const std::filesystem::path& file, const SystemSignature& system);
+
+/// Writes CSV with every number in its shortest round-trip form, so reading it back gives the same
+/// doubles bit for bit. Written to "<file>.tmp-<pid>" and renamed into place. Both writers first
+/// check the set (shapes, finite values, distinct non-negative ids, valid times) and throw
+/// std::invalid_argument rather than write a file the readers would reject.
+void write_measurements_csv(const std::filesystem::path& file, const MeasurementSet& set);
+/// Writes HDF5 in the layout above (float64, variable-length UTF-8 strings), group names /episodes/<id>.
+/// Written to a temporary file and renamed into place.
+void write_measurements_hdf5(const std::filesystem::path& file, const MeasurementSet& set);
+/// Chooses the writer by extension like read_measurements.
+void write_measurements(const std::filesystem::path& file, const MeasurementSet& set);
+
+/// Range of one column over all episodes.
+struct ColumnSummary {
+  std::string name;
+  std::string unit;
+  double min = 0.0;
+  double max = 0.0;
+  double mean = 0.0;
+  double std = 0.0;
+};
+
+struct MeasurementSummary {
+  std::string system;
+  int episodes = 0;
+  long samples = 0;
+  double dt_min = 0.0;  ///< smallest per-episode step
+  double dt_max = 0.0;  ///< largest per-episode step (equal to dt_min when all episodes agree)
+  double duration = 0.0;  ///< total measured time, sum over episodes of (T - 1) dt [s]
+  std::vector<ColumnSummary> states;
+  std::vector<ColumnSummary> controls;
+};
+
+/// Per-column min, max, mean and population std over all samples of all episodes, in the system's
+/// order; dt_min / dt_max over the episodes' Episode::dt(); duration = sum of (t_last - t_first).
+/// Statistics of a set without samples are 0.
+MeasurementSummary summarize(const MeasurementSet& set);
+
+}  // namespace gpilqg

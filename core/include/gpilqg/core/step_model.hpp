@@ -1,0 +1,56 @@
+#pragma once
+/// @file step_model.hpp
+/// Discrete-time models, the interface every controller works against (DESIGN.md section 2).
+///
+/// The paper's discrete stochastic step (its eq. for x' in the Robust-ILQG section):
+///
+///   x' = x + (f_sim + eps_hat) dt + F xi sqrt(dt) + G xi_G sqrt(dt),   xi ~ N(0, I_p), xi_G ~ N(0, I_q)
+///
+/// A StepModel returns the mean step x' = phi(x, u) with A = dphi/dx and B = dphi/du, the noise columns
+/// F (n x p) and the model-uncertainty columns G (n x q), each with the derivatives of every column.
+/// F and G are the continuous-time amplifications; the caller multiplies by sqrt(dt) (paper, appendix).
+/// iLQR uses the mean only, iLQG adds F, Robust-iLQG adds F and G.
+
+#include "gpilqg/core/dynamics.hpp"
+#include "gpilqg/core/noise.hpp"
+#include "gpilqg/core/types.hpp"
+
+namespace gpilqg {
+
+/// A = d x' / d x (n x n), B = d x' / d u (n x m).
+struct StepJacobians {
+  Matrix A;
+  Matrix B;
+  void resize(int n, int m);
+};
+
+class StepModel {
+ public:
+  virtual ~StepModel() = default;
+
+  virtual int state_dim() const = 0;
+  virtual int control_dim() const = 0;
+  /// The step length dt [s].
+  virtual double dt() const = 0;
+
+  /// Mean step x' = phi(x, u); fills A and B when `jacobians` is not null.
+  virtual void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
+                    StepJacobians* jacobians = nullptr) const = 0;
+
+  /// Number of process-noise columns p (0: deterministic).
+  virtual int noise_dim() const { return 0; }
+  /// F(x, u) with the derivatives of its columns when `derivatives` is true.
+  virtual void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
+                     bool derivatives) const;
+
+  /// Number of model-uncertainty columns q (0 for a model without learned uncertainty).
+  virtual int uncertainty_dim() const { return 0; }
+  /// G(x, u) with the derivatives of its columns (a GP residual model: G = diag(sigma_i(z))).
+  virtual void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
+                           bool derivatives) const;
+
+  /// Convenience: returns phi(x, u).
+  Vector next(const VectorCRef& x, const VectorCRef& u) const;
+};
+
+}  // namespace gpilqg

@@ -1,0 +1,249 @@
+/// Measurement sets: the parts shared by both file formats (errors, dispatch by extension, the
+/// checks of one episode, safe writing through a temporary file) and summarize().
+
+#include "gpilqg/core/measurements.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+#include <system_error>
+
+#include "measurements_internal.hpp"
+
+namespace gpilqg {
+
+double Episode::dt() const {
+  const Eigen::Index T = t.size();
+  if (T < 2) return 0.0;
+  return (t(T - 1) - t(0)) / static_cast<double>(T - 1);
+}
+
+long MeasurementSet::sample_count() const {
+  long count = 0;
+  for (const Episode& episode : episodes) count += episode.length();
+  return count;
+}
+
+namespace {
+
+std::string data_error_message(const std::filesystem::path& file, const std::string& location,
+                               const std::string& problem) {
+  if (location.empty()) return file.string() + ": " + problem;
+  return file.string() + ":" + location + ": " + problem;
+}
+
+/// The extension in lower case, e.g. ".csv".
+std::string lower_extension(const std::filesystem::path& file) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+enum class Format { Csv, Hdf5 };
+
+Format format_of(const std::filesystem::path& file) {
+  const std::string extension = lower_extension(file);
+  if (extension == ".csv") return Format::Csv;
+  if (extension == ".h5" || extension == ".hdf5") return Format::Hdf5;
+  throw DataError(file, "", "unknown measurement file extension '" + file.extension().string() + "'",
+                  "'.csv', '.h5' or '.hdf5'");
+}
+
+}  // namespace
+
+DataError::DataError(const std::filesystem::path& file, const std::string& location, const std::string& problem)
+    : std::runtime_error(data_error_message(file, location, problem)), file_(file), location_(location) {}
+
+DataError::DataError(const std::filesystem::path& file, const std::string& location, const std::string& problem,
+                     const std::string& expected)
+    : DataError(file, location, problem + "; expected " + expected) {}
+
+MeasurementSet read_measurements(const std::filesystem::path& file, const SystemSignature& system) {
+  return format_of(file) == Format::Csv ? read_measurements_csv(file, system)
+                                        : read_measurements_hdf5(file, system);
+}
+
+void write_measurements(const std::filesystem::path& file, const MeasurementSet& set) {
+  if (format_of(file) == Format::Csv)
+    write_measurements_csv(file, set);
+  else
+    write_measurements_hdf5(file, set);
+}
+
+namespace measurements_detail {
+
+std::optional<SampleIssue> check_step(double previous, double current, double first_step) {
+  const double found = current - previous;
+  if (!(found > 0.0))
+    return SampleIssue{0, fmt::format("t = {} is not greater than the previous t = {}", current, previous),
+                       "t strictly increasing within an episode"};
+  if (std::abs(found - first_step) > kDtRelativeTolerance * first_step)
+    return SampleIssue{0,
+                       fmt::format("dt = {} (t = {} after t = {}) differs from the episode's first dt = {}",
+                                   found, current, previous, first_step),
+                       fmt::format("dt = {} (constant within an episode to relative tolerance {})", first_step,
+                                   kDtRelativeTolerance)};
+  return std::nullopt;
+}
+
+SampleIssue too_few_samples(Eigen::Index count) {
+  return SampleIssue{
+      0, fmt::format("has {} sample{}; need at least 2 to define dt", count, count == 1 ? "" : "s"),
+      "2 or more samples per episode"};
+}
+
+std::optional<SampleIssue> check_times(const Vector& t) {
+  const Eigen::Index T = t.size();
+  if (T < 2) {
+    SampleIssue issue = too_few_samples(T);
+    issue.problem = "the episode " + issue.problem;
+    return issue;
+  }
+  for (Eigen::Index i = 1; i < T; ++i) {
+    if (auto issue = check_step(t(i - 1), t(i), t(1) - t(0))) {
+      issue->index = i;
+      return issue;
+    }
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> expected_columns(const SystemSignature& system) {
+  std::vector<std::string> columns{"episode", "t"};
+  for (const Quantity& q : system.states) columns.push_back(q.name);
+  for (const Quantity& q : system.controls) columns.push_back(q.name);
+  return columns;
+}
+
+std::string join(const std::vector<std::string>& names, const std::string& separator) {
+  std::string joined;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) joined += separator;
+    joined += names[i];
+  }
+  return joined;
+}
+
+std::string format_number(double value) { return fmt::format("{}", value); }
+
+namespace {
+
+void check_finite(const MatrixCRef& values, long id, const char* what) {
+  for (Eigen::Index i = 0; i < values.rows(); ++i)
+    for (Eigen::Index j = 0; j < values.cols(); ++j)
+      if (!std::isfinite(values(i, j)))
+        throw std::invalid_argument(fmt::format("measurement set: episode {}: {}({}, {}) = {} is not finite",
+                                                id, what, i, j, values(i, j)));
+}
+
+}  // namespace
+
+void check_writable(const MeasurementSet& set) {
+  const auto n = static_cast<Eigen::Index>(set.system.states.size());
+  const auto m = static_cast<Eigen::Index>(set.system.controls.size());
+  std::set<long> ids;
+  for (const Episode& e : set.episodes) {
+    if (e.id < 0) throw std::invalid_argument(fmt::format("measurement set: episode id {} is negative", e.id));
+    if (!ids.insert(e.id).second)
+      throw std::invalid_argument(fmt::format("measurement set: episode id {} appears twice", e.id));
+    const Eigen::Index T = e.t.size();
+    if (e.x.rows() != T || e.x.cols() != n || e.u.rows() != T || e.u.cols() != m)
+      throw std::invalid_argument(fmt::format(
+          "measurement set: episode {}: x is {} x {} and u is {} x {}; expected {} x {} and {} x {} "
+          "(T = length of t, {} states, {} controls)",
+          e.id, e.x.rows(), e.x.cols(), e.u.rows(), e.u.cols(), T, n, T, m, n, m));
+    check_finite(e.t, e.id, "t");
+    check_finite(e.x, e.id, "x");
+    check_finite(e.u, e.id, "u");
+    if (const auto issue = check_times(e.t))
+      throw std::invalid_argument(fmt::format("measurement set: episode {}, sample {}: {}; expected {}", e.id,
+                                              issue->index, issue->problem, issue->expected));
+  }
+}
+
+std::filesystem::path temporary_path_for(const std::filesystem::path& file) {
+  std::filesystem::path temporary = file;
+  temporary += fmt::format(".tmp-{}", static_cast<long>(::getpid()));
+  return temporary;
+}
+
+void commit_temporary(const std::filesystem::path& temporary, const std::filesystem::path& file) {
+  std::error_code error;
+  std::filesystem::rename(temporary, file, error);
+  if (error) {
+    discard_temporary(temporary);
+    throw DataError(
+        file, "",
+        "cannot rename the temporary file " + temporary.string() + " into place (" + error.message() + ")",
+        "a writable destination");
+  }
+}
+
+void discard_temporary(const std::filesystem::path& temporary) noexcept {
+  std::error_code ignored;
+  std::filesystem::remove(temporary, ignored);
+}
+
+}  // namespace measurements_detail
+
+namespace {
+
+/// Accumulates one column over all samples: min, max, mean, and the population standard deviation
+/// (computed from deviations about the mean in a second pass, for accuracy).
+ColumnSummary summarize_column(const Quantity& quantity, const std::vector<Episode>& episodes,
+                               Eigen::Index column, bool is_state) {
+  ColumnSummary s{quantity.name, quantity.unit};
+  long count = 0;
+  double sum = 0.0;
+  for (const Episode& e : episodes) {
+    const auto values = is_state ? e.x.col(column) : e.u.col(column);
+    if (values.size() == 0) continue;
+    const double lo = values.minCoeff(), hi = values.maxCoeff();
+    s.min = count == 0 ? lo : std::min(s.min, lo);
+    s.max = count == 0 ? hi : std::max(s.max, hi);
+    sum += values.sum();
+    count += values.size();
+  }
+  if (count == 0) return s;
+  s.mean = sum / static_cast<double>(count);
+  double squares = 0.0;
+  for (const Episode& e : episodes) {
+    const auto values = is_state ? e.x.col(column) : e.u.col(column);
+    squares += (values.array() - s.mean).square().sum();
+  }
+  s.std = std::sqrt(squares / static_cast<double>(count));
+  return s;
+}
+
+}  // namespace
+
+MeasurementSummary summarize(const MeasurementSet& set) {
+  MeasurementSummary summary;
+  summary.system = set.system.name;
+  summary.episodes = static_cast<int>(set.episodes.size());
+  summary.samples = set.sample_count();
+  bool first = true;
+  for (const Episode& e : set.episodes) {
+    if (e.length() < 2) continue;
+    const double dt = e.dt();
+    summary.dt_min = first ? dt : std::min(summary.dt_min, dt);
+    summary.dt_max = first ? dt : std::max(summary.dt_max, dt);
+    summary.duration += e.t(e.length() - 1) - e.t(0);
+    first = false;
+  }
+  for (std::size_t j = 0; j < set.system.states.size(); ++j)
+    summary.states.push_back(
+        summarize_column(set.system.states[j], set.episodes, static_cast<Eigen::Index>(j), true));
+  for (std::size_t j = 0; j < set.system.controls.size(); ++j)
+    summary.controls.push_back(
+        summarize_column(set.system.controls[j], set.episodes, static_cast<Eigen::Index>(j), false));
+  return summary;
+}
+
+}  // namespace gpilqg

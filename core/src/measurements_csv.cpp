@@ -1,0 +1,290 @@
+/// CSV measurement files (DESIGN.md section 4): a strict reader that names the offending line of
+/// any bad input, and a writer whose numbers read back bit for bit.
+///
+/// Accepted beyond the plain contract, because they carry no meaning: "\r\n" line endings, a UTF-8
+/// byte-order mark before the header, a missing final newline, and blank lines at the very end of
+/// the file. Rejected: a blank line anywhere else (it usually marks files pasted together), and
+/// whitespace or a '+' sign around numbers (fields must be plain numbers, nothing is trimmed).
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string_view>
+
+#include "gpilqg/core/measurements.hpp"
+#include "measurements_internal.hpp"
+
+namespace gpilqg {
+
+namespace {
+
+using measurements_detail::expected_columns;
+using measurements_detail::join;
+
+std::string line_location(long line) { return fmt::format("line {}", line); }
+
+/// The field as it appears in the file, quoted and shortened for an error message.
+std::string quote_field(std::string_view field) {
+  constexpr std::size_t kMax = 40;
+  if (field.size() > kMax) return fmt::format("'{}...'", field.substr(0, kMax));
+  return fmt::format("'{}'", field);
+}
+
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::vector<std::string> q;
+  for (const auto& name : names) q.push_back(quote_field(name));
+  return join(q);
+}
+
+std::string read_whole_file(const std::filesystem::path& file) {
+  std::error_code error;
+  if (!std::filesystem::exists(file, error))
+    throw DataError(file, "", "no such file", "an existing measurement file");
+  if (std::filesystem::is_directory(file, error))
+    throw DataError(file, "", "is a directory", "a measurement file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw DataError(file, "", "cannot open the file for reading", "a readable measurement file");
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  if (in.bad()) throw DataError(file, "", "reading the file failed", "a readable measurement file");
+  return std::move(contents).str();
+}
+
+bool is_blank(std::string_view line) { return line.find_first_not_of(" \t") == std::string_view::npos; }
+
+std::vector<std::string_view> split_fields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    if (comma == std::string_view::npos) {
+      fields.push_back(line.substr(start));
+      return fields;
+    }
+    fields.push_back(line.substr(start, comma - start));
+    start = comma + 1;
+  }
+}
+
+/// The text split into lines without their "\n" or "\r\n"; a final newline does not start a line.
+std::vector<std::string_view> split_lines(std::string_view text) {
+  std::vector<std::string_view> lines;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    const std::size_t next = end == std::string_view::npos ? text.size() : end + 1;
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(start, end - start);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    lines.push_back(line);
+    start = next;
+  }
+  return lines;
+}
+
+/// Reads the rows of one file into episodes, checking each row as it comes so that the first
+/// problem in file order is the one reported.
+class CsvReader {
+ public:
+  CsvReader(const std::filesystem::path& file, const SystemSignature& system)
+      : file_(file),
+        system_(system),
+        columns_(expected_columns(system)),
+        n_(system.states.size()),
+        m_(system.controls.size()) {}
+
+  MeasurementSet read() {
+    const std::string text = read_whole_file(file_);
+    std::string_view view = text;
+    constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
+    if (view.substr(0, kByteOrderMark.size()) == kByteOrderMark) view.remove_prefix(kByteOrderMark.size());
+    const std::vector<std::string_view> lines = split_lines(view);
+
+    std::size_t last = lines.size();  // one past the last non-blank line
+    while (last > 0 && is_blank(lines[last - 1])) --last;
+    if (last == 0)
+      throw DataError(file_, line_location(1), "the file is empty",
+                      "a header line '" + join(columns_, ",") + "' followed by data rows");
+    for (std::size_t i = 0; i < last; ++i)
+      if (is_blank(lines[i]))
+        throw DataError(file_, line_location(static_cast<long>(i) + 1), "blank line",
+                        i == 0
+                            ? "the header line '" + join(columns_, ",") + "'"
+                            : std::string("a data row (blank lines are allowed only at the end of the file)"));
+
+    check_header(lines[0]);
+    if (last == 1)
+      throw DataError(file_, line_location(2), "no data rows after the header",
+                      "one row per time step, at least 2 rows per episode");
+    for (std::size_t i = 1; i < last; ++i) read_row(lines[i], static_cast<long>(i) + 1);
+    finish_episode();
+
+    MeasurementSet set;
+    set.system = system_;
+    set.episodes = std::move(episodes_);
+    return set;
+  }
+
+ private:
+  void check_header(std::string_view line) const {
+    std::vector<std::string> found;
+    for (std::string_view field : split_fields(line)) found.emplace_back(field);
+    if (found == columns_) return;
+    const std::string expected = join(columns_, ",");
+    auto sorted_found = found, sorted_expected = columns_;
+    std::sort(sorted_found.begin(), sorted_found.end());
+    std::sort(sorted_expected.begin(), sorted_expected.end());
+    if (sorted_found == sorted_expected)
+      throw DataError(file_, line_location(1),
+                      "the header has the right column names for system '" + system_.name +
+                          "' but in a different order: found " + join(found, ","),
+                      "the order " + expected + " (episode, t, the states in order, the controls in order)");
+    std::vector<std::string> missing, unknown, repeated;
+    for (const std::string& name : columns_)
+      if (std::find(found.begin(), found.end(), name) == found.end()) missing.push_back(name);
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      const bool known = std::find(columns_.begin(), columns_.end(), found[i]) != columns_.end();
+      const bool first = std::find(found.begin(), found.begin() + static_cast<long>(i), found[i]) ==
+                         found.begin() + static_cast<long>(i);
+      if (!known && first) unknown.push_back(found[i]);
+      if (known && !first && std::find(repeated.begin(), repeated.end(), found[i]) == repeated.end())
+        repeated.push_back(found[i]);
+    }
+    std::string problem = "the header columns do not match system '" + system_.name + "':";
+    if (!missing.empty()) problem += " missing " + quoted_list(missing) + ";";
+    if (!unknown.empty()) problem += " unknown " + quoted_list(unknown) + ";";
+    if (!repeated.empty()) problem += " repeated " + quoted_list(repeated) + ";";
+    problem += " found " + join(found, ",");
+    throw DataError(file_, line_location(1), problem, "the columns " + expected);
+  }
+
+  long parse_episode(std::string_view field, long line) const {
+    long value = -1;
+    const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
+    if (error != std::errc() || end != field.data() + field.size() || value < 0)
+      throw DataError(file_, line_location(line),
+                      "column 'episode': " + quote_field(field) + " is not a non-negative integer",
+                      "an episode number 0, 1, 2, ...");
+    return value;
+  }
+
+  double parse_number(std::string_view field, const std::string& column, long line) const {
+    double value = 0.0;
+    const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
+    if (error == std::errc::result_out_of_range)
+      throw DataError(file_, line_location(line),
+                      "column '" + column + "': " + quote_field(field) + " is out of the range of a double",
+                      "a finite number");
+    if (error != std::errc() || end != field.data() + field.size())
+      throw DataError(file_, line_location(line),
+                      "column '" + column + "': cannot read " + quote_field(field) + " as a number",
+                      "a plain decimal number such as -0.25 or 1.5e-3 (no spaces or other characters)");
+    if (!std::isfinite(value))
+      throw DataError(file_, line_location(line),
+                      "column '" + column + "': " + quote_field(field) + " is not a finite number",
+                      "a finite number (no nan or inf)");
+    return value;
+  }
+
+  void read_row(std::string_view text, long line) {
+    const std::vector<std::string_view> fields = split_fields(text);
+    if (fields.size() != columns_.size())
+      throw DataError(file_, line_location(line), fmt::format("the row has {} fields", fields.size()),
+                      fmt::format("{} fields ({})", columns_.size(), join(columns_, ",")));
+    const long id = parse_episode(fields[0], line);
+    std::vector<double> values(fields.size() - 1);
+    for (std::size_t j = 1; j < fields.size(); ++j) values[j - 1] = parse_number(fields[j], columns_[j], line);
+
+    if (!started_ || id != current_id_) start_episode(id, line);
+    const double t = values[0];
+    if (!times_.empty()) {
+      const double first_step = times_.size() == 1 ? t - times_[0] : times_[1] - times_[0];
+      if (const auto issue = measurements_detail::check_step(times_.back(), t, first_step))
+        throw DataError(file_, line_location(line), fmt::format("episode {}: {}", id, issue->problem),
+                        issue->expected);
+    }
+    times_.push_back(t);
+    states_.insert(states_.end(), values.begin() + 1, values.begin() + 1 + static_cast<long>(n_));
+    controls_.insert(controls_.end(), values.begin() + 1 + static_cast<long>(n_), values.end());
+  }
+
+  void start_episode(long id, long line) {
+    if (const auto seen = first_lines_.find(id); seen != first_lines_.end())
+      throw DataError(file_, line_location(line),
+                      fmt::format("episode {} resumes after episode {} started at line {} (episode {} began at "
+                                  "line {})",
+                                  id, current_id_, current_first_line_, id, seen->second),
+                      "all rows of an episode to be contiguous");
+    if (started_) finish_episode();
+    started_ = true;
+    current_id_ = id;
+    current_first_line_ = line;
+    first_lines_.emplace(id, line);
+  }
+
+  /// Moves the rows gathered so far into a new Episode (needs 2 rows or more).
+  void finish_episode() {
+    const auto T = static_cast<Eigen::Index>(times_.size());
+    if (T < 2) {
+      const auto issue = measurements_detail::too_few_samples(T);
+      throw DataError(file_, line_location(current_first_line_),
+                      fmt::format("episode {} {}", current_id_, issue.problem), issue.expected);
+    }
+    Episode episode;
+    episode.id = current_id_;
+    episode.t = Eigen::Map<const Vector>(times_.data(), T);
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    episode.x = Eigen::Map<const RowMajor>(states_.data(), T, static_cast<Eigen::Index>(n_));
+    episode.u = Eigen::Map<const RowMajor>(controls_.data(), T, static_cast<Eigen::Index>(m_));
+    episodes_.push_back(std::move(episode));
+    times_.clear();
+    states_.clear();
+    controls_.clear();
+  }
+
+  const std::filesystem::path& file_;
+  const SystemSignature& system_;
+  const std::vector<std::string> columns_;
+  const std::size_t n_, m_;
+
+  std::vector<Episode> episodes_;
+  std::map<long, long> first_lines_;  // episode id -> line of its first row
+  bool started_ = false;
+  long current_id_ = -1;
+  long current_first_line_ = 0;
+  std::vector<double> times_, states_, controls_;  // rows of the current episode, row-major
+};
+
+}  // namespace
+
+MeasurementSet read_measurements_csv(const std::filesystem::path& file, const SystemSignature& system) {
+  return CsvReader(file, system).read();
+}
+
+void write_measurements_csv(const std::filesystem::path& file, const MeasurementSet& set) {
+  measurements_detail::check_writable(set);
+  fmt::memory_buffer out;
+  fmt::format_to(std::back_inserter(out), "{}\n", join(expected_columns(set.system), ","));
+  for (const Episode& e : set.episodes) {
+    for (Eigen::Index i = 0; i < e.length(); ++i) {
+      fmt::format_to(std::back_inserter(out), "{},{}", e.id, e.t(i));
+      for (Eigen::Index j = 0; j < e.x.cols(); ++j) fmt::format_to(std::back_inserter(out), ",{}", e.x(i, j));
+      for (Eigen::Index j = 0; j < e.u.cols(); ++j) fmt::format_to(std::back_inserter(out), ",{}", e.u(i, j));
+      out.push_back('\n');
+    }
+  }
+  measurements_detail::write_via_temporary(file, [&](const std::filesystem::path& temporary) {
+    std::ofstream stream(temporary, std::ios::binary | std::ios::trunc);
+    if (!stream)
+      throw DataError(file, "", "cannot create the temporary file " + temporary.string(), "a writable folder");
+    stream.write(out.data(), static_cast<std::streamsize>(out.size()));
+    stream.close();
+    if (!stream) throw DataError(file, "", "writing " + temporary.string() + " failed", "a writable folder");
+  });
+}
+
+}  // namespace gpilqg

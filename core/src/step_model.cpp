@@ -1,0 +1,24 @@
+#include "gpilqg/core/step_model.hpp"
+
+namespace gpilqg {
+
+void StepJacobians::resize(int n, int m) {
+  if (A.rows() != n || A.cols() != n) A.resize(n, n);
+  if (B.rows() != n || B.cols() != m) B.resize(n, m);
+}
+
+void StepModel::noise(const VectorCRef&, const VectorCRef&, DiffusionColumns& out, bool) const {
+  out.resize(state_dim(), control_dim(), 0);
+}
+
+void StepModel::uncertainty(const VectorCRef&, const VectorCRef&, DiffusionColumns& out, bool) const {
+  out.resize(state_dim(), control_dim(), 0);
+}
+
+Vector StepModel::next(const VectorCRef& x, const VectorCRef& u) const {
+  Vector x_next(state_dim());
+  step(x, u, x_next);
+  return x_next;
+}
+
+}  // namespace gpilqg

@@ -1,0 +1,30 @@
+#pragma once
+/// @file cli_errors.hpp
+/// The command line's error contract (DESIGN.md section 8): exit 0 on success; exit 2 on bad input
+/// (usage, file, data, config) with a message on stderr that starts with "error:" and names the file
+/// and the line, field or dataset; exit 1 on an internal failure.
+
+#include <functional>
+#include <iosfwd>
+#include <stdexcept>
+#include <string>
+
+namespace gpilqg {
+
+inline constexpr int kExitSuccess = 0;
+inline constexpr int kExitInternalFailure = 1;
+inline constexpr int kExitBadInput = 2;
+
+/// Bad input found by a command (an option value, a config field). The message names the option
+/// or the file and field.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Runs `command` and turns exceptions into the exit-status contract, writing to `err`:
+/// DataError, InputError and std::invalid_argument -> "error: <message>", exit 2;
+/// any other exception -> "internal error: <message>", exit 1.
+int run_reporting_errors(const std::function<int()>& command, std::ostream& err);
+
+}  // namespace gpilqg

@@ -1,0 +1,21 @@
+#pragma once
+/// @file commands.hpp
+/// Each subcommand of the `gpilqg` program registers itself on the CLI11 application and, when the
+/// user selects it, stores the action to run in `action`. main() runs that action under
+/// run_reporting_errors, so every command shares one exit-status contract.
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace gpilqg::cli {
+
+using CommandAction = std::function<int()>;
+
+/// `gpilqg data info FILE --system NAME [--json]`
+void add_data_command(CLI::App& app, CommandAction& action);
+
+/// `gpilqg simulate --system NAME --out FILE [...]`
+void add_simulate_command(CLI::App& app, CommandAction& action);
+
+}  // namespace gpilqg::cli

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Set up a fresh Debian machine, build gpilqg, and run either the main job or the whole test suite.
+#
+#   bash scripts/bootstrap.sh run    install what is missing, build, run the main job
+#   bash scripts/bootstrap.sh test   install what is missing, build, run every test
+#
+# Packages come from Debian only (DESIGN.md section 10); apt-get runs as root or through sudo, and
+# only when something is missing. The build goes to build/ (Release, tests on).
+set -euo pipefail
+mode="${1:-}"
+case "$mode" in run|test) ;; *) echo "usage: bash scripts/bootstrap.sh run|test" >&2; exit 2 ;; esac
+cd "$(dirname "$0")/.."
+
+packages=(
+  cmake make g++ pkg-config
+  libeigen3-dev libsuitesparse-dev libnlopt-cxx-dev libhdf5-dev libbenchmark-dev libgtest-dev
+  libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev python3-h5py python3-matplotlib
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "== installing: ${missing[*]}"
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+jobs="$(nproc)"
+echo "== configuring and building (build/, Release, $jobs jobs)"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DGPILQG_BUILD_TESTS=ON -DGPILQG_BUILD_BENCH=ON
+cmake --build build -j"$jobs"
+
+if [ "$mode" = run ]; then
+  exec bash scripts/main_job.sh build/experiments/gpilqg
+fi
+echo "== running the test suite"
+ctest --test-dir build --output-on-failure -j"$jobs" --timeout 600

@@ -1,0 +1,50 @@
+#pragma once
+/// @file test_support.hpp
+/// Shared helpers for the test suites: one matrix-compare assertion, reference-file paths, CSV
+/// loading of reference numbers, and central-difference checks of analytic derivatives.
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "gpilqg/core/types.hpp"
+
+namespace gpilqg::test {
+
+/// ../shared beside the repository (reference numbers and benchmark data).
+std::filesystem::path shared_dir();
+/// The repository root.
+std::filesystem::path source_dir();
+/// A fresh empty temporary folder for one test, removed by the caller or left for inspection.
+std::filesystem::path temporary_dir(const std::string& label);
+
+/// Reads a headerless numeric CSV (as in shared/reference) into a matrix.
+Matrix read_numeric_csv(const std::filesystem::path& file);
+
+/// Passes when |actual - expected| <= abs_tol + rel_tol * |expected| elementwise and the shapes agree;
+/// the failure message shows the worst entry and both matrices.
+::testing::AssertionResult matrices_near(const Matrix& actual, const Matrix& expected, double abs_tol,
+                                         double rel_tol = 0.0);
+
+/// Central-difference Jacobian of g at x with absolute step h (a test-side twin, independent of the
+/// library's finite_difference.hpp so the two check each other).
+Matrix numeric_jacobian(const std::function<Vector(const Vector&)>& g, const Vector& x, double h);
+
+/// Random vector with entries uniform in [lo, hi], from a fixed-seed generator per call site.
+Vector random_vector(int size, double lo, double hi, unsigned seed);
+
+/// Runs the gpilqg program with `arguments` (shell-quoted by the caller), capturing stdout and
+/// stderr separately; returns the exit status.
+struct CommandResult {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+CommandResult run_cli(const std::string& arguments);
+
+}  // namespace gpilqg::test
+
+#define EXPECT_MATRIX_NEAR(actual, expected, abs_tol) \
+  EXPECT_TRUE(::gpilqg::test::matrices_near((actual), (expected), (abs_tol)))
