@@ -1,0 +1,56 @@
+#pragma once
+/// @file ddp_summary.hpp
+/// What a solve did: why it stopped, the per-iteration trace, and where the time went.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace gpilqg {
+
+enum class DdpTermination {
+  CostChange,          ///< an accepted step improved the cost by less than cost_tolerance
+  GradientNorm,        ///< the projected gradient fell below gradient_tolerance
+  MaxIterations,       ///< max_iterations reached
+  WallTime,            ///< max_seconds reached
+  RegularizationLimit, ///< no acceptable step even at lambda_max (numerical trouble or a local minimum)
+  InitialRolloutDiverged,  ///< the initial controls drive the model to non-finite states
+};
+
+std::string_view to_string(DdpTermination termination);
+/// True for the terminations that mean convergence (CostChange, GradientNorm).
+bool converged(DdpTermination termination);
+
+struct DdpIteration {
+  int iteration = 0;
+  double cost = 0.0;                ///< merit (expected cost) after the iteration
+  double lambda = 0.0;              ///< regularisation used by the accepted backward pass
+  double step = 0.0;                ///< accepted line-search step (0 when rejected)
+  double expected_reduction = 0.0;  ///< predicted by the quadratic model for that step
+  double actual_reduction = 0.0;    ///< achieved (0 when rejected)
+  double gradient_norm = 0.0;       ///< max |projected dJ/du| at the start of the iteration
+  int backward_failures = 0;        ///< backward passes rejected (non-PD Quu) before this one passed
+  bool accepted = false;
+};
+
+struct DdpTimings {
+  double derivatives_s = 0.0;  ///< model and cost derivatives along the trajectory
+  double backward_s = 0.0;     ///< backward passes (including rejected ones)
+  double forward_s = 0.0;      ///< forward passes of the line search
+  double total_s = 0.0;        ///< the whole solve
+};
+
+struct DdpSummary {
+  DdpTermination termination = DdpTermination::MaxIterations;
+  int iterations = 0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;         ///< the merit at the returned trajectory
+  double final_gradient_norm = 0.0;
+  std::vector<DdpIteration> trace;
+  DdpTimings timings;
+
+  /// One line, e.g. "ilqr: gradient_norm after 139 iterations, cost 5.70e+02 -> 6.45e-01, |g| 9.1e-09, 4.2 ms".
+  std::string report(std::string_view label) const;
+};
+
+}  // namespace gpilqg

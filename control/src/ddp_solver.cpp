@@ -1,0 +1,497 @@
+#include "gpilqg/control/ddp_solver.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Cholesky>
+
+#include "gpilqg/control/box_qp.hpp"
+
+namespace gpilqg {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Columns c_i = sqrt(dt) F^(i) (and G^(j)) with their derivatives, as the Q-expansion uses them.
+void scale_columns(DiffusionColumns& d, double factor) {
+  d.columns *= factor;
+  for (auto& m : d.d_dx) m *= factor;
+  for (auto& m : d.d_du) m *= factor;
+}
+
+}  // namespace
+
+/// Every per-step buffer of one problem shape (n, m, T, p + q diffusion columns).
+struct DdpWorkspace {
+  int n = -1, m = -1, T = -1;
+
+  AffinePolicy policy;         ///< x_bar, u_bar (the current nominal), k, K, limits
+  Matrix x_new, u_new;         ///< the line-search candidate
+  std::vector<StepJacobians> jac;
+  std::vector<CostDerivatives> cost;       ///< T stages + the terminal at index T
+  std::vector<DiffusionColumns> noise;     ///< sqrt(dt) F at each step (iLQG, Robust-iLQG)
+  std::vector<DiffusionColumns> uncertainty;  ///< sqrt(dt) G at each step (Robust-iLQG)
+  std::vector<Matrix> S;                   ///< V_xx at t = 0..T from the last backward pass
+  DiffusionColumns candidate_columns;      ///< columns at a line-search candidate (no derivatives)
+
+  // Backward-pass temporaries.
+  Vector Vx, Qx, Qu, Sc, p, p_next, dx, grad;
+  Matrix Vxx, Qxx, Quu, Qux, Quu_reg, Qux_reg, SA, SB, S_reg, Sc_x;
+  Eigen::LLT<Matrix> llt;
+  BoxQpResult qp;
+  Vector lower, upper, qp_warm, step_lower, step_upper;
+
+  void resize(int n_, int m_, int T_) {
+    if (n_ == n && m_ == m && T_ == T) return;
+    n = n_;
+    m = m_;
+    T = T_;
+    policy.x_bar.setZero(n, T + 1);
+    policy.u_bar.setZero(m, T);
+    policy.k.setZero(m, T);
+    policy.K.assign(static_cast<std::size_t>(T), Matrix::Zero(m, n));
+    x_new.setZero(n, T + 1);
+    u_new.setZero(m, T);
+    jac.resize(static_cast<std::size_t>(T));
+    for (auto& j : jac) j.resize(n, m);
+    cost.resize(static_cast<std::size_t>(T + 1));
+    for (auto& c : cost) c.resize(n, m);
+    noise.resize(static_cast<std::size_t>(T));
+    uncertainty.resize(static_cast<std::size_t>(T));
+    S.assign(static_cast<std::size_t>(T + 1), Matrix::Zero(n, n));
+    for (Vector* v : {&Vx, &Qx, &Sc, &p, &p_next, &dx}) v->setZero(n);
+    for (Vector* v : {&Qu, &grad, &lower, &upper, &qp_warm, &step_lower, &step_upper}) v->setZero(m);
+    for (Matrix* a : {&Vxx, &Qxx, &SA, &S_reg, &Sc_x}) a->setZero(n, n);
+    for (Matrix* a : {&Quu, &Quu_reg}) a->setZero(m, m);
+    for (Matrix* a : {&Qux, &Qux_reg}) a->setZero(m, n);
+    SB.setZero(n, m);
+  }
+};
+
+DdpSolver::DdpSolver(DdpOptions options) : options_(options), ws_(std::make_unique<DdpWorkspace>()) {
+  options_.validate();
+}
+DdpSolver::~DdpSolver() = default;
+DdpSolver::DdpSolver(DdpSolver&&) noexcept = default;
+DdpSolver& DdpSolver::operator=(DdpSolver&&) noexcept = default;
+
+void DdpSolver::set_options(DdpOptions options) {
+  options.validate();
+  options_ = options;
+}
+
+namespace {
+
+/// The state of one solve: the problem, the options, the workspace and the bookkeeping of the
+/// regularisation schedule. Kept out of the header so the public type stays small.
+class Engine {
+ public:
+  Engine(const DdpProblem& problem, const DdpOptions& options, DdpWorkspace& ws)
+      : pb_(problem), opt_(options), ws_(ws), model_(*problem.model), cost_(*problem.cost) {}
+
+  DdpResult run(const Matrix& initial_controls);
+
+ private:
+  bool uses_noise() const { return opt_.variant != DdpVariant::ILQR; }
+  bool uses_uncertainty() const { return opt_.variant == DdpVariant::RobustILQG; }
+
+  /// Rolls out `policy` with feed-forward scale alpha into (x_out, u_out); returns the merit with the
+  /// stored S (trace terms included for iLQG variants), or +inf when the rollout diverges.
+  double forward(double alpha, Matrix& x_out, Matrix& u_out);
+  /// Derivatives of model, cost and diffusion columns along the nominal trajectory.
+  void differentiate();
+  /// One backward pass with regularisation lambda. False when a Q_uu block is not positive definite.
+  bool backward(double lambda);
+  void increase_lambda();
+  void decrease_lambda();
+  /// sum_i 0.5 c_i' S c_i for the columns at one step.
+  static double trace_term(const DiffusionColumns& d, const Matrix& S, Vector& Sc);
+
+  const DdpProblem& pb_;
+  const DdpOptions& opt_;
+  DdpWorkspace& ws_;
+  const StepModel& model_;
+  const Cost& cost_;
+
+  double lambda_ = 0.0;
+  double dlambda_ = 1.0;
+  // Results of the last backward pass.
+  double dV1_ = 0.0, dV2_ = 0.0;
+  double merit_at_nominal_ = 0.0;   ///< nominal cost + trace terms with the new S
+  double nominal_cost_ = 0.0;
+  double gradient_norm_ = 0.0;
+};
+
+double Engine::trace_term(const DiffusionColumns& d, const Matrix& S, Vector& Sc) {
+  double sum = 0.0;
+  for (int i = 0; i < d.count(); ++i) {
+    Sc.noalias() = S * d.columns.col(i);
+    sum += 0.5 * d.columns.col(i).dot(Sc);
+  }
+  return sum;
+}
+
+double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
+  const int T = ws_.T;
+  const double sqrt_dt = std::sqrt(model_.dt());
+  x_out.col(0) = pb_.x0;
+  double merit = 0.0;
+  for (int t = 0; t < T; ++t) {
+    ws_.policy.control(t, x_out.col(t), u_out.col(t), alpha);
+    merit += cost_.stage(t, x_out.col(t), u_out.col(t));
+    if (uses_noise()) {
+      const auto& S_next = ws_.S[static_cast<std::size_t>(t + 1)];
+      model_.noise(x_out.col(t), u_out.col(t), ws_.candidate_columns, false);
+      ws_.candidate_columns.columns *= sqrt_dt;
+      merit += trace_term(ws_.candidate_columns, S_next, ws_.Sc);
+      if (uses_uncertainty()) {
+        model_.uncertainty(x_out.col(t), u_out.col(t), ws_.candidate_columns, false);
+        ws_.candidate_columns.columns *= sqrt_dt;
+        merit += trace_term(ws_.candidate_columns, S_next, ws_.Sc);
+      }
+    }
+    model_.step(x_out.col(t), u_out.col(t), x_out.col(t + 1));
+    if (!x_out.col(t + 1).allFinite()) return std::numeric_limits<double>::infinity();
+  }
+  merit += cost_.terminal(x_out.col(T));
+  return std::isfinite(merit) ? merit : std::numeric_limits<double>::infinity();
+}
+
+void Engine::differentiate() {
+  const int T = ws_.T;
+  const double sqrt_dt = std::sqrt(model_.dt());
+  const auto& x = ws_.policy.x_bar;
+  const auto& u = ws_.policy.u_bar;
+  for (int t = 0; t < T; ++t) {
+    const auto ts = static_cast<std::size_t>(t);
+    model_.step(x.col(t), u.col(t), ws_.x_new.col(t + 1), &ws_.jac[ts]);
+    cost_.stage(t, x.col(t), u.col(t), &ws_.cost[ts]);
+    if (uses_noise()) {
+      model_.noise(x.col(t), u.col(t), ws_.noise[ts], true);
+      scale_columns(ws_.noise[ts], sqrt_dt);
+    }
+    if (uses_uncertainty()) {
+      model_.uncertainty(x.col(t), u.col(t), ws_.uncertainty[ts], true);
+      scale_columns(ws_.uncertainty[ts], sqrt_dt);
+    }
+  }
+  cost_.terminal(x.col(T), &ws_.cost[static_cast<std::size_t>(T)]);
+}
+
+bool Engine::backward(double lambda) {
+  auto& w = ws_;
+  const int T = w.T, m = w.m;
+  const auto& terminal = w.cost[static_cast<std::size_t>(T)];
+  w.Vx = terminal.lx;
+  w.Vxx = terminal.lxx;
+  w.S[static_cast<std::size_t>(T)] = w.Vxx;
+  w.p = terminal.lx;  // costate of the merit with S held: p_t = dM/dx_t
+  dV1_ = dV2_ = 0.0;
+  nominal_cost_ = terminal.value;
+  double trace_sum = 0.0;
+  gradient_norm_ = 0.0;
+  const bool limited = pb_.has_limits();
+
+  for (int t = T - 1; t >= 0; --t) {
+    const auto ts = static_cast<std::size_t>(t);
+    const Matrix& A = w.jac[ts].A;
+    const Matrix& B = w.jac[ts].B;
+    const CostDerivatives& l = w.cost[ts];
+    const Matrix& S = w.Vxx;  // S' = V'_xx
+
+    // Deterministic part of the expansion.
+    w.SA.noalias() = S * A;
+    w.SB.noalias() = S * B;
+    w.Qx = l.lx;
+    w.Qx.noalias() += A.transpose() * w.Vx;
+    w.Qu = l.lu;
+    w.Qu.noalias() += B.transpose() * w.Vx;
+    w.Qxx = l.lxx;
+    w.Qxx.noalias() += A.transpose() * w.SA;
+    w.Qux = l.lux;
+    w.Qux.noalias() += B.transpose() * w.SA;
+    w.Quu = l.luu;
+    w.Quu.noalias() += B.transpose() * w.SB;
+    nominal_cost_ += l.value;
+
+    // Costate of the merit (deterministic part; the diffusion part is added below).
+    w.p_next = w.p;
+    w.grad = l.lu;
+    w.grad.noalias() += B.transpose() * w.p_next;
+    w.p = l.lx;
+    w.p.noalias() += A.transpose() * w.p_next;
+
+    // The variant's stochastic terms: sums over the diffusion columns (paper, q, Q, g, G, H).
+    auto add_columns = [&](const DiffusionColumns& d) {
+      for (int i = 0; i < d.count(); ++i) {
+        const auto is = static_cast<std::size_t>(i);
+        const auto c = d.columns.col(i);
+        w.Sc.noalias() = S * c;
+        trace_sum += 0.5 * c.dot(w.Sc);
+        w.Qx.noalias() += d.d_dx[is].transpose() * w.Sc;
+        w.Qu.noalias() += d.d_du[is].transpose() * w.Sc;
+        w.p.noalias() += d.d_dx[is].transpose() * w.Sc;
+        w.grad.noalias() += d.d_du[is].transpose() * w.Sc;
+        w.Sc_x.noalias() = S * d.d_dx[is];
+        w.Qxx.noalias() += d.d_dx[is].transpose() * w.Sc_x;
+        w.Qux.noalias() += d.d_du[is].transpose() * w.Sc_x;
+        w.SB.noalias() = S * d.d_du[is];
+        w.Quu.noalias() += d.d_du[is].transpose() * w.SB;
+      }
+    };
+    if (uses_noise()) add_columns(w.noise[ts]);
+    if (uses_uncertainty()) add_columns(w.uncertainty[ts]);
+
+    // Regularised blocks that determine the step.
+    if (opt_.regularization == RegularizationTarget::ControlHessian) {
+      w.Quu_reg = w.Quu;
+      w.Quu_reg.diagonal().array() += lambda;
+      w.Qux_reg = w.Qux;
+    } else {
+      w.Quu_reg = w.Quu;
+      w.Quu_reg.noalias() += lambda * (B.transpose() * B);
+      w.Qux_reg = w.Qux;
+      w.Qux_reg.noalias() += lambda * (B.transpose() * A);
+    }
+
+    // Projected gradient of the merit with respect to u_t (zero where a bound is active and the
+    // gradient pushes outwards).
+    const auto u_t = w.policy.u_bar.col(t);
+    for (int j = 0; j < m; ++j) {
+      double g = w.grad(j);
+      if (limited && ((u_t(j) <= w.lower(j) && g > 0.0) || (u_t(j) >= w.upper(j) && g < 0.0))) g = 0.0;
+      gradient_norm_ = std::max(gradient_norm_, std::abs(g));
+    }
+
+    auto k = w.policy.k.col(t);
+    Matrix& K = w.policy.K[ts];
+    if (!limited) {
+      w.llt.compute(w.Quu_reg);
+      if (w.llt.info() != Eigen::Success) return false;
+      k = -w.Qu;
+      w.llt.solveInPlace(k);
+      K = -w.Qux_reg;
+      w.llt.solveInPlace(K);
+    } else {
+      // Limits on the step: lower - u_bar <= du <= upper - u_bar, warm-started from the previous k.
+      w.qp_warm = k;
+      w.step_lower = w.lower - u_t;
+      w.step_upper = w.upper - u_t;
+      solve_box_qp(w.Quu_reg, w.Qu, w.step_lower, w.step_upper, w.qp_warm, w.qp);
+      if (!usable(w.qp.status)) return false;
+      k = w.qp.x;
+      K.setZero();
+      const auto& idx = w.qp.free_index;
+      if (idx.size() > 0) {
+        Matrix rhs(idx.size(), w.n);
+        for (Eigen::Index a = 0; a < idx.size(); ++a) rhs.row(a) = w.Qux_reg.row(idx(a));
+        const Matrix Kf = -w.qp.free_factor.solve(rhs);
+        for (Eigen::Index a = 0; a < idx.size(); ++a) K.row(idx(a)) = Kf.row(a);
+      }
+    }
+
+    // Value update with the unregularised blocks (Tassa et al. 2012, eq. 11).
+    dV1_ += k.dot(w.Qu);
+    dV2_ += 0.5 * k.dot(w.Quu * k);
+    w.SB.noalias() = K.transpose() * w.Quu;  // K' Q_uu (n x m), scratch
+    w.Vx = w.Qx;
+    w.Vx.noalias() += w.SB * k;
+    w.Vx.noalias() += K.transpose() * w.Qu;
+    w.Vx.noalias() += w.Qux.transpose() * k;
+    w.Vxx = w.Qxx;
+    w.Vxx.noalias() += w.SB * K;
+    w.Vxx.noalias() += K.transpose() * w.Qux;
+    w.Vxx.noalias() += w.Qux.transpose() * K;
+    w.SA = w.Vxx.transpose();  // symmetrise against round-off
+    w.Vxx += w.SA;
+    w.Vxx *= 0.5;
+    w.S[ts] = w.Vxx;
+  }
+  merit_at_nominal_ = nominal_cost_ + trace_sum;
+  return true;
+}
+
+void Engine::increase_lambda() {
+  dlambda_ = std::max(dlambda_ * opt_.lambda_factor, opt_.lambda_factor);
+  lambda_ = std::max(lambda_ * dlambda_, opt_.lambda_min);
+}
+
+void Engine::decrease_lambda() {
+  dlambda_ = std::min(dlambda_ / opt_.lambda_factor, 1.0 / opt_.lambda_factor);
+  lambda_ = lambda_ * dlambda_;
+  if (lambda_ < opt_.lambda_min) lambda_ = 0.0;
+}
+
+DdpResult Engine::run(const Matrix& initial_controls) {
+  const auto start = Clock::now();
+  auto& w = ws_;
+  const int n = model_.state_dim(), m = model_.control_dim(), T = pb_.horizon;
+  w.resize(n, m, T);
+  w.lower = pb_.u_min.size() ? pb_.u_min : Vector::Constant(m, -std::numeric_limits<double>::infinity());
+  w.upper = pb_.u_max.size() ? pb_.u_max : Vector::Constant(m, std::numeric_limits<double>::infinity());
+  w.policy.u_min = pb_.u_min.size() ? w.lower : Vector();
+  w.policy.u_max = pb_.u_max.size() ? w.upper : Vector();
+  for (auto& S : w.S) S.setZero();
+  for (auto& K : w.policy.K) K.setZero();
+  w.policy.k.setZero();
+
+  DdpResult result;
+  DdpSummary& summary = result.summary;
+  lambda_ = opt_.lambda_initial;
+  dlambda_ = 1.0;
+
+  // Initial rollout: the initial controls, clamped, open loop (K = 0, k = 0, u_bar = controls).
+  w.policy.u_bar = initial_controls.cwiseMax(w.lower.replicate(1, T)).cwiseMin(w.upper.replicate(1, T));
+  w.policy.x_bar.setZero();
+  double merit = forward(0.0, w.x_new, w.u_new);
+  if (!std::isfinite(merit)) {
+    summary.termination = DdpTermination::InitialRolloutDiverged;
+    summary.initial_cost = summary.final_cost = merit;
+    summary.timings.total_s = seconds_since(start);
+    result.trajectory.x = w.x_new;
+    result.trajectory.u = w.u_new;
+    result.policy = w.policy;
+    return result;
+  }
+  w.policy.x_bar = w.x_new;
+  summary.initial_cost = merit;
+
+  const double log_first = 0.0, log_last = -3.0;
+  bool stop = false;
+  for (int iter = 1; iter <= opt_.max_iterations && !stop; ++iter) {
+    DdpIteration record;
+    record.iteration = iter;
+
+    auto t0 = Clock::now();
+    differentiate();
+    summary.timings.derivatives_s += seconds_since(t0);
+
+    // Backward pass, raising the regularisation until every Q_uu block is positive definite.
+    t0 = Clock::now();
+    bool backward_ok = false;
+    while (!backward_ok) {
+      backward_ok = backward(lambda_);
+      if (!backward_ok) {
+        ++record.backward_failures;
+        increase_lambda();
+        if (lambda_ > opt_.lambda_max) break;
+      }
+    }
+    summary.timings.backward_s += seconds_since(t0);
+    record.lambda = lambda_;
+    record.gradient_norm = gradient_norm_;
+    merit = merit_at_nominal_;  // the current trajectory's merit under the new S
+    if (iter == 1) summary.initial_cost = merit;
+    if (!backward_ok) {
+      record.cost = merit;
+      summary.trace.push_back(record);
+      summary.termination = DdpTermination::RegularizationLimit;
+      break;
+    }
+    if (gradient_norm_ < opt_.gradient_tolerance) {
+      record.cost = merit;
+      summary.trace.push_back(record);
+      summary.termination = DdpTermination::GradientNorm;
+      break;
+    }
+
+    // Line search on the ratio of actual to expected reduction.
+    t0 = Clock::now();
+    bool accepted = false;
+    double new_merit = merit;
+    for (int s = 0; s < opt_.line_search_steps && !accepted; ++s) {
+      const double exponent =
+          opt_.line_search_steps == 1 ? log_first
+                                      : log_first + (log_last - log_first) * s / (opt_.line_search_steps - 1);
+      const double alpha = std::pow(10.0, exponent);
+      new_merit = forward(alpha, w.x_new, w.u_new);
+      const double expected = -(alpha * dV1_ + alpha * alpha * dV2_);
+      const double actual = merit - new_merit;
+      if (!std::isfinite(new_merit)) continue;
+      const double ratio = expected > 0.0 ? actual / expected : (actual > 0.0 ? 1.0 : -1.0);
+      if (ratio > opt_.min_reduction_ratio) {
+        accepted = true;
+        record.step = alpha;
+        record.expected_reduction = expected;
+        record.actual_reduction = actual;
+      }
+    }
+    summary.timings.forward_s += seconds_since(t0);
+
+    if (accepted) {
+      w.policy.x_bar.swap(w.x_new);
+      w.policy.u_bar.swap(w.u_new);
+      decrease_lambda();
+      record.accepted = true;
+      record.cost = new_merit;
+      summary.trace.push_back(record);
+      if (record.actual_reduction <= opt_.cost_tolerance * std::max(std::abs(merit), 1e-12)) {
+        summary.termination = DdpTermination::CostChange;
+        stop = true;
+      }
+      merit = new_merit;
+    } else {
+      increase_lambda();
+      record.cost = merit;
+      summary.trace.push_back(record);
+      if (lambda_ > opt_.lambda_max) {
+        summary.termination = DdpTermination::RegularizationLimit;
+        stop = true;
+      }
+    }
+    if (!stop && seconds_since(start) > opt_.max_seconds) {
+      summary.termination = DdpTermination::WallTime;
+      stop = true;
+    }
+    if (!stop && iter == opt_.max_iterations) summary.termination = DdpTermination::MaxIterations;
+  }
+  summary.iterations = static_cast<int>(summary.trace.size());
+
+  // Gains, value Hessians and expected cost at the returned trajectory: one more backward pass there
+  // (with the smallest regularisation that works, starting from none).
+  auto t0 = Clock::now();
+  differentiate();
+  summary.timings.derivatives_s += seconds_since(t0);
+  t0 = Clock::now();
+  double final_lambda = 0.0;
+  while (!backward(final_lambda) && final_lambda <= opt_.lambda_max)
+    final_lambda = std::max(final_lambda * 10.0, opt_.lambda_min);
+  summary.timings.backward_s += seconds_since(t0);
+  summary.final_gradient_norm = gradient_norm_;
+  summary.final_cost = merit_at_nominal_;
+
+  result.trajectory.x = w.policy.x_bar;
+  result.trajectory.u = w.policy.u_bar;
+  result.policy = w.policy;
+  result.policy.k.setZero();
+  result.nominal_cost = nominal_cost_;
+  result.expected_cost = merit_at_nominal_;
+  result.value_hessians = w.S;
+  summary.timings.total_s = seconds_since(start);
+  return result;
+}
+
+}  // namespace
+
+DdpResult DdpSolver::solve(const DdpProblem& problem, const Matrix& initial_controls) {
+  problem.validate();
+  if (initial_controls.rows() != problem.model->control_dim() || initial_controls.cols() != problem.horizon)
+    throw std::invalid_argument("initial controls are " + std::to_string(initial_controls.rows()) + "x" +
+                                std::to_string(initial_controls.cols()) + "; expected " +
+                                std::to_string(problem.model->control_dim()) + "x" +
+                                std::to_string(problem.horizon) + " (m x T)");
+  if (!initial_controls.allFinite()) throw std::invalid_argument("initial controls contain non-finite values");
+  Engine engine(problem, options_, *ws_);
+  return engine.run(initial_controls);
+}
+
+}  // namespace gpilqg

@@ -1,0 +1,32 @@
+#include "gpilqg/control/ddp_summary.hpp"
+
+#include <cstdio>
+
+namespace gpilqg {
+
+std::string_view to_string(DdpTermination termination) {
+  switch (termination) {
+    case DdpTermination::CostChange: return "cost_change";
+    case DdpTermination::GradientNorm: return "gradient_norm";
+    case DdpTermination::MaxIterations: return "max_iterations";
+    case DdpTermination::WallTime: return "wall_time";
+    case DdpTermination::RegularizationLimit: return "regularization_limit";
+    case DdpTermination::InitialRolloutDiverged: return "initial_rollout_diverged";
+  }
+  return "?";
+}
+
+bool converged(DdpTermination termination) {
+  return termination == DdpTermination::CostChange || termination == DdpTermination::GradientNorm;
+}
+
+std::string DdpSummary::report(std::string_view label) const {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, "%.*s: %.*s after %d iterations, cost %.6e -> %.12e, |g| %.1e, %.2f ms",
+                static_cast<int>(label.size()), label.data(),
+                static_cast<int>(to_string(termination).size()), to_string(termination).data(), iterations,
+                initial_cost, final_cost, final_gradient_norm, 1e3 * timings.total_s);
+  return buffer;
+}
+
+}  // namespace gpilqg
