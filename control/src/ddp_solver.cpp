@@ -41,6 +41,7 @@ struct DdpWorkspace {
   std::vector<DiffusionColumns> noise;     ///< sqrt(dt) F at each step (iLQG, Robust-iLQG)
   std::vector<DiffusionColumns> uncertainty;  ///< sqrt(dt) G at each step (Robust-iLQG)
   std::vector<Matrix> S;                   ///< V_xx at t = 0..T from the last backward pass
+  Matrix gradient;                         ///< dM/du_t (m x T) from the last backward pass
   DiffusionColumns candidate_columns;      ///< columns at a line-search candidate (no derivatives)
 
   // Backward-pass temporaries.
@@ -68,6 +69,7 @@ struct DdpWorkspace {
     noise.resize(static_cast<std::size_t>(T));
     uncertainty.resize(static_cast<std::size_t>(T));
     S.assign(static_cast<std::size_t>(T + 1), Matrix::Zero(n, n));
+    gradient.setZero(m, T);
     for (Vector* v : {&Vx, &Qx, &Sc, &p, &p_next, &dx}) v->setZero(n);
     for (Vector* v : {&Qu, &grad, &lower, &upper, &qp_warm, &step_lower, &step_upper}) v->setZero(m);
     for (Matrix* a : {&Vxx, &Qxx, &SA, &S_reg, &Sc_x}) a->setZero(n, n);
@@ -265,6 +267,7 @@ bool Engine::backward(double lambda) {
 
     // Projected gradient of the merit with respect to u_t (zero where a bound is active and the
     // gradient pushes outwards).
+    w.gradient.col(t) = w.grad;
     const auto u_t = w.policy.u_bar.col(t);
     for (int j = 0; j < m; ++j) {
       double g = w.grad(j);
@@ -476,6 +479,7 @@ DdpResult Engine::run(const Matrix& initial_controls) {
   result.nominal_cost = nominal_cost_;
   result.expected_cost = merit_at_nominal_;
   result.value_hessians = w.S;
+  result.gradient = w.gradient;
   summary.timings.total_s = seconds_since(start);
   return result;
 }

@@ -23,6 +23,11 @@ double AffinePolicy::distance(const AffinePolicy& other) const {
   return d;
 }
 
+RolloutNoise PolicyRolloutSettings::noise() const {
+  if (uncertainty) return process_noise ? RolloutNoise::ProcessAndUncertainty : RolloutNoise::UncertaintyOnly;
+  return process_noise ? RolloutNoise::Process : RolloutNoise::None;
+}
+
 PolicyRollout rollout_policy(const StepModel& world, const AffinePolicy& policy, const VectorCRef& x0,
                              const PolicyRolloutSettings& settings, std::mt19937_64& rng) {
   const int n = world.state_dim(), m = world.control_dim(), T = policy.horizon();
@@ -35,9 +40,6 @@ PolicyRollout rollout_policy(const StepModel& world, const AffinePolicy& policy,
     throw std::invalid_argument("policy rollout: observation_std has " +
                                 std::to_string(settings.observation_std.size()) + " entries; expected " +
                                 std::to_string(n));
-  std::normal_distribution<double> normal(0.0, 1.0);
-  const double sqrt_dt = std::sqrt(world.dt());
-
   PolicyRollout out;
   out.trajectory = Trajectory(n, m, T);
   out.trajectory.x.col(0) = x0;
@@ -46,20 +48,10 @@ PolicyRollout rollout_policy(const StepModel& world, const AffinePolicy& policy,
   for (int t = 0; t < T; ++t) {
     const auto x = out.trajectory.x.col(t);
     observed = x;
-    for (Eigen::Index i = 0; i < settings.observation_std.size(); ++i)
-      observed(i) += settings.observation_std(i) * normal(rng);
+    add_observation_noise(settings.observation_std, rng, observed);
     auto u = out.trajectory.u.col(t);
     policy.control(t, observed, u);
-    world.step(x, u, next);
-    if (settings.process_noise) {
-      world.noise(x, u, columns, false);
-      for (int i = 0; i < columns.count(); ++i) next += (sqrt_dt * normal(rng)) * columns.columns.col(i);
-    }
-    if (settings.uncertainty) {
-      world.uncertainty(x, u, columns, false);
-      for (int i = 0; i < columns.count(); ++i) next += (sqrt_dt * normal(rng)) * columns.columns.col(i);
-    }
-    if (!next.allFinite()) {
+    if (!sample_step(world, x, u, settings.noise(), columns, &rng, next)) {
       out.finite = false;
       for (int s = t + 1; s <= T; ++s) out.trajectory.x.col(s) = x;
       return out;

@@ -6,15 +6,32 @@
 
 namespace gpilqg {
 
-namespace {
-
-/// Adds sqrt(dt) * columns * xi with fresh standard normal draws.
-void add_sampled(const DiffusionColumns& terms, double sqrt_dt, std::mt19937_64& rng, VectorRef x) {
-  std::normal_distribution<double> normal(0.0, 1.0);
-  for (int i = 0; i < terms.count(); ++i) x += (sqrt_dt * normal(rng)) * terms.columns.col(i);
+bool sample_step(const StepModel& model, const VectorCRef& x, const VectorCRef& u, RolloutNoise noise,
+                 DiffusionColumns& scratch, std::mt19937_64* rng, VectorRef x_next) {
+  model.step(x, u, x_next);
+  if (noise != RolloutNoise::None) {
+    if (rng == nullptr) throw std::invalid_argument("sample_step: a random generator is needed to sample noise");
+    std::normal_distribution<double> normal(0.0, 1.0);
+    const double sqrt_dt = std::sqrt(model.dt());
+    auto add_columns = [&] {
+      for (int i = 0; i < scratch.count(); ++i) x_next += (sqrt_dt * normal(*rng)) * scratch.columns.col(i);
+    };
+    if (noise != RolloutNoise::UncertaintyOnly) {
+      model.noise(x, u, scratch, false);
+      add_columns();
+    }
+    if (noise == RolloutNoise::ProcessAndUncertainty || noise == RolloutNoise::UncertaintyOnly) {
+      model.uncertainty(x, u, scratch, false);
+      add_columns();
+    }
+  }
+  return x_next.allFinite();
 }
 
-}  // namespace
+void add_observation_noise(const Vector& std, std::mt19937_64& rng, VectorRef x) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (Eigen::Index i = 0; i < std.size(); ++i) x(i) += std(i) * normal(rng);
+}
 
 RolloutResult rollout(const StepModel& model, const VectorCRef& x0, const Matrix& u, RolloutNoise noise,
                       std::mt19937_64* rng) {
@@ -34,21 +51,11 @@ RolloutResult rollout(const StepModel& model, const VectorCRef& x0, const Matrix
   result.trajectory = Trajectory(n, m, T);
   result.trajectory.u = u;
   result.trajectory.x.col(0) = x0;
-  const double sqrt_dt = std::sqrt(model.dt());
   DiffusionColumns terms;
   Vector next(n);
   for (int t = 0; t < T; ++t) {
     const auto x = result.trajectory.x.col(t);
-    model.step(x, u.col(t), next);
-    if (noise != RolloutNoise::None) {
-      model.noise(x, u.col(t), terms, false);
-      add_sampled(terms, sqrt_dt, *rng, next);
-      if (noise == RolloutNoise::ProcessAndUncertainty) {
-        model.uncertainty(x, u.col(t), terms, false);
-        add_sampled(terms, sqrt_dt, *rng, next);
-      }
-    }
-    if (!next.allFinite()) {
+    if (!sample_step(model, x, u.col(t), noise, terms, rng, next)) {
       result.finite = false;
       for (int s = t + 1; s <= T; ++s) result.trajectory.x.col(s) = x;
       return result;

@@ -1,5 +1,6 @@
 #include "gpilqg/core/cost.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -77,19 +78,15 @@ QuadraticCost QuadraticCost::tracking(double dt, Matrix Q, Matrix R, Matrix Qf, 
 }
 
 Eigen::Ref<const Vector> QuadraticCost::state_reference(int t) const {
+  if (t < 0) throw std::out_of_range("state reference step " + std::to_string(t) + " is negative");
   if (!tracking_) return x_ref_.col(0);
-  if (t < 0 || t >= x_ref_.cols())
-    throw std::out_of_range("state reference step " + std::to_string(t) + " outside 0.." +
-                            std::to_string(x_ref_.cols() - 1));
-  return x_ref_.col(t);
+  return x_ref_.col(std::min<Eigen::Index>(t, x_ref_.cols() - 1));
 }
 
 Eigen::Ref<const Vector> QuadraticCost::control_reference(int t) const {
+  if (t < 0) throw std::out_of_range("control reference step " + std::to_string(t) + " is negative");
   if (!tracking_) return u_ref_.col(0);
-  if (t < 0 || t >= u_ref_.cols())
-    throw std::out_of_range("control reference step " + std::to_string(t) + " outside 0.." +
-                            std::to_string(u_ref_.cols() - 1));
-  return u_ref_.col(t);
+  return u_ref_.col(std::min<Eigen::Index>(t, u_ref_.cols() - 1));
 }
 
 double QuadraticCost::stage(int t, const VectorCRef& x, const VectorCRef& u,
@@ -112,8 +109,11 @@ double QuadraticCost::stage(int t, const VectorCRef& x, const VectorCRef& u,
 }
 
 double QuadraticCost::terminal(const VectorCRef& x, CostDerivatives* derivatives) const {
-  const int T = tracking_ ? static_cast<int>(x_ref_.cols()) - 1 : 0;
-  const Vector e = x - state_reference(T);
+  return terminal_at(tracking_ ? static_cast<int>(x_ref_.cols()) - 1 : 0, x, derivatives);
+}
+
+double QuadraticCost::terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives) const {
+  const Vector e = x - state_reference(t);
   const Vector Qe = Qf_ * e;
   const double value = 0.5 * e.dot(Qe);
   if (derivatives) {

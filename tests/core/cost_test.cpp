@@ -91,7 +91,11 @@ TEST(Cost, TrackingUsesTheReferenceOfEachStep) {
   EXPECT_DOUBLE_EQ(cost.stage(1, x_ref.col(0), u_ref.col(1)), 0.5 * 0.5 * 2.0);  // |e1 - e2|^2 = 2
   EXPECT_DOUBLE_EQ(cost.terminal(x_ref.col(2)), 0.0);
   EXPECT_DOUBLE_EQ(cost.terminal(x_ref.col(0)), 0.5 * 2.0);
-  EXPECT_THROW(cost.stage(2, x_ref.col(0), u_ref.col(0)), std::out_of_range);
+  // Past the end the final reference is held (receding-horizon windows run past the task).
+  EXPECT_DOUBLE_EQ(cost.stage(5, x_ref.col(2), u_ref.col(1)), 0.0);
+  EXPECT_DOUBLE_EQ(cost.terminal_at(1, x_ref.col(1)), 0.0);
+  EXPECT_DOUBLE_EQ(cost.terminal_at(9, x_ref.col(0)), 1.0);
+  EXPECT_THROW(cost.stage(-1, x_ref.col(0), u_ref.col(0)), std::out_of_range);
 }
 
 TEST(Cost, StraightLineReferenceRunsFromStartToGoal) {

@@ -43,6 +43,10 @@ struct DdpResult {
   double nominal_cost = 0.0;    ///< l_T(x_T) + sum_t l_t(x_t, u_t) along the nominal trajectory
   double expected_cost = 0.0;   ///< nominal_cost plus the trace terms: the predicted E[J] of the policy
   std::vector<Matrix> value_hessians;  ///< S_t = V_xx at t = 0..T along the returned trajectory
+  /// dM/du_t (m x T) at the returned trajectory, M the merit with S = value_hessians held fixed:
+  /// M(u) = l_T(x_T) + sum_t [ l_t(x_t, u_t) + 0.5 sum_i c_i(x_t, u_t)' S_{t+1} c_i(x_t, u_t) ] along the
+  /// open-loop rollout of u. Not projected onto the limits (the summary's gradient norm is).
+  Matrix gradient;
 };
 
 /// The per-step buffers of one problem shape (defined in ddp_solver.cpp).

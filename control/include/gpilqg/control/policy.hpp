@@ -10,6 +10,7 @@
 
 #include <random>
 
+#include "gpilqg/control/rollout.hpp"
 #include "gpilqg/control/trajectory.hpp"
 #include "gpilqg/core/step_model.hpp"
 
@@ -34,6 +35,8 @@ struct PolicyRolloutSettings {
   bool process_noise = true;      ///< sample the model's noise columns F
   bool uncertainty = false;       ///< also sample its uncertainty columns G
   Vector observation_std;         ///< the policy sees x + N(0, diag(std^2)) (empty: exact state)
+  /// What sample_step draws, from the two flags above.
+  RolloutNoise noise() const;
 };
 
 /// Runs the policy in closed loop on `world` from x0 (the world may differ from the model the policy

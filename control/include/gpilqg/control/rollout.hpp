@@ -17,13 +17,14 @@ enum class RolloutNoise {
   None,                    ///< the mean step only
   Process,                 ///< process noise F
   ProcessAndUncertainty,   ///< F and the model-uncertainty columns G
+  UncertaintyOnly,         ///< the model-uncertainty columns G alone
 };
 
 /// Rolls `model` out from x0 under the controls u (m x T). `rng` must be non-null unless
-/// noise == None. Throws std::invalid_argument when sizes do not match the model. Stops early and
-/// returns false when a state becomes non-finite (a diverging rollout); the states reached so far
-/// are kept and the rest are left as NaN-free copies of the last finite state, with `steps_completed`
-/// telling how far it went.
+/// noise == None. Throws std::invalid_argument when sizes do not match the model. When a state becomes
+/// non-finite (a diverging rollout) it stops with finite = false: the states reached so far are kept,
+/// the remaining columns repeat the last finite state (so no NaN is ever returned), and
+/// `steps_completed` tells how far it went.
 struct RolloutResult {
   Trajectory trajectory;
   int steps_completed = 0;
@@ -32,5 +33,15 @@ struct RolloutResult {
 
 RolloutResult rollout(const StepModel& model, const VectorCRef& x0, const Matrix& u,
                       RolloutNoise noise = RolloutNoise::None, std::mt19937_64* rng = nullptr);
+
+/// One sampled step, the shared mechanism of every simulated rollout in the project:
+///   x' = phi(x, u) [+ sqrt(dt) F(x, u) xi] [+ sqrt(dt) G(x, u) xi_G]
+/// as `noise` selects (None: the mean step; rng may then be null). `scratch` holds the columns
+/// between calls. Returns false when x' is not finite (a diverging rollout).
+bool sample_step(const StepModel& model, const VectorCRef& x, const VectorCRef& u, RolloutNoise noise,
+                 DiffusionColumns& scratch, std::mt19937_64* rng, VectorRef x_next);
+
+/// Adds N(0, diag(std^2)) to x (a measurement of the state); no-op when `std` is empty.
+void add_observation_noise(const Vector& std, std::mt19937_64& rng, VectorRef x);
 
 }  // namespace gpilqg

@@ -41,6 +41,12 @@ class Cost {
                        CostDerivatives* derivatives = nullptr) const = 0;
   /// l_T(x); fills lx and lxx of `derivatives` when not null.
   virtual double terminal(const VectorCRef& x, CostDerivatives* derivatives = nullptr) const = 0;
+  /// The terminal cost of a horizon that ends at step t (used by receding-horizon windows); the
+  /// default ignores t.
+  virtual double terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives = nullptr) const {
+    (void)t;
+    return terminal(x, derivatives);
+  }
 };
 
 class QuadraticCost final : public Cost {
@@ -57,11 +63,16 @@ class QuadraticCost final : public Cost {
   double stage(int t, const VectorCRef& x, const VectorCRef& u,
                CostDerivatives* derivatives = nullptr) const override;
   double terminal(const VectorCRef& x, CostDerivatives* derivatives = nullptr) const override;
+  /// 0.5 e' Qf e with e = x - x_ref(t) (the reference held at its final value past its end).
+  double terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives = nullptr) const override;
 
-  /// The state reference at step t (the goal when regulating).
+  /// The state reference at step t (the goal when regulating). Past the end of a tracking reference
+  /// its final value is held, so receding-horizon windows may extend beyond the task. t < 0 throws.
   Eigen::Ref<const Vector> state_reference(int t) const;
-  /// The control reference at step t (zero when regulating).
+  /// The control reference at step t (zero when regulating), held at its final value past the end.
   Eigen::Ref<const Vector> control_reference(int t) const;
+  /// Number of stages of a tracking reference (0 when regulating).
+  int reference_horizon() const { return tracking_ ? static_cast<int>(u_ref_.cols()) : 0; }
 
  private:
   QuadraticCost(double dt, Matrix Q, Matrix R, Matrix Qf, Matrix x_ref, Matrix u_ref, bool tracking);
