@@ -162,7 +162,12 @@ double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
       }
     }
     model_.step(x_out.col(t), u_out.col(t), x_out.col(t + 1));
-    if (!x_out.col(t + 1).allFinite()) return std::numeric_limits<double>::infinity();
+    if (!x_out.col(t + 1).allFinite()) {
+      // Diverged: keep the candidate NaN-free (the last finite state repeated) and reject it.
+      for (int s = t + 1; s <= T; ++s) x_out.col(s) = x_out.col(t);
+      for (int s = t + 1; s < T; ++s) u_out.col(s) = u_out.col(t);
+      return std::numeric_limits<double>::infinity();
+    }
   }
   merit += cost_.terminal(x_out.col(T));
   return std::isfinite(merit) ? merit : std::numeric_limits<double>::infinity();
