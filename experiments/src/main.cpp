@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   gpilqg::cli::CommandAction action;
   gpilqg::cli::add_data_command(app, action);
+  gpilqg::cli::add_solve_command(app, action);
   gpilqg::cli::add_simulate_command(app, action);
 
   try {

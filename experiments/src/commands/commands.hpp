@@ -15,6 +15,9 @@ using CommandAction = std::function<int()>;
 /// `gpilqg data info FILE --system NAME [--json]`
 void add_data_command(CLI::App& app, CommandAction& action);
 
+/// `gpilqg solve CONFIG.toml [--json]`
+void add_solve_command(CLI::App& app, CommandAction& action);
+
 /// `gpilqg simulate --system NAME --out FILE [...]`
 void add_simulate_command(CLI::App& app, CommandAction& action);
 

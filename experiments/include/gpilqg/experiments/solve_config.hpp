@@ -1,0 +1,44 @@
+#pragma once
+/// @file solve_config.hpp
+/// One trajectory-optimisation problem described in TOML (DESIGN.md section 8, `gpilqg solve`):
+///
+///   [system]   name, preset ("sim"|"real"), integrator ("euler"|"rk4"), dt, substeps (optional)
+///   [noise]    actuator_additive, actuator_multiplicative (m entries), state (n entries)   optional
+///   [problem]  horizon, x0, goal, Q, R, Qf (diagonals), u_min, u_max (optional), u_init (optional, m)
+///   [solver]   algorithm ("ilqr"|"ilqg"|"robust_ilqg"), max_iterations, tolerance (relative cost
+///              change), gradient_tolerance, regularization ("control"|"value"), max_seconds (optional)
+///
+/// Running cost dt (0.5 e'Qe + 0.5 u'Ru), terminal 0.5 e'Qf e, e = x - goal. Unknown fields, wrong
+/// sizes and non-finite numbers are errors naming the file, line and field.
+
+#include <filesystem>
+#include <string>
+
+#include "gpilqg/control/ddp_solver.hpp"
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/noise.hpp"
+#include "gpilqg/core/systems.hpp"
+
+namespace gpilqg {
+
+struct SolveConfig {
+  std::string system = "cartpole";
+  Preset preset = Preset::Simulator;
+  Integrator integrator = Integrator::Euler;
+  double dt = 0.05;
+  int substeps = 1;
+  ActuatorNoise noise;
+  int horizon = 100;
+  Vector x0, goal, Q, R, Qf;
+  Vector u_min, u_max;  ///< empty: unconstrained
+  Vector u_init;        ///< constant initial control (empty: zero)
+  DdpOptions solver;
+};
+
+/// Reads and validates a config; throws InputError naming the file, line and field.
+SolveConfig read_solve_config(const std::filesystem::path& file);
+
+/// Builds the model and cost of the config and solves it.
+DdpResult solve_config(const SolveConfig& config);
+
+}  // namespace gpilqg

@@ -1,0 +1,57 @@
+/// `gpilqg solve CONFIG.toml [--json]`: one trajectory-optimisation problem from a TOML file.
+
+#include <iostream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/solve_config.hpp"
+
+namespace gpilqg::cli {
+
+namespace {
+
+std::vector<double> as_list(const VectorCRef& v) { return {v.data(), v.data() + v.size()}; }
+
+int run_solve(const std::string& file, bool json) {
+  const SolveConfig config = read_solve_config(file);
+  const DdpResult r = solve_config(config);
+  const auto& s = r.summary;
+  const Vector x_final = r.trajectory.x.col(r.trajectory.x.cols() - 1);
+  if (json) {
+    nlohmann::json out;
+    out["cost"] = r.nominal_cost;
+    out["expected_cost"] = r.expected_cost;
+    out["iterations"] = s.iterations;
+    out["termination"] = std::string(to_string(s.termination));
+    out["converged"] = converged(s.termination);
+    out["gradient_norm"] = s.final_gradient_norm;
+    out["x_final"] = as_list(x_final);
+    nlohmann::json u = nlohmann::json::array();
+    for (Eigen::Index t = 0; t < r.trajectory.u.cols(); ++t) u.push_back(as_list(r.trajectory.u.col(t)));
+    out["u"] = u;
+    out["solve_time_s"] = s.timings.total_s;
+    out["algorithm"] = std::string(to_string(config.solver.variant));
+    std::cout << out.dump() << '\n';
+  } else {
+    std::cout << s.report(to_string(config.solver.variant)) << '\n';
+    std::cout << fmt::format("cost {:.12g} (expected {:.12g}), final state [{}]\n", r.nominal_cost, r.expected_cost,
+                             fmt::join(as_list(x_final), ", "));
+  }
+  return converged(s.termination) ? kExitSuccess : kExitInternalFailure;
+}
+
+}  // namespace
+
+void add_solve_command(CLI::App& app, CommandAction& action) {
+  auto file = std::make_shared<std::string>();
+  auto json = std::make_shared<bool>(false);
+  auto* cmd = app.add_subcommand("solve", "Solve one trajectory-optimisation problem described in a TOML file");
+  cmd->add_option("CONFIG", *file, "TOML problem description (DESIGN.md section 8)")->required();
+  cmd->add_flag("--json", *json, "Print one JSON document: cost, iterations, termination, x_final, u, solve_time_s");
+  cmd->callback([&action, file, json] { action = [file, json] { return run_solve(*file, *json); }; });
+}
+
+}  // namespace gpilqg::cli

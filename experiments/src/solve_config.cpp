@@ -1,0 +1,100 @@
+#include "gpilqg/experiments/solve_config.hpp"
+
+#include <fmt/format.h>
+
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/toml_fields.hpp"
+
+namespace gpilqg {
+
+SolveConfig read_solve_config(const std::filesystem::path& file) {
+  const toml::table root = TomlFields::parse(file);
+  const TomlFields f(root, file);
+  f.only_keys("", {"system", "noise", "problem", "solver"});
+  f.require_section("system");
+  f.require_section("problem");
+  f.only_keys("system", {"name", "preset", "integrator", "dt", "substeps"});
+  f.only_keys("noise", {"actuator_additive", "actuator_multiplicative", "state"});
+  f.only_keys("problem", {"horizon", "x0", "goal", "Q", "R", "Qf", "u_min", "u_max", "u_init"});
+  f.only_keys("solver", {"algorithm", "max_iterations", "tolerance", "gradient_tolerance", "regularization",
+                         "max_seconds"});
+
+  SolveConfig c;
+  c.system = f.string("system.name");
+  SystemSignature signature;
+  try {
+    signature = system_signature(c.system);
+  } catch (const std::invalid_argument& e) {
+    f.fail("system.name", e.what());
+  }
+  const int n = static_cast<int>(signature.states.size());
+  const int m = static_cast<int>(signature.controls.size());
+
+  const std::string preset = f.string("system.preset", "sim");
+  if (auto p = parse_preset(preset)) c.preset = *p;
+  else f.fail("system.preset", fmt::format("'{}'; expected \"sim\" or \"real\"", preset));
+  const std::string integrator = f.string("system.integrator", "euler");
+  if (auto i = parse_integrator(integrator)) c.integrator = *i;
+  else f.fail("system.integrator", fmt::format("'{}'; expected \"euler\" or \"rk4\"", integrator));
+  c.dt = f.number("system.dt");
+  if (c.dt <= 0.0) f.fail("system.dt", "must be > 0");
+  c.substeps = static_cast<int>(f.integer("system.substeps", 1));
+  if (c.substeps < 1) f.fail("system.substeps", "must be >= 1");
+
+  c.noise.additive_std = f.vector("noise.actuator_additive", m, Vector());
+  c.noise.multiplicative_std = f.vector("noise.actuator_multiplicative", m, Vector());
+  c.noise.state_std = f.vector("noise.state", n, Vector());
+  for (const char* field : {"noise.actuator_additive", "noise.actuator_multiplicative", "noise.state"})
+    if (f.has(field) && (f.vector(field, -1).array() < 0.0).any()) f.fail(field, "has negative entries; expected standard deviations >= 0");
+
+  c.horizon = static_cast<int>(f.integer("problem.horizon"));
+  if (c.horizon < 1) f.fail("problem.horizon", "must be >= 1");
+  c.x0 = f.vector("problem.x0", n);
+  c.goal = f.vector("problem.goal", n);
+  c.Q = f.vector("problem.Q", n);
+  c.R = f.vector("problem.R", m);
+  c.Qf = f.vector("problem.Qf", n);
+  for (const char* field : {"problem.Q", "problem.R", "problem.Qf"})
+    if ((f.vector(field, -1).array() < 0.0).any()) f.fail(field, "has negative entries; expected weights >= 0");
+  c.u_min = f.vector("problem.u_min", m, Vector());
+  c.u_max = f.vector("problem.u_max", m, Vector());
+  if (c.u_min.size() && c.u_max.size() && (c.u_min.array() > c.u_max.array()).any())
+    f.fail("problem.u_min", "exceeds problem.u_max");
+  c.u_init = f.vector("problem.u_init", m, Vector());
+
+  const std::string algorithm = f.string("solver.algorithm", "ilqr");
+  if (auto v = parse_variant(algorithm)) c.solver.variant = *v;
+  else f.fail("solver.algorithm", fmt::format("'{}'; expected \"ilqr\", \"ilqg\" or \"robust_ilqg\"", algorithm));
+  c.solver.max_iterations = static_cast<int>(f.integer("solver.max_iterations", c.solver.max_iterations));
+  c.solver.cost_tolerance = f.number("solver.tolerance", c.solver.cost_tolerance);
+  c.solver.gradient_tolerance = f.number("solver.gradient_tolerance", c.solver.gradient_tolerance);
+  c.solver.max_seconds = f.number("solver.max_seconds", c.solver.max_seconds);
+  const std::string regularization = f.string("solver.regularization", "control");
+  if (auto r = parse_regularization(regularization)) c.solver.regularization = *r;
+  else f.fail("solver.regularization", fmt::format("'{}'; expected \"control\" or \"value\"", regularization));
+  try {
+    c.solver.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: [solver]: {}", file.string(), e.what()));
+  }
+  return c;
+}
+
+DdpResult solve_config(const SolveConfig& c) {
+  auto dynamics = make_system(c.system, c.preset, {}, c.noise);
+  IntegratedStepModel model(dynamics, c.integrator, c.dt, c.substeps);
+  const QuadraticCost cost(c.dt, c.Q.asDiagonal(), c.R.asDiagonal(), c.Qf.asDiagonal(), c.goal);
+  DdpProblem problem;
+  problem.model = &model;
+  problem.cost = &cost;
+  problem.x0 = c.x0;
+  problem.horizon = c.horizon;
+  problem.u_min = c.u_min;
+  problem.u_max = c.u_max;
+  const int m = model.control_dim();
+  const Matrix u0 = c.u_init.size() ? Matrix(c.u_init.replicate(1, c.horizon)) : Matrix(Matrix::Zero(m, c.horizon));
+  DdpSolver solver(c.solver);
+  return solver.solve(problem, u0);
+}
+
+}  // namespace gpilqg

@@ -1,0 +1,109 @@
+#include "gpilqg/experiments/toml_fields.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gpilqg/experiments/cli_errors.hpp"
+
+namespace gpilqg {
+
+toml::table TomlFields::parse(const std::filesystem::path& file) {
+  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: no such file; expected a TOML config", file.string()));
+  try {
+    return toml::parse_file(file.string());
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:line {}: {}; expected valid TOML", file.string(), e.source().begin.line,
+                                 e.description()));
+  }
+}
+
+const toml::node* TomlFields::find(const std::string& path) const {
+  return root_.at_path(path).node();
+}
+
+bool TomlFields::has(const std::string& path) const { return find(path) != nullptr; }
+
+void TomlFields::fail(const std::string& path, const std::string& problem) const {
+  const toml::node* node = find(path);
+  if (node != nullptr && node->source().begin.line > 0)
+    throw InputError(fmt::format("{}:line {}: field '{}': {}", file_.string(), node->source().begin.line, path, problem));
+  throw InputError(fmt::format("{}: field '{}': {}", file_.string(), path, problem));
+}
+
+void TomlFields::require_section(const std::string& section) const {
+  const toml::node* node = find(section);
+  if (node == nullptr || !node->is_table())
+    throw InputError(fmt::format("{}: missing section [{}]; expected it (see DESIGN.md section 8)", file_.string(), section));
+}
+
+void TomlFields::only_keys(const std::string& section, const std::vector<std::string>& allowed) const {
+  const toml::table* table = section.empty() ? &root_ : (find(section) ? find(section)->as_table() : nullptr);
+  if (table == nullptr) return;
+  for (const auto& [key, node] : *table) {
+    const std::string name(key.str());
+    if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+    const std::string path = section.empty() ? name : section + "." + name;
+    throw InputError(fmt::format("{}:line {}: unknown field '{}'; expected one of: {}", file_.string(),
+                                 node.source().begin.line, path, list));
+  }
+}
+
+std::string TomlFields::string(const std::string& path, std::optional<std::string> fallback) const {
+  const toml::node* node = find(path);
+  if (node == nullptr) {
+    if (fallback) return *fallback;
+    fail(path, "missing; expected a string");
+  }
+  if (const auto* s = node->as_string()) return s->get();
+  fail(path, "is not a string");
+}
+
+double TomlFields::number(const std::string& path, std::optional<double> fallback) const {
+  const toml::node* node = find(path);
+  if (node == nullptr) {
+    if (fallback) return *fallback;
+    fail(path, "missing; expected a number");
+  }
+  double value = 0.0;
+  if (const auto* f = node->as_floating_point()) value = f->get();
+  else if (const auto* i = node->as_integer()) value = static_cast<double>(i->get());
+  else fail(path, "is not a number");
+  if (!std::isfinite(value)) fail(path, "is not finite; expected a finite number");
+  return value;
+}
+
+long TomlFields::integer(const std::string& path, std::optional<long> fallback) const {
+  const toml::node* node = find(path);
+  if (node == nullptr) {
+    if (fallback) return *fallback;
+    fail(path, "missing; expected an integer");
+  }
+  if (const auto* i = node->as_integer()) return static_cast<long>(i->get());
+  fail(path, "is not an integer");
+}
+
+Vector TomlFields::vector(const std::string& path, int size, std::optional<Vector> fallback) const {
+  const toml::node* node = find(path);
+  if (node == nullptr) {
+    if (fallback) return *fallback;
+    fail(path, size >= 0 ? fmt::format("missing; expected an array of {} numbers", size) : "missing; expected an array of numbers");
+  }
+  const auto* array = node->as_array();
+  if (array == nullptr) fail(path, "is not an array");
+  if (size >= 0 && static_cast<int>(array->size()) != size)
+    fail(path, fmt::format("has {} entries; expected {}", array->size(), size));
+  Vector v(static_cast<Eigen::Index>(array->size()));
+  for (std::size_t i = 0; i < array->size(); ++i) {
+    const toml::node& e = (*array)[i];
+    if (const auto* f = e.as_floating_point()) v(static_cast<Eigen::Index>(i)) = f->get();
+    else if (const auto* n = e.as_integer()) v(static_cast<Eigen::Index>(i)) = static_cast<double>(n->get());
+    else fail(path, fmt::format("entry {} is not a number", i));
+    if (!std::isfinite(v(static_cast<Eigen::Index>(i)))) fail(path, fmt::format("entry {} is not finite", i));
+  }
+  return v;
+}
+
+}  // namespace gpilqg
