@@ -49,7 +49,7 @@ struct DdpWorkspace {
   Matrix Vxx, Qxx, Quu, Qux, Quu_reg, Qux_reg, SA, SB, S_reg, Sc_x;
   Eigen::LLT<Matrix> llt;
   BoxQpResult qp;
-  Vector lower, upper, qp_warm, step_lower, step_upper;
+  Vector lower, upper, qp_warm, step_lower, step_upper, Quu_k;
 
   void resize(int n_, int m_, int T_) {
     if (n_ == n && m_ == m && T_ == T) return;
@@ -71,7 +71,7 @@ struct DdpWorkspace {
     S.assign(static_cast<std::size_t>(T + 1), Matrix::Zero(n, n));
     gradient.setZero(m, T);
     for (Vector* v : {&Vx, &Qx, &Sc, &p, &p_next, &dx}) v->setZero(n);
-    for (Vector* v : {&Qu, &grad, &lower, &upper, &qp_warm, &step_lower, &step_upper}) v->setZero(m);
+    for (Vector* v : {&Qu, &grad, &lower, &upper, &qp_warm, &step_lower, &step_upper, &Quu_k}) v->setZero(m);
     for (Matrix* a : {&Vxx, &Qxx, &SA, &S_reg, &Sc_x}) a->setZero(n, n);
     for (Matrix* a : {&Quu, &Quu_reg}) a->setZero(m, m);
     for (Matrix* a : {&Qux, &Qux_reg}) a->setZero(m, n);
@@ -309,7 +309,8 @@ bool Engine::backward(double lambda) {
 
     // Value update with the unregularised blocks (Tassa et al. 2012, eq. 11).
     dV1_ += k.dot(w.Qu);
-    dV2_ += 0.5 * k.dot(w.Quu * k);
+    w.Quu_k.noalias() = w.Quu * k;
+    dV2_ += 0.5 * k.dot(w.Quu_k);
     w.SB.noalias() = K.transpose() * w.Quu;  // K' Q_uu (n x m), scratch
     w.Vx = w.Qx;
     w.Vx.noalias() += w.SB * k;
@@ -422,6 +423,7 @@ DdpResult Engine::run(const Matrix& initial_controls) {
                                       : log_first + (log_last - log_first) * s / (opt_.line_search_steps - 1);
       const double alpha = std::pow(10.0, exponent);
       new_merit = forward(alpha, w.x_new, w.u_new);
+      ++record.line_search_trials;
       const double expected = -(alpha * dV1_ + alpha * alpha * dV2_);
       const double actual = merit - new_merit;
       if (!std::isfinite(new_merit)) continue;

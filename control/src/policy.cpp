@@ -8,9 +8,11 @@
 namespace gpilqg {
 
 void AffinePolicy::control(int t, const VectorCRef& x, VectorRef u, double alpha) const {
+  thread_local Vector dx;  // no allocation per call once sized
+  dx = x - x_bar.col(t);
   u = u_bar.col(t);
   u.noalias() += alpha * k.col(t);
-  u.noalias() += K[static_cast<std::size_t>(t)] * (x - x_bar.col(t));
+  u.noalias() += K[static_cast<std::size_t>(t)] * dx;
   if (u_min.size()) u = u.cwiseMax(u_min);
   if (u_max.size()) u = u.cwiseMin(u_max);
 }

@@ -91,10 +91,12 @@ Eigen::Ref<const Vector> QuadraticCost::control_reference(int t) const {
 
 double QuadraticCost::stage(int t, const VectorCRef& x, const VectorCRef& u,
                             CostDerivatives* derivatives) const {
-  const Vector e = x - state_reference(t);
-  const Vector d = u - control_reference(t);
-  const Vector Qe = Q_ * e;
-  const Vector Rd = R_ * d;
+  // Per-thread scratch: the cost is evaluated T times per pass and must not allocate.
+  thread_local Vector e, d, Qe, Rd;
+  e = x - state_reference(t);
+  d = u - control_reference(t);
+  Qe.noalias() = Q_ * e;
+  Rd.noalias() = R_ * d;
   const double value = dt_ * 0.5 * (e.dot(Qe) + d.dot(Rd));
   if (derivatives) {
     derivatives->resize(state_dim(), control_dim());
@@ -113,8 +115,9 @@ double QuadraticCost::terminal(const VectorCRef& x, CostDerivatives* derivatives
 }
 
 double QuadraticCost::terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives) const {
-  const Vector e = x - state_reference(t);
-  const Vector Qe = Qf_ * e;
+  thread_local Vector e, Qe;
+  e = x - state_reference(t);
+  Qe.noalias() = Qf_ * e;
   const double value = 0.5 * e.dot(Qe);
   if (derivatives) {
     derivatives->resize(state_dim(), 0);

@@ -30,6 +30,7 @@ struct DdpIteration {
   double actual_reduction = 0.0;    ///< achieved (0 when rejected)
   double gradient_norm = 0.0;       ///< max |projected dJ/du| at the start of the iteration
   int backward_failures = 0;        ///< backward passes rejected (non-PD Quu) before this one passed
+  int line_search_trials = 0;       ///< forward passes tried by the line search
   bool accepted = false;
 };
 
