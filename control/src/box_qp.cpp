@@ -10,8 +10,10 @@ bool usable(BoxQpStatus status) {
 
 namespace {
 
-double objective(const Matrix& H, const Vector& g, const Vector& x) {
-  return 0.5 * x.dot(H * x) + g.dot(x);
+/// 0.5 x'Hx + g'x, with H x written into `Hx` (no allocation once sized).
+double objective(const Matrix& H, const Vector& g, const Vector& x, Vector& Hx) {
+  Hx.noalias() = H * x;
+  return 0.5 * x.dot(Hx) + g.dot(x);
 }
 
 /// Free: not at a bound with the gradient pointing out of the box.
@@ -30,7 +32,8 @@ bool factor_free_block(const Matrix& H, BoxQpResult& out) {
   out.free_index.resize(n_free);
   for (int i = 0, k = 0; i < out.free.size(); ++i)
     if (out.free(i)) out.free_index(k++) = i;
-  Matrix Hff(n_free, n_free);
+  Matrix& Hff = out.scratch.free_block;
+  Hff.resize(n_free, n_free);
   for (int a = 0; a < n_free; ++a)
     for (int b = 0; b < n_free; ++b) Hff(a, b) = H(out.free_index(a), out.free_index(b));
   out.free_factor.compute(Hff);
@@ -47,9 +50,15 @@ void solve_box_qp(const Matrix& H, const Vector& g, const Vector& lower, const V
   out.iterations = 0;
   out.status = BoxQpStatus::MaxIterations;
 
-  double value = objective(H, g, out.x);
-  Eigen::Matrix<bool, Eigen::Dynamic, 1> previous_free;
-  Vector gradient(n), search(n), candidate(n);
+  auto& sc = out.scratch;
+  double value = objective(H, g, out.x, sc.Hx);
+  auto& previous_free = sc.previous_free;
+  Vector& gradient = sc.gradient;
+  Vector& search = sc.search;
+  Vector& candidate = sc.candidate;
+  gradient.resize(n);
+  search.resize(n);
+  candidate.resize(n);
 
   for (int iter = 0; iter < options.max_iterations; ++iter) {
     out.iterations = iter + 1;
@@ -80,16 +89,18 @@ void solve_box_qp(const Matrix& H, const Vector& g, const Vector& lower, const V
 
     // Newton step on the free block with the clamped variables held: the free part of the minimiser
     // of the model is -H_ff^-1 (g + H_fc x_c)_f, so the search direction is that minus x_f.
-    Vector x_clamped = out.x;
+    sc.x_clamped = out.x;
     for (Eigen::Index i = 0; i < n; ++i)
-      if (out.free(i)) x_clamped(i) = 0.0;
-    const Vector grad_clamped = g + H * x_clamped;
+      if (out.free(i)) sc.x_clamped(i) = 0.0;
+    sc.grad_clamped = g;
+    sc.grad_clamped.noalias() += H * sc.x_clamped;
     const int n_free = static_cast<int>(out.free_index.size());
-    Vector rhs(n_free);
-    for (int a = 0; a < n_free; ++a) rhs(a) = grad_clamped(out.free_index(a));
-    const Vector newton = -out.free_factor.solve(rhs);
+    sc.rhs.resize(n_free);
+    for (int a = 0; a < n_free; ++a) sc.rhs(a) = -sc.grad_clamped(out.free_index(a));
+    sc.newton = sc.rhs;
+    out.free_factor.solveInPlace(sc.newton);
     search.setZero();
-    for (int a = 0; a < n_free; ++a) search(out.free_index(a)) = newton(a) - out.x(out.free_index(a));
+    for (int a = 0; a < n_free; ++a) search(out.free_index(a)) = sc.newton(a) - out.x(out.free_index(a));
 
     const double slope = search.dot(gradient);
     if (slope >= 0.0) {  // no descent left: at the optimum up to round-off
@@ -103,7 +114,7 @@ void solve_box_qp(const Matrix& H, const Vector& g, const Vector& lower, const V
     bool accepted = false;
     while (step >= options.min_step) {
       candidate = (out.x + step * search).cwiseMax(lower).cwiseMin(upper);
-      new_value = objective(H, g, candidate);
+      new_value = objective(H, g, candidate, sc.Hx);
       if ((new_value - value) / (step * slope) > options.armijo) {
         accepted = true;
         break;

@@ -49,6 +49,7 @@ struct DdpWorkspace {
   Matrix Vxx, Qxx, Quu, Qux, Quu_reg, Qux_reg, SA, SB, S_reg, Sc_x;
   Eigen::LLT<Matrix> llt;
   BoxQpResult qp;
+  Matrix free_rows;  ///< feedback rows of the free controls (box-limited problems)
   Vector lower, upper, qp_warm, step_lower, step_upper, Quu_k;
 
   void resize(int n_, int m_, int T_) {
@@ -298,12 +299,13 @@ bool Engine::backward(double lambda) {
       if (!usable(w.qp.status)) return false;
       k = w.qp.x;
       K.setZero();
+      // Feedback for the free controls: K_f = -H_ff^-1 Q_ux,f; clamped rows stay zero.
       const auto& idx = w.qp.free_index;
       if (idx.size() > 0) {
-        Matrix rhs(idx.size(), w.n);
-        for (Eigen::Index a = 0; a < idx.size(); ++a) rhs.row(a) = w.Qux_reg.row(idx(a));
-        const Matrix Kf = -w.qp.free_factor.solve(rhs);
-        for (Eigen::Index a = 0; a < idx.size(); ++a) K.row(idx(a)) = Kf.row(a);
+        w.free_rows.resize(idx.size(), w.n);  // no reallocation while the free count is unchanged
+        for (Eigen::Index a = 0; a < idx.size(); ++a) w.free_rows.row(a) = -w.Qux_reg.row(idx(a));
+        w.qp.free_factor.solveInPlace(w.free_rows);
+        for (Eigen::Index a = 0; a < idx.size(); ++a) K.row(idx(a)) = w.free_rows.row(a);
       }
     }
 

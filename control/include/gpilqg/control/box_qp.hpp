@@ -47,6 +47,14 @@ struct BoxQpResult {
   Eigen::VectorXi free_index;       ///< indices of the free variables, in order
   BoxQpStatus status = BoxQpStatus::Converged;
   int iterations = 0;
+
+  /// Scratch of the iterations, kept here so repeated solves of one size do not allocate (only the
+  /// free-block factor is refactored, and reallocated when the number of free variables changes).
+  struct Scratch {
+    Vector gradient, search, candidate, x_clamped, grad_clamped, rhs, newton, Hx;
+    Matrix free_block;
+    Eigen::Matrix<bool, Eigen::Dynamic, 1> previous_free;
+  } scratch;
 };
 
 /// Solves the box QP from the warm start x0 (projected onto the box first). H must be symmetric;
