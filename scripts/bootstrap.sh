@@ -2,7 +2,8 @@
 # Set up a fresh Debian machine, build gpilqg, and run either the main job or the whole test suite.
 #
 #   bash scripts/bootstrap.sh run    install what is missing, build, run the main job
-#   bash scripts/bootstrap.sh test   install what is missing, build, run every test
+#   bash scripts/bootstrap.sh test   install what is missing, build, run every test, then the whole
+#                                    suite again under AddressSanitizer + UndefinedBehaviorSanitizer
 #
 # Packages come from Debian only (DESIGN.md section 10); apt-get runs as root or through sudo, and
 # only when something is missing. The build goes to build/ (Release, tests on).
@@ -38,3 +39,11 @@ if [ "$mode" = run ]; then
 fi
 echo "== running the test suite"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 600
+
+# The same suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its own build folder.
+echo "== building and running the test suite under ASan + UBSan (build-sanitize/)"
+cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGPILQG_SANITIZE=ON -DGPILQG_BUILD_TESTS=ON \
+  -DGPILQG_BUILD_BENCH=OFF
+cmake --build build-sanitize -j"$jobs"
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build-sanitize --output-on-failure -j"$jobs" --timeout 900 -E package_consumer
