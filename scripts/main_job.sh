@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
-# The main job until the experiments land: make "real-world" cart-pole measurements (the paper's
-# 30% longer pole, multiplicative actuator noise, observation noise), store them as CSV and HDF5,
-# and summarise both through the measurement reader that validates every row.
+# The main job until the experiments land:
+#  1. make "real-world" measurements of both systems (the paper's 30% longer pole and 40% heavier
+#     quadrotor, multiplicative actuator noise, observation noise) as CSV and HDF5, and summarise them
+#     through the validating reader;
+#  2. solve the reference cart-pole swing-up with iLQR (unconstrained and with |u| <= 2.5, compare
+#     with shared/reference/ilqr_cartpole: 0.645046921446 and 0.677802315918) and under
+#     control-multiplicative noise with iLQG.
 set -euo pipefail
 gpilqg="${1:-build/experiments/gpilqg}"
 out="${GPILQG_OUT:-out}"
@@ -12,3 +16,7 @@ mkdir -p "$out"
   --multiplicative-noise 0.05 --seed 7 --out "$out/quadrotor_real.h5"
 "$gpilqg" data info "$out/cartpole_real.csv" --system cartpole
 "$gpilqg" data info "$out/quadrotor_real.h5" --system quadrotor
+for problem in cartpole_swingup cartpole_swingup_box cartpole_swingup_ilqg; do
+  echo "== gpilqg solve experiments/configs/$problem.toml"
+  "$gpilqg" solve "experiments/configs/$problem.toml"
+done
