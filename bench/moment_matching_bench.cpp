@@ -1,0 +1,70 @@
+// Cost of one belief propagation through a multi-output SE-ARD GP by exact moment matching
+// (gp/moment_matching.hpp), with and without the derivatives PDDP needs, at N = 300 training points:
+//   cart-pole  D = 5  (4 states + 1 control), E = 4 outputs  (belief dimension 4 + 10 = 14)
+//   quadrotor  D = 16 (12 states + 4 controls), E = 12 outputs (belief dimension 12 + 78 = 90)
+// Run e.g. build/bench/gpilqg_moment_matching_bench --benchmark_min_time=0.5
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "gpilqg/gp/moment_matching.hpp"
+
+namespace {
+
+using gpilqg::Matrix;
+using gpilqg::Vector;
+using namespace gpilqg::gp;
+
+/// E GPs on N random inputs in [-2, 2]^D with smooth targets and length-scales between 0.8 and 2.
+SeArdMomentMatcher make_matcher(int n, int d, int e) {
+  std::mt19937 gen(17);
+  std::uniform_real_distribution<double> uniform(-2.0, 2.0);
+  std::uniform_real_distribution<double> log_l(std::log(0.8), std::log(2.0));
+  Matrix x(n, d);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < d; ++j) x(i, j) = uniform(gen);
+  std::vector<SeArdOutput> outputs;
+  for (int a = 0; a < e; ++a) {
+    Vector y(n);
+    for (int i = 0; i < n; ++i) y(i) = std::sin(x(i, a % d) + 0.3 * a) + 0.2 * x(i, (a + 1) % d) * x(i, 0);
+    Vector lengthscales(d);
+    for (int j = 0; j < d; ++j) lengthscales(j) = log_l(gen);
+    outputs.push_back(condition_se_ard_output(x, y, lengthscales, 0.0, std::log(0.05)));
+  }
+  return SeArdMomentMatcher(std::move(x), std::move(outputs));
+}
+
+/// A belief with the last `controls` inputs deterministic (zero rows and columns), as in PDDP.
+void propagate(benchmark::State& state, int d, int e, int controls, MomentDerivatives derivatives) {
+  const int n = static_cast<int>(state.range(0));
+  const SeArdMomentMatcher matcher = make_matcher(n, d, e);
+  const Vector mu = Vector::LinSpaced(d, -0.5, 0.5);
+  Matrix sigma = Matrix::Zero(d, d);
+  const int states = d - controls;
+  Matrix root = Matrix::Random(states, states) * 0.1;
+  sigma.topLeftCorner(states, states) = root * root.transpose() + 0.01 * Matrix::Identity(states, states);
+  MomentMatch out;
+  matcher.propagate(mu, sigma, out, derivatives);  // warm-up: sizes the workspace
+  for (auto _ : state) {
+    matcher.propagate(mu, sigma, out, derivatives);
+    benchmark::DoNotOptimize(out.covariance.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+void BM_CartpoleMoments(benchmark::State& state) { propagate(state, 5, 4, 1, MomentDerivatives::None); }
+void BM_CartpoleMomentsAndDerivatives(benchmark::State& state) { propagate(state, 5, 4, 1, MomentDerivatives::All); }
+void BM_QuadrotorMoments(benchmark::State& state) { propagate(state, 16, 12, 4, MomentDerivatives::None); }
+void BM_QuadrotorMomentsAndDerivatives(benchmark::State& state) {
+  propagate(state, 16, 12, 4, MomentDerivatives::All);
+}
+
+BENCHMARK(BM_CartpoleMoments)->Arg(300)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_CartpoleMomentsAndDerivatives)->Arg(300)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_QuadrotorMoments)->Arg(300)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QuadrotorMomentsAndDerivatives)->Arg(300)->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,30 @@
+#pragma once
+/// @file fit.hpp
+/// Maximum-likelihood fitting (type-II ML, GPML book section 5.4.1), written once for all backends:
+/// minimise the negative log marginal likelihood of a MarginalLikelihoodObjective over its parameter
+/// vector with NLopt's L-BFGS (LD_LBFGS) inside the objective's box bounds.
+///
+/// Start points, in order: FitOptions::warm_start (if given, clipped to the bounds), the objective's
+/// data-driven initial values, then FitOptions::restarts random restarts (restart_parameters). The
+/// start with the lowest NLML wins.
+///
+/// Numerical safeguards: an evaluation whose Cholesky needs jitter is counted and its largest jitter
+/// reported. An evaluation that fails even with jitter returns +infinity from the objective; the
+/// fitter never hands that (or a NaN) to NLopt. It returns a large finite value (1e10 (1 + |best
+/// value seen|)) with a zero gradient instead: L-BFGS's line search sees a steep increase and
+/// shortens the step, i.e. it backtracks into the region where K is positive definite. If every
+/// start fails inside NLopt, the best point evaluated is returned with FitTermination::OptimiserError.
+
+#include "gpilqg/gp/backend.hpp"
+
+namespace gpilqg::gp {
+
+struct ParameterFit {
+  Vector parameters;
+  FitSummary summary;  ///< everything but backend, training_points and conditioning
+};
+
+/// Runs the fit. Throws std::invalid_argument for invalid options or a warm start of the wrong size.
+ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOptions& options);
+
+}  // namespace gpilqg::gp

@@ -1,0 +1,44 @@
+#pragma once
+/// @file gp_io.hpp
+/// Saving and loading fitted GPs in HDF5, kept out of the GP types (DESIGN.md practice 9).
+///
+/// Layout of one fitted GP in group G (e.g. "/gp/x_dot"):
+///   G attributes: backend (string), format_version (int, 1), input_dim (int),
+///                 jitter (double), negative_log_marginal_likelihood (double)
+///   G/parameters  (P)      [log l; log sf; log sn; backend extras]
+///   G/inputs      (N x D)  the points the model is conditioned on
+///   G/targets     (N)
+/// Loading re-conditions the named backend on the stored points with the stored parameters, which
+/// reproduces the saved model exactly (conditioning is deterministic).
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "gpilqg/gp/backend.hpp"
+#include "gpilqg/gp/residual_model.hpp"
+
+namespace gpilqg::gp {
+
+/// Writes `model` to group `group` of `file`, creating the file and intermediate groups when missing
+/// and replacing an existing group of that name. Throws std::runtime_error naming the file on failure.
+void save_fitted_gp(const std::filesystem::path& file, const std::string& group, const FittedGp& model);
+
+/// Reads group `group` of `file` and conditions `backend` on it. Throws std::runtime_error naming the
+/// file and the object for a missing file, group, attribute or dataset, wrong shapes, or a backend
+/// name that differs from backend.name().
+std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, const std::string& group,
+                                         const GpBackend& backend);
+
+/// Writes the GP of every state of a residual model to `<group>/<i>` (i = 0 .. n-1) in the layout
+/// above, plus the attributes `state_dim`, `control_dim` and `dt` on `group`. The simulator is code
+/// and is not saved.
+void save_residual_model(const std::filesystem::path& file, const std::string& group, const ResidualModel& model);
+
+/// Reads what save_residual_model wrote and rebuilds the model around `simulator` with `backend`.
+/// Throws std::runtime_error naming the file and object when a GP is missing or the stored
+/// dimensions or dt (1e-6 relative) differ from the simulator's.
+ResidualModel load_residual_model(const std::filesystem::path& file, const std::string& group,
+                                  ResidualModel::SimulatorPtr simulator, const GpBackend& backend);
+
+}  // namespace gpilqg::gp

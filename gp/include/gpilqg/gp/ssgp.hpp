@@ -1,0 +1,158 @@
+#pragma once
+/// @file ssgp.hpp
+/// Sparse spectrum GP (SSGP) of Lazaro-Gredilla, Quinonero-Candela, Rasmussen and Figueiras-Vidal
+/// (2010, JMLR 11), with the conventions of the authors' ssgpr.m.
+///
+/// Model (paper, sec. 2 and eqs. 5-8): m spectral points w_r (rows of W, m x D, unscaled), frequencies
+/// s_r = w_r ./ l, features phi(x) = [cos(S x); sin(S x)] (2m), and
+///
+///   f(x) = phi(x)' a,   a ~ N(0, sf2/m I_2m),   y = f + noise, noise ~ N(0, sn2),
+///
+/// which approximates the SE ARD kernel sf2 exp(-0.5 sum_d (x_d - z_d)^2 / l_d^2) by its Monte Carlo
+/// spectral estimate (sf2/m) sum_r cos(s_r'(x - z)) (Bochner's theorem; exact as m -> infinity when
+/// w_r ~ N(0, I)). The GP layer is zero-mean: targets are residuals (prior_mean.hpp).
+///
+/// Parameter vector (hyperparameters.hpp): theta = [log l (D); log sf; log sn; vec(W) (m*D,
+/// column-major)]. The spectral points are optimised jointly with the hyperparameters.
+///
+/// Cost: one NLML with its gradient is O(N m^2 + N m D) (one rank-N update Phi'Phi, one N x 2m by
+/// 2m x 2m product), O(N m) memory. A prediction with gradients is O(m D + m^2).
+
+#include <memory>
+
+#include "gpilqg/core/types.hpp"
+#include "gpilqg/gp/backend.hpp"
+
+namespace gpilqg::gp {
+
+/// Index layout of the packed SSGP parameter vector.
+struct SsgpLayout {
+  int input_dim = 0;    ///< D
+  int frequencies = 0;  ///< m (2m features)
+
+  int size() const { return input_dim + 2 + frequencies * input_dim; }
+  /// Offset of vec(W); entry (r, d) of W is at spectral_offset() + d * m + r.
+  int spectral_offset() const { return input_dim + 2; }
+
+  /// [hyperparameters (D + 2); vec(W)] (throws std::invalid_argument on a size mismatch).
+  Vector pack(const VectorCRef& hyper, const MatrixCRef& spectral_points) const;
+  /// The m x D unscaled spectral points W of a packed vector.
+  Matrix spectral_points(const VectorCRef& theta) const;
+  /// The layout of a vector of `size` entries for D inputs; throws std::invalid_argument when no
+  /// m >= 1 fits.
+  static SsgpLayout from_size(int size, int input_dim);
+};
+
+class SsgpPredictor;
+
+/// The SSGP negative log marginal likelihood (ssgpr.m; paper eq. 8), with A = Phi'Phi + (m sn2/sf2) I
+/// = L L' (2m x 2m), b = Phi' r, alpha = A^-1 b:
+///
+///   nlml = (r'r - b'alpha) / (2 sn2) + sum(log diag L) - m log(m sn2/sf2) + N/2 log(2 pi sn2).
+///
+/// Gradient (our derivation; a = m sn2/sf2, e = r - Phi alpha):
+///   dnlml/dPhi     = Gamma = Phi A^-1 - e alpha' / sn2                             (N x 2m)
+///   dnlml/dz_ir    = Gamma_{i,m+r} cos(z_ir) - Gamma_{i,r} sin(z_ir),  z = X S'   (N x m)
+///   dnlml/dS       = (dnlml/dz)' X,   dnlml/dW = dnlml/dS ./ l',
+///   dnlml/dlog l_d = -sum_r (dnlml/dS)_rd S_rd,
+///   dnlml/da       = alpha'alpha / (2 sn2) + tr(A^-1)/2 - m/a,
+///   dnlml/dlog sf  = -2a dnlml/da,    dnlml/dlog sn = N - (r'r - b'alpha)/sn2 + 2a dnlml/da.
+/// Escalated jitter (JitterSchedule, relative to N/2 = mean(diag(Phi'Phi)), a constant) is added to
+/// the ridge a in A only, so the gradient stays exact for the value returned.
+///
+/// Not thread-safe: evaluate() reuses an internal O(N m) workspace (copies get their own).
+class SsgpLikelihood {
+ public:
+  /// X: N x D inputs, r: N targets, `frequencies`: m >= 1. `threads` > 1 splits the O(N m^2) work
+  /// over blocks of training points (at least 500 points per thread; same results up to the order
+  /// of a few sums). Throws std::invalid_argument on empty or non-finite data, mismatched sizes,
+  /// m < 1, threads < 1 or an invalid schedule.
+  SsgpLikelihood(const MatrixCRef& X, const VectorCRef& r, int frequencies, JitterSchedule schedule = {},
+                 int threads = 1);
+  ~SsgpLikelihood();
+  SsgpLikelihood(const SsgpLikelihood& other);
+  SsgpLikelihood& operator=(const SsgpLikelihood& other);
+  SsgpLikelihood(SsgpLikelihood&&) noexcept;
+  SsgpLikelihood& operator=(SsgpLikelihood&&) noexcept;
+
+  const SsgpLayout& layout() const { return layout_; }
+  int parameter_count() const { return layout_.size(); }
+
+  /// nlml at theta; fills `gradient` (resized to parameter_count()) when not null. Never NaN: a
+  /// non-finite theta or a failed factorisation gives status Failed, +infinity and a zero gradient.
+  /// Throws std::invalid_argument only for a wrongly sized theta.
+  NlmlEvaluation evaluate(const VectorCRef& theta, Vector* gradient = nullptr) const;
+
+  /// The cached posterior at theta and the conditioning report. Throws std::runtime_error when no
+  /// factorisation is possible even with the largest jitter.
+  SsgpPredictor predictor(const VectorCRef& theta, ConditioningReport* report = nullptr) const;
+
+ private:
+  struct Workspace;
+  NlmlEvaluation factorise(const VectorCRef& theta) const;
+
+  Matrix X_;
+  Vector r_;
+  SsgpLayout layout_;
+  JitterSchedule schedule_;
+  int threads_ = 1;
+  mutable std::unique_ptr<Workspace> ws_;
+};
+
+/// The fitted SSGP posterior (ssgpr.m's prediction), cached so that one query is O(m D + m^2):
+///
+///   mu(x) = phi(x)' alpha,   s2(x) = max(phi(x)' C phi(x), 0),   C = sn2 A^-1,
+///   dmu/dx = S' (alpha_s .* cos(z) - alpha_c .* sin(z)),  ds2/dx = 2 S' (c_s .* cos(z) - c_c .* sin(z)),
+///
+/// with z = S x, c = C phi(x), and _c / _s the cosine and sine halves. s2 is the latent variance.
+class SsgpPredictor {
+ public:
+  SsgpPredictor() = default;
+
+  int input_dim() const { return static_cast<int>(S_.cols()); }
+  int frequencies() const { return static_cast<int>(S_.rows()); }
+  /// The scaled frequencies S = W ./ l' (m x D).
+  const Matrix& frequency_matrix() const { return S_; }
+  const Vector& alpha() const { return alpha_; }
+
+  /// Latent mean at x (D entries) and, for each non-null pointer, the variance, d mean / dx and
+  /// d variance / dx (D doubles each). Scratch owned by the caller (no allocation): phi receives the
+  /// 2m features, c receives C phi (2m doubles).
+  void predict(const VectorCRef& x, double* phi, double* c, double& mean, double* variance = nullptr,
+               double* dmean = nullptr, double* dvariance = nullptr) const;
+
+ private:
+  friend class SsgpLikelihood;
+  Matrix S_;      ///< m x D
+  Vector alpha_;  ///< 2m
+  Matrix C_;      ///< 2m x 2m, symmetric
+};
+
+/// Options of the SSGP backend.
+struct SsgpOptions {
+  int frequencies = 100;   ///< m, the number of spectral points (2m features)
+  int initial_draws = 50;  ///< W ~ N(0, I) draws tried at the initial hyperparameters; the best is kept
+  int threads = 1;         ///< threads for one NLML evaluation (>= 1; see SsgpLikelihood)
+  /// Throws std::invalid_argument naming the field.
+  void validate() const;
+};
+
+/// The SSGP backend ("ssgp"). objective(): SsgpLikelihood with bounds (hyperparameter_bounds; W
+/// unbounded) and initial values (initial_hyperparameters and the best of `initial_draws` random W
+/// with FitOptions::seed). condition(): m is read from the parameter vector's length.
+class SsgpBackend final : public GpBackend {
+ public:
+  explicit SsgpBackend(SsgpOptions options = {});
+  std::string_view name() const override { return "ssgp"; }
+  const SsgpOptions& options() const { return options_; }
+
+  std::unique_ptr<MarginalLikelihoodObjective> objective(const TrainingSet& data,
+                                                         const FitOptions& options) const override;
+  std::unique_ptr<FittedGp> condition(TrainingSet data, const VectorCRef& parameters,
+                                      const JitterSchedule& jitter = {}) const override;
+
+ private:
+  SsgpOptions options_;
+};
+
+}  // namespace gpilqg::gp

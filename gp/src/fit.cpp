@@ -1,0 +1,140 @@
+#include "gpilqg/gp/fit.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include <nlopt.hpp>
+
+namespace gpilqg::gp {
+
+namespace {
+
+/// The bridge between NLopt and an objective: counts evaluations, remembers the best point seen and
+/// shields NLopt from failed evaluations (see fit.hpp).
+struct ObjectiveBridge {
+  MarginalLikelihoodObjective* objective = nullptr;
+  Vector theta;     // reused buffers
+  Vector gradient;
+  int evaluations = 0;
+  int jittered = 0;
+  int failed = 0;
+  double max_jitter = 0.0;
+  double best_value = std::numeric_limits<double>::infinity();
+  Vector best_theta;
+
+  double operator()(const std::vector<double>& x, std::vector<double>& grad) {
+    theta = Eigen::Map<const Vector>(x.data(), static_cast<Eigen::Index>(x.size()));
+    const NlmlEvaluation e = objective->evaluate(theta, grad.empty() ? nullptr : &gradient);
+    ++evaluations;
+    if (e.status == FactorStatus::JitterAdded) ++jittered;
+    max_jitter = std::max(max_jitter, e.jitter);
+    if (e.status == FactorStatus::Failed || !std::isfinite(e.value)) {
+      ++failed;
+      std::fill(grad.begin(), grad.end(), 0.0);
+      const double reference = std::isfinite(best_value) ? std::abs(best_value) : 1.0;
+      return 1e10 * (1.0 + reference);
+    }
+    if (!grad.empty()) std::copy(gradient.data(), gradient.data() + gradient.size(), grad.begin());
+    if (e.value < best_value) {
+      best_value = e.value;
+      best_theta = theta;
+    }
+    return e.value;
+  }
+
+  static double call(const std::vector<double>& x, std::vector<double>& grad, void* self) {
+    return (*static_cast<ObjectiveBridge*>(self))(x, grad);
+  }
+};
+
+std::vector<double> to_std(const Vector& v) { return {v.data(), v.data() + v.size()}; }
+
+Vector clip(const Vector& theta, const ParameterBounds& b) {
+  return theta.cwiseMax(b.lower).cwiseMin(b.upper);
+}
+
+}  // namespace
+
+ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOptions& options) {
+  const auto start_time = std::chrono::steady_clock::now();
+  options.validate();
+  const int p = objective.parameter_count();
+  if (options.warm_start.size() != 0 && options.warm_start.size() != p)
+    throw std::invalid_argument("fit_parameters: warm start has " + std::to_string(options.warm_start.size()) +
+                                " entries; expected the backend's " + std::to_string(p) + " parameters");
+  const ParameterBounds bounds = objective.bounds();
+
+  std::vector<Vector> starts;
+  if (options.warm_start.size() == p) starts.push_back(clip(options.warm_start, bounds));
+  const Vector initial = clip(objective.initial_parameters(), bounds);
+  starts.push_back(initial);
+  if (options.optimise) {
+    std::mt19937_64 rng(options.seed);
+    for (int r = 0; r < options.restarts; ++r) starts.push_back(clip(objective.restart_parameters(initial, rng), bounds));
+  }
+
+  ObjectiveBridge bridge;
+  bridge.objective = &objective;
+  ParameterFit out;
+  FitSummary& s = out.summary;
+  s.parameters = p;
+
+  std::vector<double> no_gradient;
+  {
+    std::vector<double> x0 = to_std(starts.front());
+    s.initial_nlml = bridge(x0, no_gradient);
+  }
+  if (!options.optimise) {
+    out.parameters = starts.front();
+    s.starts = 1;
+    s.termination = FitTermination::NotOptimised;
+  } else {
+    double best_of_starts = std::numeric_limits<double>::infinity();
+    bool any_start_worked = false;
+    for (std::size_t k = 0; k < starts.size(); ++k) {
+      nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(p));
+      opt.set_lower_bounds(to_std(bounds.lower));
+      opt.set_upper_bounds(to_std(bounds.upper));
+      opt.set_min_objective(&ObjectiveBridge::call, &bridge);
+      opt.set_maxeval(options.max_evaluations);
+      opt.set_ftol_rel(options.relative_tolerance);
+      opt.set_xtol_rel(options.parameter_tolerance);
+      std::vector<double> x = to_std(starts[k]);
+      double value = 0.0;
+      FitTermination termination = FitTermination::Converged;
+      bool worked = true;
+      try {
+        const nlopt::result r = opt.optimize(x, value);
+        if (r == nlopt::MAXEVAL_REACHED) termination = FitTermination::MaxEvaluations;
+      } catch (const nlopt::roundoff_limited&) {
+        // L-BFGS stops this way when it cannot improve further at the working precision, typically
+        // at the optimum; the best point seen is kept.
+      } catch (const std::exception&) {
+        worked = false;
+      }
+      any_start_worked = any_start_worked || worked;
+      // The best point of this start is the best seen so far if it improved on the earlier starts.
+      if (bridge.best_value < best_of_starts) {
+        best_of_starts = bridge.best_value;
+        s.best_start = static_cast<int>(k);
+        s.termination = worked ? termination : FitTermination::OptimiserError;
+      }
+    }
+    s.starts = static_cast<int>(starts.size());
+    if (!any_start_worked) s.termination = FitTermination::OptimiserError;
+    out.parameters = bridge.best_theta.size() == p ? bridge.best_theta : starts.front();
+  }
+  s.nlml = std::isfinite(bridge.best_value) ? bridge.best_value : s.initial_nlml;
+  s.evaluations = bridge.evaluations;
+  s.jittered_evaluations = bridge.jittered;
+  s.failed_evaluations = bridge.failed;
+  s.max_jitter = bridge.max_jitter;
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  return out;
+}
+
+}  // namespace gpilqg::gp

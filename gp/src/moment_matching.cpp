@@ -1,0 +1,310 @@
+/// @file moment_matching.cpp
+/// SeArdMomentMatcher: construction, validation, the predictive mean M, the input-output covariance C
+/// and their derivatives. The covariance S is in moment_matching_covariance.cpp.
+///
+/// Notation (per output a; see moment_matching.hpp): w = diag(W_a), V = X - 1 mu' (rows nu_i'),
+/// Rt_a = W^1/2 Sigma W^1/2 + I (eigenvalues >= 1 for a PSD Sigma), and
+///
+///   P_a = (Sigma + Lambda_a)^-1 = W^1/2 Rt_a^-1 W^1/2,   |Sigma W_a + I| = |Rt_a|,
+///   T_a = V P_a            (rows t_i' = (P_a nu_i)'),
+///   q_ai = sf^2 |Rt_a|^-1/2 exp(-1/2 nu_i' t_i),   gamma_a = beta_a .* q_a,   M_a = sum_i gamma_ai,
+///   g_a = dM_a/dmu = T_a' gamma_a                          (dq_i/dmu = q_i t_i),
+///   C_:a = Sigma P_a sum_i gamma_ai nu_i = Sigma g_a.
+///
+/// Derivatives (dq_i/dSigma = q_i (t_i t_i' - P_a) / 2, dt_i/dSigma_kl = -P_:k t_il):
+///   H_a = T_a' diag(gamma_a) T_a - M_a P_a     (D x D, symmetric) = d^2 M_a / dmu^2,
+///   dM_a/dSigma = H_a / 2,   dC_:a/dmu = Sigma H_a,
+///   dC_ka/dSigma_ij (before symmetrisation) = (P_a Lambda_a)_ik g_j - C_ka (P_a)_ij / 2
+///                                              + 1/2 sum_n gamma_n (Sigma t_n)_k t_ni t_nj,
+/// using I - Sigma P_a = Lambda_a P_a. Because the moments are functions of sym(Sigma), the reported
+/// derivative is the symmetric part of this partial derivative (header comment).
+
+#include "gpilqg/gp/moment_matching.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "moment_matching_internal.hpp"
+
+namespace gpilqg::gp {
+
+using detail::tiled_product;
+
+namespace {
+
+[[noreturn]] void fail(const std::string& message) {
+  throw std::invalid_argument("SeArdMomentMatcher: " + message);
+}
+
+std::string shape(Eigen::Index rows, Eigen::Index cols) {
+  return std::to_string(rows) + " x " + std::to_string(cols);
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------------
+// Conditioning helper
+
+SeArdOutput condition_se_ard_output(const MatrixCRef& inputs, const VectorCRef& targets,
+                                    const VectorCRef& log_lengthscales, double log_signal_std,
+                                    double log_noise_std) {
+  const Eigen::Index n = inputs.rows();
+  const Eigen::Index d = inputs.cols();
+  const auto bad = [](const std::string& message) {
+    throw std::invalid_argument("condition_se_ard_output: " + message);
+  };
+  if (n == 0 || d == 0) bad("inputs is " + shape(n, d) + ", need at least one row and column");
+  if (targets.size() != n)
+    bad("targets has " + std::to_string(targets.size()) + " entries, expected " + std::to_string(n));
+  if (log_lengthscales.size() != d)
+    bad("log_lengthscales has " + std::to_string(log_lengthscales.size()) + " entries, expected " +
+        std::to_string(d));
+  if (!inputs.allFinite()) bad("inputs has a non-finite entry");
+  if (!targets.allFinite()) bad("targets has a non-finite entry");
+  if (!log_lengthscales.allFinite() || !std::isfinite(log_signal_std) || !std::isfinite(log_noise_std))
+    bad("a hyperparameter is not finite");
+  const Vector w = (-2.0 * log_lengthscales.array()).exp().matrix();
+  const double sf2 = std::exp(2.0 * log_signal_std);
+  const double sn2 = std::exp(2.0 * log_noise_std);
+  Matrix k(n, n);
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = j; i < n; ++i) {
+      const double r2 = ((inputs.row(i) - inputs.row(j)).array().square() * w.transpose().array()).sum();
+      k(i, j) = k(j, i) = sf2 * std::exp(-0.5 * r2);
+    }
+  k.diagonal().array() += sn2;
+  const Eigen::LLT<Matrix> llt(k);
+  if (llt.info() != Eigen::Success) bad("K + sn^2 I is not numerically positive definite (raise the noise)");
+  SeArdOutput out;
+  out.log_lengthscales = log_lengthscales;
+  out.log_signal_std = log_signal_std;
+  out.beta = llt.solve(targets);
+  out.Kinv = llt.solve(Matrix::Identity(n, n));
+  if (!out.beta.allFinite() || !out.Kinv.allFinite())
+    bad("K + sn^2 I is too ill-conditioned (non-finite weights; raise the noise)");
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------------
+// Construction
+
+SeArdMomentMatcher::SeArdMomentMatcher(Matrix inputs, std::vector<SeArdOutput> outputs)
+    : inputs_(std::move(inputs)) {
+  const Eigen::Index n = inputs_.rows();
+  const Eigen::Index d = inputs_.cols();
+  if (n == 0 || d == 0) fail("inputs is " + shape(n, d) + ", need at least one row and one column");
+  if (!inputs_.allFinite()) fail("inputs has a non-finite entry");
+  if (outputs.empty()) fail("outputs is empty, need at least one output");
+  outputs_.reserve(outputs.size());
+  for (std::size_t a = 0; a < outputs.size(); ++a) {
+    SeArdOutput& src = outputs[a];
+    const std::string name = "outputs[" + std::to_string(a) + "]";
+    if (src.log_lengthscales.size() != d)
+      fail(name + ".log_lengthscales has " + std::to_string(src.log_lengthscales.size()) +
+           " entries, expected D = " + std::to_string(d) + " (columns of inputs)");
+    if (src.beta.size() != n)
+      fail(name + ".beta has " + std::to_string(src.beta.size()) + " entries, expected N = " +
+           std::to_string(n) + " (rows of inputs)");
+    if (src.Kinv.rows() != n || src.Kinv.cols() != n)
+      fail(name + ".Kinv is " + shape(src.Kinv.rows(), src.Kinv.cols()) + ", expected N x N = " +
+           shape(n, n));
+    if (!src.log_lengthscales.allFinite()) fail(name + ".log_lengthscales has a non-finite entry");
+    if (!std::isfinite(src.log_signal_std)) fail(name + ".log_signal_std is not finite");
+    if (!src.beta.allFinite()) fail(name + ".beta has a non-finite entry");
+    if (!src.Kinv.allFinite()) fail(name + ".Kinv has a non-finite entry");
+    OutputData o;
+    o.inverse_squared_lengthscales = (-2.0 * src.log_lengthscales.array()).exp().matrix();
+    o.sqrt_w = (-src.log_lengthscales.array()).exp().matrix();
+    o.lengthscales = src.log_lengthscales.array().exp().matrix();
+    o.log_signal_variance = 2.0 * src.log_signal_std;
+    o.signal_variance = std::exp(o.log_signal_variance);
+    const auto positive_finite = [](const Vector& v) {
+      return v.allFinite() && (v.array() > 0.0).all();
+    };
+    if (!positive_finite(o.inverse_squared_lengthscales) || !positive_finite(o.lengthscales))
+      fail(name + ".log_lengthscales out of range (1/l^2 or l^2 overflows)");
+    if (!std::isfinite(o.signal_variance) || !(o.signal_variance > 0.0))
+      fail(name + ".log_signal_std out of range (sf^2 overflows)");
+    o.beta = std::move(src.beta);
+    o.Kinv = std::move(src.Kinv);
+    outputs_.push_back(std::move(o));
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Propagation
+
+void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives) const {
+  const Eigen::Index n = inputs_.rows();
+  const Eigen::Index d = inputs_.cols();
+  const Eigen::Index e = static_cast<Eigen::Index>(outputs_.size());
+  out.mean.resize(e);
+  out.covariance.resize(e, e);
+  out.cross_covariance.resize(d, e);
+  if (derivatives) {
+    out.dmean_dmu.resize(e, d);
+    out.dmean_dsigma.resize(e, d * d);
+    out.dcovariance_dmu.resize(e * e, d);
+    out.dcovariance_dsigma.resize(e * e, d * d);
+    out.dcross_dmu.resize(d * e, d);
+    out.dcross_dsigma.resize(d * e, d * d);
+  }
+  MomentMatchScratch& s = out.scratch;
+  s.sigma.resize(d, d);
+  s.centred.resize(n, d);
+  const auto size_all = [e](std::vector<Matrix>& v, Eigen::Index rows, Eigen::Index cols) {
+    v.resize(static_cast<std::size_t>(e));
+    for (Matrix& m : v) m.resize(rows, cols);
+  };
+  const auto size_all_vectors = [e](std::vector<Vector>& v, Eigen::Index size) {
+    v.resize(static_cast<std::size_t>(e));
+    for (Vector& x : v) x.resize(size);
+  };
+  size_all(s.precision, d, d);
+  size_all(s.precision_lambda, d, d);
+  size_all(s.solved, n, d);
+  size_all(s.scaled, n, d);
+  size_all(s.hessian, d, d);
+  size_all_vectors(s.weighted, n);
+  size_all_vectors(s.log_kernel, n);
+  size_all_vectors(s.gradient, d);
+  for (Matrix* m : {&s.rt, &s.rt_inverse, &s.xi, &s.gain, &s.pair_precision, &s.dd, &s.dd2, &s.inner})
+    m->resize(d, d);
+  s.nd.resize(n, d);
+  s.nd2.resize(n, d);
+  for (Vector* v : {&s.row_term, &s.col_term, &s.row_sums, &s.col_sums}) v->resize(n);
+  s.nn.resize(n, n);
+  for (Vector* v : {&s.sqrt_w_pair, &s.lengthscale_pair, &s.dvec, &s.dvec2}) v->resize(d);
+  if (derivatives) {
+    s.outer.resize(n, d * d);
+    s.third.resize(d, d * d);
+  }
+}
+
+double SeArdMomentMatcher::factor_scaled(MomentMatchScratch& s, const Vector& sqrt_w, std::size_t a,
+                                         std::size_t b) const {
+  s.rt.noalias() = sqrt_w.asDiagonal() * s.sigma * sqrt_w.asDiagonal();
+  s.rt.diagonal().array() += 1.0;
+  s.llt.compute(s.rt);
+  const auto diagonal = s.llt.matrixLLT().diagonal();
+  if (s.llt.info() != Eigen::Success || !diagonal.allFinite() || !(diagonal.array() > 0.0).all()) {
+    const std::string what = a == b ? "output " + std::to_string(a)
+                                    : "outputs " + std::to_string(a) + " and " + std::to_string(b);
+    throw std::invalid_argument(
+        "SeArdMomentMatcher::propagate: Sigma is too far from positive semidefinite: "
+        "W^1/2 Sigma W^1/2 + I is not positive definite for " + what);
+  }
+  s.rt_inverse.setIdentity();
+  s.llt.solveInPlace(s.rt_inverse);
+  return 2.0 * diagonal.array().log().sum();
+}
+
+void SeArdMomentMatcher::propagate(const VectorCRef& mu, const MatrixCRef& sigma, MomentMatch& out,
+                                   MomentDerivatives derivatives) const {
+  const Eigen::Index d = inputs_.cols();
+  if (mu.size() != d)
+    throw std::invalid_argument("SeArdMomentMatcher::propagate: mu has " + std::to_string(mu.size()) +
+                                " entries, expected D = " + std::to_string(d));
+  if (sigma.rows() != d || sigma.cols() != d)
+    throw std::invalid_argument("SeArdMomentMatcher::propagate: Sigma is " + shape(sigma.rows(), sigma.cols()) +
+                                ", expected D x D = " + shape(d, d));
+  if (!mu.allFinite()) throw std::invalid_argument("SeArdMomentMatcher::propagate: mu has a non-finite entry");
+  if (!sigma.allFinite())
+    throw std::invalid_argument("SeArdMomentMatcher::propagate: Sigma has a non-finite entry");
+
+  const bool with_derivatives = derivatives == MomentDerivatives::All;
+  out.has_derivatives = false;
+  prepare(out, with_derivatives);
+  MomentMatchScratch& s = out.scratch;
+  s.sigma = 0.5 * (sigma + sigma.transpose());
+  s.centred = inputs_.rowwise() - mu.transpose();
+
+  propagate_mean(out, with_derivatives);
+  propagate_covariance(out, with_derivatives);
+
+  bool finite = out.mean.allFinite() && out.covariance.allFinite() && out.cross_covariance.allFinite();
+  if (with_derivatives)
+    finite = finite && out.dmean_dmu.allFinite() && out.dmean_dsigma.allFinite() &&
+             out.dcovariance_dmu.allFinite() && out.dcovariance_dsigma.allFinite() &&
+             out.dcross_dmu.allFinite() && out.dcross_dsigma.allFinite();
+  if (!finite)
+    throw std::invalid_argument(
+        "SeArdMomentMatcher::propagate: a moment or derivative overflowed (mu, Sigma or the GP weights "
+        "are out of range)");
+  out.has_derivatives = with_derivatives;
+}
+
+void SeArdMomentMatcher::propagate_mean(MomentMatch& out, bool derivatives) const {
+  MomentMatchScratch& s = out.scratch;
+  const Eigen::Index d = inputs_.cols();
+  const Matrix& v = s.centred;
+  for (std::size_t a = 0; a < outputs_.size(); ++a) {
+    const OutputData& o = outputs_[a];
+    const auto ai = static_cast<Eigen::Index>(a);
+    const double log_det = factor_scaled(s, o.sqrt_w, a, a);
+
+    Matrix& p = s.precision[a];
+    p.noalias() = o.sqrt_w.asDiagonal() * s.rt_inverse * o.sqrt_w.asDiagonal();
+    Matrix& p_lambda = s.precision_lambda[a];  // P Lambda = W^1/2 Rt^-1 Lambda^1/2
+    p_lambda.noalias() = o.sqrt_w.asDiagonal() * s.rt_inverse * o.lengthscales.asDiagonal();
+
+    Matrix& t = s.solved[a];
+    tiled_product(v, p, t);
+    // gamma_i = beta_i q_i, q_i = exp(log sf^2 - 1/2 log|Rt| - 1/2 nu_i' P nu_i)
+    const double log_c = o.log_signal_variance - 0.5 * log_det;
+    Vector& gamma = s.weighted[a];
+    gamma = t.cwiseProduct(v).rowwise().sum();
+    gamma = (log_c - 0.5 * gamma.array()).exp() * o.beta.array();
+    const double m = gamma.sum();
+    out.mean(ai) = m;
+    Vector& g = s.gradient[a];
+    g.noalias() = t.transpose() * gamma;
+    out.cross_covariance.col(ai).noalias() = s.sigma * g;
+
+    // For the pairs: A_a = V W_a and -1/2 nu_i' W_a nu_i = log k_a(x_i, mu) - log sf^2.
+    Matrix& scaled = s.scaled[a];
+    scaled.noalias() = v * o.inverse_squared_lengthscales.asDiagonal();
+    s.log_kernel[a] = -0.5 * scaled.cwiseProduct(v).rowwise().sum();
+
+    if (!derivatives) continue;
+    Matrix& h = s.hessian[a];
+    s.nd = t;
+    s.nd.array().colwise() *= gamma.array();
+    tiled_product(t.transpose(), s.nd, h);
+    h -= m * p;
+    out.dmean_dmu.row(ai) = g.transpose();
+    out.dmean_dsigma.row(ai) = 0.5 * Eigen::Map<const Vector>(h.data(), d * d).transpose();
+    out.dcross_dmu.middleRows(ai * d, d).noalias() = s.sigma * h;
+    cross_covariance_derivatives(out, a);
+  }
+}
+
+void SeArdMomentMatcher::cross_covariance_derivatives(MomentMatch& out, std::size_t a) const {
+  MomentMatchScratch& s = out.scratch;
+  const Eigen::Index d = inputs_.cols();
+  const auto ai = static_cast<Eigen::Index>(a);
+  const Matrix& t = s.solved[a];
+  const Matrix& p = s.precision[a];
+  const Matrix& p_lambda = s.precision_lambda[a];
+  const Vector& g = s.gradient[a];
+
+  // third(k, i + D j) = sum_n gamma_n s_nk t_ni t_nj with s_n = Sigma t_n: one (D x N) (N x D^2) GEMM.
+  for (Eigen::Index j = 0; j < d; ++j)
+    for (Eigen::Index i = 0; i < d; ++i) s.outer.col(i + d * j) = t.col(i).cwiseProduct(t.col(j));
+  tiled_product(t, s.sigma, s.nd);
+  s.nd.array().colwise() *= s.weighted[a].array();
+  tiled_product(s.nd.transpose(), s.outer, s.third);
+
+  // Symmetrised: 1/2 third_k - 1/2 C_ka P + 1/2 ((P Lambda)_:k g' + g (P Lambda)_:k').
+  for (Eigen::Index k = 0; k < d; ++k) {
+    const Eigen::Index row = k + d * ai;
+    const double c = out.cross_covariance(k, ai);
+    for (Eigen::Index j = 0; j < d; ++j)
+      for (Eigen::Index i = 0; i < d; ++i)
+        out.dcross_dsigma(row, i + d * j) =
+            0.5 * (s.third(k, i + d * j) - c * p(i, j) + p_lambda(i, k) * g(j) + g(i) * p_lambda(j, k));
+  }
+}
+
+}  // namespace gpilqg::gp

@@ -1,0 +1,177 @@
+#include "gpilqg/gp/residual_model.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <stdexcept>
+#include <thread>
+
+namespace gpilqg::gp {
+
+namespace {
+
+/// Per-thread scratch space: a const model shared between threads never allocates per step once each
+/// thread has warmed up its buffers.
+struct StepScratch {
+  Vector z;
+  std::vector<Prediction> predictions;
+};
+
+StepScratch& step_scratch(int input_dim, int outputs) {
+  thread_local StepScratch scratch;
+  if (scratch.z.size() != input_dim) scratch.z.resize(input_dim);
+  if (scratch.predictions.size() < static_cast<std::size_t>(outputs))
+    scratch.predictions.resize(static_cast<std::size_t>(outputs));
+  return scratch;
+}
+
+/// Runs task(i) for i in [0, count) on up to `threads` threads; rethrows the first exception.
+template <class Task>
+void run_parallel(int count, int threads, Task&& task) {
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(count));
+  std::atomic<int> next{0};
+  auto worker = [&] {
+    for (int i = next++; i < count; i = next++) {
+      try {
+        task(i);
+      } catch (...) {
+        errors[static_cast<std::size_t>(i)] = std::current_exception();
+      }
+    }
+  };
+  const int workers = std::max(1, std::min(threads, count));
+  std::vector<std::thread> pool;
+  for (int w = 1; w < workers; ++w) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace
+
+void ResidualModelOptions::validate() const {
+  fit.validate();
+  resample.validate();
+  if (threads < 1)
+    throw std::invalid_argument("ResidualModelOptions::threads = " + std::to_string(threads) + "; expected >= 1");
+}
+
+ResidualModel::ResidualModel(SimulatorPtr simulator, std::vector<std::unique_ptr<FittedGp>> outputs)
+    : simulator_(std::move(simulator)) {
+  if (!simulator_) throw std::invalid_argument("ResidualModel: null simulator");
+  const int n = simulator_->state_dim(), m = simulator_->control_dim();
+  if (static_cast<int>(outputs.size()) != n)
+    throw std::invalid_argument("ResidualModel: " + std::to_string(outputs.size()) + " GPs; expected one per state (" +
+                                std::to_string(n) + ")");
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    if (!outputs[i]) throw std::invalid_argument("ResidualModel: GP " + std::to_string(i) + " is null");
+    if (outputs[i]->input_dim() != n + m)
+      throw std::invalid_argument("ResidualModel: GP " + std::to_string(i) + " has " +
+                                  std::to_string(outputs[i]->input_dim()) + " inputs; expected n + m = " +
+                                  std::to_string(n + m) + " (z = [x; u])");
+    outputs_.push_back(std::move(outputs[i]));
+  }
+}
+
+ResidualModel ResidualModel::fit(SimulatorPtr simulator, const ResidualData& data, const GpBackend& backend,
+                                 const ResidualModelOptions& options, ResidualFitReport* report,
+                                 const ResidualData* validation, const ResidualModel* previous) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!simulator) throw std::invalid_argument("ResidualModel::fit: null simulator");
+  options.validate();
+  const int n = simulator->state_dim(), m = simulator->control_dim();
+  if (data.inputs.cols() != n + m || data.residuals.cols() != n || data.residuals.rows() != data.inputs.rows())
+    throw std::invalid_argument("ResidualModel::fit: data has inputs " + std::to_string(data.inputs.rows()) + "x" +
+                                std::to_string(data.inputs.cols()) + " and residuals " +
+                                std::to_string(data.residuals.rows()) + "x" + std::to_string(data.residuals.cols()) +
+                                "; expected N x " + std::to_string(n + m) + " and N x " + std::to_string(n));
+  if (previous != nullptr && (previous->state_dim() != n || previous->control_dim() != m))
+    throw std::invalid_argument("ResidualModel::fit: the previous model has different dimensions");
+
+  std::vector<std::unique_ptr<FittedGp>> outputs(static_cast<std::size_t>(n));
+  ResidualFitReport local;
+  ResidualFitReport& r = report != nullptr ? *report : local;
+  r = ResidualFitReport{};
+  r.outputs.resize(static_cast<std::size_t>(n));
+  if (validation != nullptr) r.resampling.resize(static_cast<std::size_t>(n));
+
+  run_parallel(n, options.threads, [&](int i) {
+    const auto index = static_cast<std::size_t>(i);
+    FitOptions fit_options = options.fit;
+    // Warm start from the previous learner of the same backend (the GP-ILQG loop refits every iteration).
+    if (previous != nullptr && previous->output(i).backend_name() == backend.name())
+      fit_options.warm_start = previous->output(i).parameters();
+    FitResult result;
+    if (validation != nullptr) {
+      result = fit_with_resampling(backend, data.output(i), validation->output(i),
+                                   previous != nullptr ? &previous->output(i) : nullptr, fit_options,
+                                   options.resample, &r.resampling[index]);
+    } else {
+      // The same seed for every output draws the same subsample, so all outputs share their inputs;
+      // restarts then differ per output through the offset seed (re-selection is a no-op).
+      const TrainingSet selected = backend.select_training_points(data.output(i), options.fit.seed);
+      fit_options.seed = options.fit.seed + 7919u * static_cast<std::uint64_t>(i);
+      result = backend.fit(selected, fit_options);
+    }
+    r.outputs[index] = result.summary;
+    outputs[index] = std::move(result.model);
+  });
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return ResidualModel(std::move(simulator), std::move(outputs));
+}
+
+ResidualModel ResidualModel::fit(SimulatorPtr simulator, const MeasurementSet& measurements, const GpBackend& backend,
+                                 const ResidualModelOptions& options, ResidualFitReport* report) {
+  if (!simulator) throw std::invalid_argument("ResidualModel::fit: null simulator");
+  const ResidualData data = make_residual_data(*simulator, measurements);
+  return fit(std::move(simulator), data, backend, options, report);
+}
+
+void ResidualModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians) const {
+  simulator_->step(x, u, x_next, jacobians);
+  const int n = state_dim(), m = control_dim();
+  StepScratch& s = step_scratch(n + m, n);
+  s.z.head(n) = x;
+  s.z.tail(m) = u;
+  const PredictionRequest request{false, jacobians != nullptr};
+  for (int i = 0; i < n; ++i) {
+    Prediction& p = s.predictions[static_cast<std::size_t>(i)];
+    outputs_[static_cast<std::size_t>(i)]->predict(s.z, p, request);
+    x_next(i) += p.mean;
+    if (jacobians != nullptr) {
+      jacobians->A.row(i) += p.mean_gradient.head(n).transpose();
+      jacobians->B.row(i) += p.mean_gradient.tail(m).transpose();
+    }
+  }
+}
+
+void ResidualModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const {
+  simulator_->noise(x, u, out, derivatives);
+}
+
+void ResidualModel::uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
+                                bool derivatives) const {
+  const int n = state_dim(), m = control_dim();
+  const double step = dt();
+  out.resize(n, m, n);
+  StepScratch& s = step_scratch(n + m, n);
+  s.z.head(n) = x;
+  s.z.tail(m) = u;
+  const PredictionRequest request{true, derivatives};
+  for (int i = 0; i < n; ++i) {
+    Prediction& p = s.predictions[static_cast<std::size_t>(i)];
+    outputs_[static_cast<std::size_t>(i)]->predict(s.z, p, request);
+    // The GP's variance is the per-step error variance (Sigma dt)_ii; G_ii^2 dt = var_i.
+    const double sigma = std::sqrt(p.variance / step);
+    out.columns(i, i) = sigma;
+    if (derivatives && sigma > 0.0) {
+      const double scale = 1.0 / (2.0 * sigma * step);
+      out.d_dx[static_cast<std::size_t>(i)].row(i) = scale * p.variance_gradient.head(n).transpose();
+      out.d_du[static_cast<std::size_t>(i)].row(i) = scale * p.variance_gradient.tail(m).transpose();
+    }
+  }
+}
+
+}  // namespace gpilqg::gp

@@ -1,0 +1,99 @@
+/// Practice 1 of DESIGN.md: after a warm-up, prediction and the residual model's step and
+/// uncertainty do not touch the heap. Counted by interposing glibc's malloc in this test program.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstddef>
+#include <vector>
+
+#include "gp_test_support.hpp"
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/systems.hpp"
+#include "gpilqg/gp/residual_model.hpp"
+
+// AddressSanitizer owns malloc itself; under it (GPILQG_SANITIZE) the counter is off and the tests skip.
+#if defined(__SANITIZE_ADDRESS__)
+#define GPILQG_COUNT_MALLOC 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define GPILQG_COUNT_MALLOC 0
+#endif
+#endif
+#ifndef GPILQG_COUNT_MALLOC
+#define GPILQG_COUNT_MALLOC 1
+#endif
+
+namespace {
+std::atomic<long> g_malloc_calls{0};
+}  // namespace
+
+#if GPILQG_COUNT_MALLOC
+extern "C" void* __libc_malloc(std::size_t size);  // NOLINT: glibc's allocator behind malloc
+
+extern "C" void* malloc(std::size_t size) {  // NOLINT: counts every allocation of the process
+  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_malloc(size);
+}
+#define SKIP_WITHOUT_COUNTER() (void)0
+#else
+#define SKIP_WITHOUT_COUNTER() GTEST_SKIP() << "malloc is AddressSanitizer's here; nothing to count"
+#endif
+
+namespace gpilqg::gp::test {
+namespace {
+
+TEST(Allocation, TheCounterSeesAllocations) {
+  SKIP_WITHOUT_COUNTER();
+  const long before = g_malloc_calls.load();
+  auto* block = new std::vector<double>(100);
+  delete block;
+  Vector v(1000);
+  v.setZero();
+  EXPECT_GE(g_malloc_calls.load() - before, 2);
+}
+
+TEST(Allocation, PredictionDoesNotAllocateAfterWarmUp) {
+  SKIP_WITHOUT_COUNTER();
+  const OracleData oracle = load_oracle();
+  const auto model = ExactGpBackend{}.condition(oracle.train, oracle.hyp.pack());
+  Prediction p;
+  const Vector z = oracle.test_inputs.row(0).transpose();
+  const PredictionRequest full{true, true};
+  model->predict(z, p, full);  // warm-up
+  const long before = g_malloc_calls.load();
+  for (int i = 0; i < 10; ++i) {
+    model->predict(z, p, full);
+    model->predict(z, p, PredictionRequest{false, true});
+    model->predict(z, p, PredictionRequest{true, false});
+  }
+  EXPECT_EQ(g_malloc_calls.load() - before, 0);
+}
+
+TEST(Allocation, ResidualModelStepAndUncertaintyDoNotAllocateAfterWarmUp) {
+  SKIP_WITHOUT_COUNTER();
+  auto simulator = std::make_shared<IntegratedStepModel>(make_system("cartpole"), Integrator::RK4, 0.05);
+  ResidualData data;
+  data.inputs = Matrix::Random(40, 5);
+  data.residuals = 0.01 * Matrix::Random(40, 4);
+  ResidualModelOptions options;
+  options.fit.optimise = false;
+  const ResidualModel model = ResidualModel::fit(simulator, data, ExactGpBackend{}, options);
+  const Vector x = Vector::Constant(4, 0.1), u = Vector::Constant(1, 0.2);
+  Vector next(4);
+  StepJacobians jac;
+  jac.resize(4, 1);
+  DiffusionColumns g;
+  model.step(x, u, next, &jac);  // warm-up
+  model.uncertainty(x, u, g, true);
+  const long before = g_malloc_calls.load();
+  for (int i = 0; i < 10; ++i) {
+    model.step(x, u, next, &jac);
+    model.step(x, u, next);
+    model.uncertainty(x, u, g, true);
+  }
+  EXPECT_EQ(g_malloc_calls.load() - before, 0);
+}
+
+}  // namespace
+}  // namespace gpilqg::gp::test

@@ -1,0 +1,495 @@
+// FITC / SPGP: agreement with the gp_oracle golden numbers (GPML 4.2 infFITC and NumPy, both jitter
+// rules, the pseudo-input gradient), central differences for every analytic gradient, the reduction
+// to the exact GP when the pseudo-inputs sit on the training inputs, the initialisation of the
+// pseudo-inputs, the backend (fit, options, prediction API) and failure paths. The properties shared
+// with every backend (save/load, degenerate data, far-field prior, ...) are in backend_typed_test.cpp.
+
+#include "gpilqg/gp/fitc.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "gp_test_support.hpp"
+#include "gpilqg/gp/hyperparameters.hpp"
+
+namespace gpilqg::gp::test {
+namespace {
+
+/// |a - e| <= tol * (|e| + max|e|): relative to each entry and to the largest one.
+::testing::AssertionResult near_relative(const Matrix& actual, const Matrix& expected, double tol) {
+  return matrices_near(actual, expected, tol * expected.cwiseAbs().maxCoeff(), tol);
+}
+
+Matrix scalar(double v) { return Matrix::Constant(1, 1, v); }
+
+/// Analytic against central-difference gradient: each entry within 1e-6 relative plus 1e-7 of the
+/// largest entry (the differences' rounding error scales with the NLML's magnitude).
+::testing::AssertionResult gradient_near(const Vector& analytic, const Vector& numeric) {
+  return matrices_near(analytic, numeric, 1e-7 * numeric.cwiseAbs().maxCoeff(), 1e-6);
+}
+
+Matrix oracle_inducing() { return read_numeric_csv(oracle_dir() / "data" / "Xu.csv"); }
+
+Vector oracle_theta(const OracleData& o) { return FitcLayout{3, 7}.pack(o.hyp.pack(), oracle_inducing()); }
+
+struct Predictions {
+  Vector mean, variance;
+  Matrix dmean, dvariance;  // one row per test point
+};
+
+/// Predictions of a predictor with the oracle's prior mean m(x) = sum sin(x_d) added.
+Predictions predict_with_prior_mean(const FitcPredictor& p, const Matrix& Xs) {
+  const int D = p.input_dim(), M = p.inducing();
+  Predictions out{Vector(Xs.rows()), Vector(Xs.rows()), Matrix(Xs.rows(), D), Matrix(Xs.rows(), D)};
+  Vector k(M), c(M), xs(D), dm(D), dv(D), dprior(D);
+  for (Eigen::Index i = 0; i < Xs.rows(); ++i) {
+    const Vector x = Xs.row(i).transpose();
+    double mean = 0, var = 0;
+    p.predict(x, k.data(), c.data(), xs.data(), mean, &var, dm.data(), dv.data());
+    out.mean(i) = mean + sum_of_sines(x, &dprior);
+    out.variance(i) = var;
+    out.dmean.row(i) = (dm + dprior).transpose();
+    out.dvariance.row(i) = dv.transpose();
+  }
+  return out;
+}
+
+/// Central-difference gradient of the NLML.
+Vector numeric_gradient(const FitcLikelihood& lik, const Vector& theta, double h = 1e-5) {
+  return ::gpilqg::test::numeric_jacobian(
+             [&](const Vector& t) { return Vector::Constant(1, lik.evaluate(t).value); }, theta, h)
+      .transpose();
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Oracle agreement (values to 1e-10 relative, prediction gradients to 1e-9)
+
+TEST(FitcOracle, DefaultJitterMatchesGpmlAndNumpy) {
+  const OracleData o = load_oracle();
+  const auto ref = load_oracle_json("gpml")["fitc_default"];
+  const auto numpy = load_oracle_json("python")["numpy_fitc_default"];
+  const FitcLikelihood lik(o.train.inputs, o.train.targets, 7, FitcJitter::gpml());
+  Vector grad;
+  const NlmlEvaluation e = lik.evaluate(oracle_theta(o), &grad);
+  EXPECT_EQ(e.status, FactorStatus::Ok);
+  EXPECT_TRUE(near_relative(scalar(e.value), scalar(ref["nlZ"].get<double>()), 1e-10));
+  Vector dhyp(5);
+  dhyp << json_matrix(ref["dnlZ_cov"]), ref["dnlZ_lik"].get<double>();
+  EXPECT_TRUE(near_relative(grad.head(5), dhyp, 1e-10));
+
+  const Predictions p = predict_with_prior_mean(lik.predictor(oracle_theta(o)), o.test_inputs);
+  EXPECT_TRUE(near_relative(p.mean, json_matrix(ref["fmu"]), 1e-10));
+  EXPECT_TRUE(near_relative(p.variance, json_matrix(ref["fs2"]), 1e-10));
+  EXPECT_TRUE(near_relative(p.mean, json_matrix(numpy["fmu"]), 1e-10));
+  EXPECT_TRUE(near_relative(p.variance, json_matrix(numpy["fs2"]), 1e-10));
+  EXPECT_TRUE(matrices_near(p.dmean, json_matrix(numpy["dfmu_dxs"]), 1e-9, 1e-9));
+  EXPECT_TRUE(matrices_near(p.dvariance, json_matrix(numpy["dfs2_dxs"]), 1e-9, 1e-9));
+  // GPML's central differences (h = 1e-5) carry about 1e-9 of truncation error.
+  EXPECT_TRUE(matrices_near(p.dmean, json_matrix(ref["dfmu_dxs_fd"]), 1e-8, 1e-8));
+  EXPECT_TRUE(matrices_near(p.dvariance, json_matrix(ref["dfs2_dxs_fd"]), 1e-8, 1e-8));
+}
+
+TEST(FitcOracle, PseudoInputGradientMatchesGpml) {
+  const OracleData o = load_oracle();
+  const auto ref = load_oracle_json("gpml")["fitc_xu"];
+  const FitcLikelihood lik(o.train.inputs, o.train.targets, 7, FitcJitter::gpml());
+  Vector grad;
+  const NlmlEvaluation e = lik.evaluate(oracle_theta(o), &grad);
+  EXPECT_TRUE(near_relative(scalar(e.value), scalar(ref["nlZ"].get<double>()), 1e-10));
+  Vector dhyp(5);
+  dhyp << json_matrix(ref["dnlZ_cov"]), ref["dnlZ_lik"].get<double>();
+  EXPECT_TRUE(near_relative(grad.head(5), dhyp, 1e-10));
+  const Matrix dxu = grad.tail(21).reshaped(7, 3);  // column-major, as vec(Xu)
+  EXPECT_TRUE(near_relative(dxu, json_matrix(ref["dnlZ_xu"]), 1e-10));
+}
+
+TEST(FitcOracle, FixedJitterMatchesGpmlAndNumpy) {
+  const OracleData o = load_oracle();
+  const auto ref = load_oracle_json("gpml")["fitc_snu1e-5"];
+  const auto numpy = load_oracle_json("python")["numpy_fitc_snu2_1e-10"];
+  const FitcLikelihood lik(o.train.inputs, o.train.targets, 7, FitcJitter::fixed(1e-10));
+  Vector grad;
+  const NlmlEvaluation e = lik.evaluate(oracle_theta(o), &grad);
+  EXPECT_TRUE(near_relative(scalar(e.value), scalar(ref["nlZ"].get<double>()), 1e-10));
+  EXPECT_TRUE(near_relative(scalar(e.value), scalar(numpy["nlZ"].get<double>()), 1e-10));
+  Vector dhyp(5);
+  dhyp << json_matrix(ref["dnlZ_cov"]), ref["dnlZ_lik"].get<double>();
+  EXPECT_TRUE(near_relative(grad.head(5), dhyp, 1e-10));
+  const Predictions p = predict_with_prior_mean(lik.predictor(oracle_theta(o)), o.test_inputs);
+  EXPECT_TRUE(near_relative(p.mean, json_matrix(ref["fmu"]), 1e-10));
+  EXPECT_TRUE(near_relative(p.variance, json_matrix(ref["fs2"]), 1e-10));
+  EXPECT_TRUE(matrices_near(p.dmean, json_matrix(numpy["dfmu_dxs"]), 1e-9, 1e-9));
+  EXPECT_TRUE(matrices_near(p.dvariance, json_matrix(numpy["dfs2_dxs"]), 1e-9, 1e-9));
+}
+
+TEST(FitcOracle, TheJitterRuleMatters) {
+  // The two rules differ by 2.8e-5 in nlZ (README): GPML's relative rule is really applied.
+  const OracleData o = load_oracle();
+  const auto run = [&](FitcJitter j) {
+    return FitcLikelihood(o.train.inputs, o.train.targets, 7, j).evaluate(oracle_theta(o)).value;
+  };
+  EXPECT_NEAR(run(FitcJitter::fixed(1e-10)) - run(FitcJitter::gpml()), 2.8283178266974573e-05, 1e-9);
+}
+
+TEST(FitcOracle, TheBackendPredictsTheOracleThroughTheInterface) {
+  const OracleData o = load_oracle();
+  const auto ref = load_oracle_json("gpml")["fitc_default"];
+  const auto numpy = load_oracle_json("python")["numpy_fitc_default"];
+  const auto model = FitcBackend().condition(o.train, oracle_theta(o));
+  EXPECT_EQ(model->backend_name(), "fitc");
+  EXPECT_EQ(model->conditioning().status, FactorStatus::Ok);
+  EXPECT_TRUE(near_relative(scalar(model->negative_log_marginal_likelihood()),
+                            scalar(ref["nlZ"].get<double>()), 1e-10));
+  Prediction p;
+  const Matrix dmean_ref = json_matrix(numpy["dfmu_dxs"]);
+  for (Eigen::Index i = 0; i < o.test_inputs.rows(); ++i) {
+    const Vector z = o.test_inputs.row(i).transpose();
+    model->predict(z, p, PredictionRequest{true, true});
+    add_prior_mean(&sum_of_sines, z, p);
+    EXPECT_TRUE(near_relative(scalar(p.mean), scalar(json_matrix(ref["fmu"])(i)), 1e-10));
+    EXPECT_TRUE(near_relative(scalar(p.variance), scalar(json_matrix(ref["fs2"])(i)), 1e-10));
+    EXPECT_TRUE(matrices_near(p.mean_gradient.transpose(), dmean_ref.row(i), 1e-9, 1e-9));
+    EXPECT_TRUE(
+        matrices_near(p.variance_gradient.transpose(), json_matrix(numpy["dfs2_dxs"]).row(i), 1e-9, 1e-9));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Central differences for every analytic gradient
+
+TEST(FitcGradient, EveryParameterMatchesCentralDifferencesForBothJitterRules) {
+  const OracleData o = load_oracle();
+  Vector theta = oracle_theta(o);
+  theta.head(5) += Vector::LinSpaced(5, -0.4, 0.3);                     // away from the reference values
+  theta.tail(21) += 0.3 * ::gpilqg::test::random_vector(21, -1, 1, 5);  // and other pseudo-inputs
+  for (const FitcJitter& rule :
+       {FitcJitter::gpml(), FitcJitter::fixed(1e-10), FitcJitter{FitcJitterKind::Relative, 1e-3}}) {
+    const FitcLikelihood lik(o.train.inputs, o.train.targets, 7, rule);
+    Vector grad;
+    ASSERT_EQ(lik.evaluate(theta, &grad).status, FactorStatus::Ok);
+    EXPECT_TRUE(gradient_near(grad, numeric_gradient(lik, theta))) << "jitter value " << rule.value;
+  }
+}
+
+TEST(FitcGradient, MatchesCentralDifferencesInFiveDimensionsWithManyPoints) {
+  const int N = 60, D = 5, M = 12;
+  const Matrix X = 2.0 * Matrix::Random(N, D);
+  const Vector r = X.array().sin().rowwise().sum().matrix() + 0.1 * Vector::Random(N);
+  Vector hyper(D + 2);
+  hyper << 0.2, 0.5, -0.1, 0.8, 0.3, 0.1, std::log(0.2);
+  const Matrix Xu = 2.0 * Matrix::Random(M, D);
+  const FitcLikelihood lik(X, r, M);
+  const Vector theta = FitcLayout{D, M}.pack(hyper, Xu);
+  Vector grad;
+  ASSERT_EQ(lik.evaluate(theta, &grad).status, FactorStatus::Ok);
+  EXPECT_TRUE(gradient_near(grad, numeric_gradient(lik, theta)));
+}
+
+TEST(FitcGradient, StaysExactWhenTheJitterIsEscalated) {
+  // Two identical pseudo-inputs and no jitter of its own: Kuu is singular, the schedule adds jitter
+  // proportional to sf2, and the gradient accounts for it.
+  const OracleData o = load_oracle();
+  Matrix Xu = oracle_inducing();
+  Xu.row(1) = Xu.row(0);
+  const FitcLikelihood lik(o.train.inputs, o.train.targets, 7, FitcJitter::fixed(0.0));
+  Vector theta = FitcLayout{3, 7}.pack(o.hyp.pack(), Xu);
+  Vector grad;
+  const NlmlEvaluation e = lik.evaluate(theta, &grad);
+  ASSERT_EQ(e.status, FactorStatus::JitterAdded);
+  EXPECT_GT(e.jitter, 0.0);
+  // Differences in the hyperparameters only: moving one of the duplicated points would change
+  // which jitter the schedule needs.
+  const Vector numeric = numeric_gradient(lik, theta);
+  EXPECT_TRUE(gradient_near(grad.head(5), numeric.head(5)));
+}
+
+TEST(FitcGradient, TwoThreadsGiveTheSameValueAndGradient) {
+  const int N = 1300, D = 3, M = 25;  // >= 500 points per thread, so two blocks are used
+  const Matrix X = 2.0 * Matrix::Random(N, D);
+  const Vector r = X.array().sin().rowwise().sum().matrix() + 0.1 * Vector::Random(N);
+  Vector hyper(D + 2);
+  hyper << 0.1, -0.2, 0.3, 0.2, std::log(0.1);
+  const Vector theta = FitcLayout{D, M}.pack(hyper, 2.0 * Matrix::Random(M, D));
+  Vector g1, g2;
+  const double v1 = FitcLikelihood(X, r, M, FitcJitter::gpml(), {}, 1).evaluate(theta, &g1).value;
+  const double v2 = FitcLikelihood(X, r, M, FitcJitter::gpml(), {}, 2).evaluate(theta, &g2).value;
+  EXPECT_NEAR(v1, v2, 1e-12 * std::abs(v1));
+  EXPECT_TRUE(matrices_near(g2, g1, 1e-11 * g1.cwiseAbs().maxCoeff()));
+}
+
+TEST(FitcGradient, PredictionGradientsMatchCentralDifferencesFarAndNear) {
+  const OracleData o = load_oracle();
+  const FitcPredictor p = FitcLikelihood(o.train.inputs, o.train.targets, 7).predictor(oracle_theta(o));
+  Vector k(7), c(7), xs(3), dm(3), dv(3);
+  for (const Vector& x : {Vector(o.test_inputs.row(2).transpose()),
+                          Vector(oracle_inducing().row(3).transpose()), Vector(Vector::Constant(3, 2.5))}) {
+    double mean = 0, var = 0;
+    p.predict(x, k.data(), c.data(), xs.data(), mean, &var, dm.data(), dv.data());
+    const Matrix numeric = ::gpilqg::test::numeric_jacobian(
+        [&](const Vector& at) {
+          Vector v(2);
+          p.predict(at, k.data(), c.data(), xs.data(), v(0), &v(1));
+          return v;
+        },
+        x, 1e-6);
+    EXPECT_TRUE(matrices_near(dm.transpose(), numeric.row(0), 1e-8, 1e-6));
+    EXPECT_TRUE(matrices_near(dv.transpose(), numeric.row(1), 1e-8, 1e-6));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Reduction: pseudo-inputs on the training inputs give the exact GP
+
+TEST(FitcReduction, PseudoInputsAtTheTrainingInputsGiveTheExactGp) {
+  // With Xu = X, Qff = Kff Kuu^-1 Kff = Kff - snu2 I + O(snu2^2) and Lambda = (snu2 + sn2) I, so
+  // Qff + Lambda = Kff + sn2 I up to snu2^2 / lambda_min(Kff): FITC equals the exact GP.
+  const OracleData o = load_oracle();
+  const auto exact = load_oracle_json("gpml")["exact"];
+  const Vector theta = FitcLayout{3, 20}.pack(o.hyp.pack(), o.train.inputs);
+  const FitcLikelihood lik(o.train.inputs, o.train.targets, 20, FitcJitter::fixed(1e-10));
+  Vector grad;
+  const NlmlEvaluation e = lik.evaluate(theta, &grad);
+  EXPECT_TRUE(near_relative(scalar(e.value), scalar(exact["nlZ"].get<double>()), 1e-7));
+  Vector dhyp(5);
+  dhyp << json_matrix(exact["dnlZ_cov"]), exact["dnlZ_lik"].get<double>();
+  EXPECT_TRUE(near_relative(grad.head(5), dhyp, 1e-6));
+  const Predictions p = predict_with_prior_mean(lik.predictor(theta), o.test_inputs);
+  EXPECT_TRUE(near_relative(p.mean, json_matrix(exact["fmu"]), 1e-7));
+  EXPECT_TRUE(near_relative(p.variance, json_matrix(exact["fs2"]), 1e-6));
+  const auto numpy = load_oracle_json("python")["numpy_exact"];
+  EXPECT_TRUE(matrices_near(p.dmean, json_matrix(numpy["dfmu_dxs"]), 1e-6, 1e-6));
+  EXPECT_TRUE(matrices_near(p.dvariance, json_matrix(numpy["dfs2_dxs"]), 1e-6, 1e-6));
+
+  // The same through the interface against the exact backend, on larger data at other points.
+  const int N = 80, D = 2;
+  TrainingSet data{3.0 * Matrix::Random(N, D), Vector(N)};
+  data.targets = data.inputs.col(0).array().sin() * data.inputs.col(1).array().cos();
+  Vector hyper(D + 2);
+  hyper << std::log(1.2), std::log(0.9), std::log(0.8), std::log(0.1);
+  FitcOptions options;
+  options.jitter = FitcJitter::fixed(1e-10);
+  const auto fitc = FitcBackend(options).condition(data, FitcLayout{D, N}.pack(hyper, data.inputs));
+  const auto reference = ExactGpBackend(ExactGpOptions{ExactGpOptions::kAllPoints}).condition(data, hyper);
+  EXPECT_NEAR(fitc->negative_log_marginal_likelihood(), reference->negative_log_marginal_likelihood(),
+              1e-6 * std::abs(reference->negative_log_marginal_likelihood()));
+  Prediction a, b;
+  for (int i = 0; i < 10; ++i) {
+    const Vector z = 3.5 * Vector::Random(D);
+    fitc->predict(z, a, PredictionRequest{true, true});
+    reference->predict(z, b, PredictionRequest{true, true});
+    EXPECT_NEAR(a.mean, b.mean, 1e-6);
+    EXPECT_NEAR(a.variance, b.variance, 1e-6);
+    EXPECT_TRUE(matrices_near(a.mean_gradient, b.mean_gradient, 1e-5));
+    EXPECT_TRUE(matrices_near(a.variance_gradient, b.variance_gradient, 1e-5));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Initialisation of the pseudo-inputs
+
+TEST(FitcInitialisation, KMeansPicksDistinctCentresInsideTheDataAndIsDeterministic) {
+  const OracleData o = load_oracle();
+  const Matrix& X = o.fit.inputs;  // 200 points
+  const Vector scale = initial_hyperparameters(o.fit).lengthscales();
+  const Matrix a = initial_pseudo_inputs(X, 15, scale, FitcInitialisation::KMeans, 3);
+  const Matrix b = initial_pseudo_inputs(X, 15, scale, FitcInitialisation::KMeans, 3);
+  const Matrix c = initial_pseudo_inputs(X, 15, scale, FitcInitialisation::KMeans, 4);
+  ASSERT_EQ(a.rows(), 15);
+  ASSERT_EQ(a.cols(), X.cols());
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  for (Eigen::Index m = 0; m < a.rows(); ++m) {
+    EXPECT_TRUE(((a.row(m).array() >= X.colwise().minCoeff().array()) &&
+                 (a.row(m).array() <= X.colwise().maxCoeff().array()))
+                    .all());
+    for (Eigen::Index n = m + 1; n < a.rows(); ++n) EXPECT_GT((a.row(m) - a.row(n)).norm(), 1e-6);
+  }
+  // Lloyd iterations lower the k-means objective (sum of squared distances to the nearest centre).
+  const auto cost = [&](const Matrix& centres) {
+    double total = 0;
+    for (Eigen::Index i = 0; i < X.rows(); ++i)
+      total += (centres.rowwise() - X.row(i))
+                   .cwiseQuotient(scale.transpose().replicate(centres.rows(), 1))
+                   .rowwise()
+                   .squaredNorm()
+                   .minCoeff();
+    return total;
+  };
+  const Matrix seeded = initial_pseudo_inputs(X, 15, scale, FitcInitialisation::KMeans, 3, 0);
+  EXPECT_LT(cost(a), cost(seeded));
+}
+
+TEST(FitcInitialisation, RandomSubsetAndSmallDataUseTrainingInputs) {
+  const OracleData o = load_oracle();
+  const Matrix& X = o.train.inputs;
+  const Vector scale = Vector::Ones(3);
+  const Matrix s = initial_pseudo_inputs(X, 6, scale, FitcInitialisation::RandomSubset, 9);
+  std::set<Eigen::Index> rows;
+  for (Eigen::Index m = 0; m < s.rows(); ++m) {
+    bool found = false;
+    for (Eigen::Index i = 0; i < X.rows(); ++i)
+      if (X.row(i) == s.row(m)) {
+        found = true;
+        rows.insert(i);
+      }
+    EXPECT_TRUE(found);
+  }
+  EXPECT_EQ(rows.size(), 6u);
+  EXPECT_EQ(initial_pseudo_inputs(X, 20, scale, FitcInitialisation::KMeans, 1), X);
+  EXPECT_EQ(initial_pseudo_inputs(X, 50, scale, FitcInitialisation::KMeans, 1), X);
+  EXPECT_THROW((void)initial_pseudo_inputs(X, 0, scale, FitcInitialisation::KMeans, 1),
+               std::invalid_argument);
+  EXPECT_THROW((void)initial_pseudo_inputs(X, 3, Vector::Ones(2), FitcInitialisation::KMeans, 1),
+               std::invalid_argument);
+  EXPECT_THROW((void)initial_pseudo_inputs(X, 3, -scale, FitcInitialisation::KMeans, 1),
+               std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The backend
+
+TEST(FitcBackendTest, FitMovesThePseudoInputsAndLowersTheNlml) {
+  const OracleData o = load_oracle();
+  FitcOptions fitc;
+  fitc.inducing = 10;
+  FitOptions options;
+  options.restarts = 0;
+  options.max_evaluations = 150;
+  const FitResult result = FitcBackend(fitc).fit(o.fit, options);
+  EXPECT_LT(result.summary.nlml, result.summary.initial_nlml) << result.summary.one_line();
+  EXPECT_EQ(result.model->parameters().size(), 5 + 10 * 3);
+  auto objective = FitcBackend(fitc).objective(o.fit, options);
+  const Vector initial = objective->initial_parameters();
+  EXPECT_GT((result.model->parameters().tail(30) - initial.tail(30)).norm(), 1e-3);
+  // The fitted sparse model predicts the held-out function about as well as the data allow.
+  Vector mean, variance;
+  result.model->predict(o.test_inputs, mean, variance);
+  EXPECT_TRUE(mean.allFinite());
+  EXPECT_TRUE((variance.array() >= 0.0).all());
+}
+
+TEST(FitcBackendTest, FixedPseudoInputsStayWhereTheyStarted) {
+  const OracleData o = load_oracle();
+  FitcOptions fitc;
+  fitc.inducing = 8;
+  fitc.optimise_pseudo_inputs = false;
+  FitOptions options;
+  options.restarts = 0;
+  options.max_evaluations = 60;
+  const auto backend = FitcBackend(fitc);
+  const Vector initial = backend.objective(o.fit, options)->initial_parameters();
+  const FitResult result = backend.fit(o.fit, options);
+  EXPECT_EQ(result.model->parameters().tail(24), initial.tail(24));
+  EXPECT_LT(result.summary.nlml, result.summary.initial_nlml);
+}
+
+TEST(FitcBackendTest, ObjectiveBoundsAndInitialValuesAreConsistent) {
+  const OracleData o = load_oracle();
+  FitcOptions fitc;
+  fitc.inducing = 50;  // more than N = 20: min(M, N) pseudo-inputs, on the training inputs
+  const auto objective = FitcBackend(fitc).objective(o.train, FitOptions{});
+  EXPECT_EQ(objective->parameter_count(), 5 + 20 * 3);
+  EXPECT_EQ(objective->input_dim(), 3);
+  const Vector initial = objective->initial_parameters();
+  const ParameterBounds b = objective->bounds();
+  EXPECT_TRUE((initial.array() >= b.lower.array()).all() && (initial.array() <= b.upper.array()).all());
+  EXPECT_EQ((FitcLayout{3, 20}.inducing_inputs(initial)), o.train.inputs);
+}
+
+TEST(FitcBackendTest, PredictionRequestsComputeOnlyWhatIsAsked) {
+  const OracleData o = load_oracle();
+  const auto model = FitcBackend().condition(o.train, oracle_theta(o));
+  const Vector z = o.test_inputs.row(1).transpose();
+  Prediction full, mean_only, no_gradient;
+  model->predict(z, full, PredictionRequest{true, true});
+  model->predict(z, mean_only, PredictionRequest{false, true});
+  model->predict(z, no_gradient, PredictionRequest{true, false});
+  EXPECT_EQ(mean_only.mean, full.mean);
+  EXPECT_EQ(mean_only.mean_gradient, full.mean_gradient);
+  EXPECT_EQ(mean_only.variance_gradient.size(), 0);
+  EXPECT_EQ(no_gradient.variance, full.variance);
+  EXPECT_EQ(no_gradient.mean_gradient.size(), 0);
+  EXPECT_EQ(full.workspace.cross.size(), 7);  // k(Xu, z)
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Failure paths
+
+TEST(FitcFailure, BadParametersGiveAFailedStatusNeverNaN) {
+  const OracleData o = load_oracle();
+  const FitcLikelihood lik(o.train.inputs, o.train.targets, 7);
+  Vector theta = oracle_theta(o);
+  Vector grad;
+  for (const double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    Vector t = theta;
+    t(8) = bad;
+    const NlmlEvaluation e = lik.evaluate(t, &grad);
+    EXPECT_EQ(e.status, FactorStatus::Failed);
+    EXPECT_EQ(e.value, std::numeric_limits<double>::infinity());
+    EXPECT_EQ(grad, Vector::Zero(theta.size()));
+  }
+  Vector huge = theta;
+  huge(3) = 400.0;  // sf^2 = exp(800) overflows
+  EXPECT_EQ(lik.evaluate(huge, &grad).status, FactorStatus::Failed);
+  EXPECT_THROW((void)lik.predictor(huge), std::runtime_error);
+  EXPECT_THROW((void)FitcBackend().condition(o.train, huge), std::runtime_error);
+  // Tiny noise and tiny length-scales: still a finite value or a clean failure, never NaN.
+  Vector tiny = theta;
+  tiny.head(3).setConstant(-20.0);
+  tiny(4) = -30.0;
+  const NlmlEvaluation t = lik.evaluate(tiny, &grad);
+  EXPECT_FALSE(std::isnan(t.value));
+  EXPECT_TRUE(grad.allFinite());
+}
+
+TEST(FitcFailure, SizesAndOptionsAreCheckedWithTheValuesInTheMessage) {
+  const OracleData o = load_oracle();
+  const FitcLikelihood lik(o.train.inputs, o.train.targets, 7);
+  EXPECT_THROW((void)lik.evaluate(Vector::Zero(5)), std::invalid_argument);
+  EXPECT_THROW(FitcLikelihood(o.train.inputs, o.train.targets.head(3), 7), std::invalid_argument);
+  EXPECT_THROW(FitcLikelihood(o.train.inputs, o.train.targets, 0), std::invalid_argument);
+  EXPECT_THROW(FitcLikelihood(o.train.inputs, o.train.targets, 7, FitcJitter::fixed(-1.0)),
+               std::invalid_argument);
+  auto message = [](auto&& action) {
+    try {
+      action();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no exception");
+  };
+  FitcOptions bad;
+  bad.inducing = 0;
+  EXPECT_NE(message([&] { FitcBackend b(bad); }).find("FitcOptions::inducing = 0"), std::string::npos);
+  bad = FitcOptions{};
+  bad.kmeans_iterations = -2;
+  EXPECT_NE(message([&] { FitcBackend b(bad); }).find("kmeans_iterations = -2"), std::string::npos);
+  // 5 + 7 entries cannot hold whole pseudo-inputs in 3 dimensions.
+  EXPECT_NE(message([&] { (void)FitcBackend().condition(o.train, Vector::Zero(12)); }).find("12 entries"),
+            std::string::npos);
+  Vector nan_theta = oracle_theta(o);
+  nan_theta(0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW((void)FitcBackend().condition(o.train, nan_theta), std::invalid_argument);
+}
+
+TEST(FitcFailure, DuplicatePseudoInputsAreConditionedWithReportedJitter) {
+  const OracleData o = load_oracle();
+  Matrix Xu = oracle_inducing();
+  Xu.row(4) = Xu.row(2);
+  FitcOptions options;
+  options.jitter = FitcJitter::fixed(0.0);
+  const auto model = FitcBackend(options).condition(o.train, FitcLayout{3, 7}.pack(o.hyp.pack(), Xu));
+  EXPECT_EQ(model->conditioning().status, FactorStatus::JitterAdded);
+  EXPECT_GT(model->conditioning().jitter, 0.0);
+  Prediction p;
+  model->predict(o.test_inputs.row(0).transpose(), p, PredictionRequest{true, true});
+  EXPECT_TRUE(std::isfinite(p.mean) && std::isfinite(p.variance));
+  EXPECT_TRUE(p.mean_gradient.allFinite() && p.variance_gradient.allFinite());
+}
+
+}  // namespace
+}  // namespace gpilqg::gp::test

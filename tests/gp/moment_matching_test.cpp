@@ -1,0 +1,470 @@
+/// Exact moment matching of SE-ARD GPs (moment_matching.hpp) against independent references:
+///  1. Sigma = 0: the plain GP posterior mean and latent variance, computed here from the kernel;
+///  2. Monte Carlo with 1e5 input samples: M, S and C within 4 standard errors;
+///  3. every derivative against central differences (one Sigma entry at a time, and symmetric pairs);
+///  4. size and value validation.
+/// The GPs are conditioned here with Eigen's LLT, independently of the library's helper.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "gpilqg/gp/moment_matching.hpp"
+#include "test_support.hpp"
+
+namespace gpilqg::gp::test {
+namespace {
+
+using ::gpilqg::test::matrices_near;
+using ::gpilqg::test::numeric_jacobian;
+
+double se_ard(const VectorCRef& x, const VectorCRef& y, const Vector& log_l, double log_sf) {
+  const double r2 = ((x - y).array() / log_l.array().exp()).square().sum();
+  return std::exp(2.0 * log_sf - 0.5 * r2);
+}
+
+/// E independent GPs on N random inputs in [-spread, spread]^D with smooth targets; beta and Kinv
+/// from LLT.
+struct TestGp {
+  Matrix inputs;
+  std::vector<SeArdOutput> outputs;
+
+  Vector kernel_column(int a, const VectorCRef& z) const {
+    Vector k(inputs.rows());
+    for (Eigen::Index i = 0; i < inputs.rows(); ++i)
+      k(i) = se_ard(inputs.row(i).transpose(), z, outputs[a].log_lengthscales, outputs[a].log_signal_std);
+    return k;
+  }
+  double posterior_mean(int a, const VectorCRef& z) const { return outputs[a].beta.dot(kernel_column(a, z)); }
+  double posterior_variance(int a, const VectorCRef& z) const {
+    const Vector k = kernel_column(a, z);
+    return std::exp(2.0 * outputs[a].log_signal_std) - k.dot(outputs[a].Kinv * k);
+  }
+  SeArdMomentMatcher matcher() const { return SeArdMomentMatcher(inputs, outputs); }
+};
+
+TestGp make_gp(int n, int d, int e, unsigned seed, double spread = 1.0) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> uniform(-spread, spread);
+  std::uniform_real_distribution<double> log_l(std::log(0.5), std::log(1.5));
+  std::uniform_real_distribution<double> log_sf(std::log(0.5), std::log(1.5));
+  std::normal_distribution<double> noise(0.0, 0.05);
+  TestGp gp;
+  gp.inputs.resize(n, d);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < d; ++j) gp.inputs(i, j) = uniform(gen);
+  const double sn2 = 0.1 * 0.1;
+  for (int a = 0; a < e; ++a) {
+    SeArdOutput o;
+    o.log_lengthscales.resize(d);
+    for (int j = 0; j < d; ++j) o.log_lengthscales(j) = log_l(gen);
+    o.log_signal_std = log_sf(gen);
+    Vector y(n);
+    for (int i = 0; i < n; ++i) {
+      const auto x = gp.inputs.row(i);
+      y(i) = std::sin(2.0 * x(0) + a) + 0.5 * x(d - 1) * x(0) + 0.3 * (a + 1) * x(d / 2) + noise(gen);
+    }
+    Matrix k(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        k(i, j) = se_ard(gp.inputs.row(i).transpose(), gp.inputs.row(j).transpose(), o.log_lengthscales,
+                         o.log_signal_std);
+    k.diagonal().array() += sn2;
+    const Eigen::LLT<Matrix> llt(k);
+    EXPECT_EQ(llt.info(), Eigen::Success);
+    o.beta = llt.solve(y);
+    o.Kinv = llt.solve(Matrix::Identity(n, n));
+    gp.outputs.push_back(o);
+  }
+  return gp;
+}
+
+/// A correlated covariance L L' (D x D); zero_index >= 0 zeroes that row and column (a deterministic
+/// input such as a control).
+Matrix make_sigma(int d, double scale, unsigned seed, int zero_index = -1) {
+  std::mt19937 gen(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Matrix l = Matrix::Zero(d, d);
+  for (int i = 0; i < d; ++i) {
+    for (int j = 0; j < i; ++j) l(i, j) = 0.4 * scale * normal(gen);
+    l(i, i) = scale * (0.6 + 0.2 * std::abs(normal(gen)));
+  }
+  Matrix sigma = l * l.transpose();
+  if (zero_index >= 0) {
+    sigma.row(zero_index).setZero();
+    sigma.col(zero_index).setZero();
+  }
+  return sigma;
+}
+
+/// [M; vec S; vec C] as one vector, for finite differences.
+Vector stacked_moments(const SeArdMomentMatcher& matcher, const Vector& mu, const Matrix& sigma) {
+  MomentMatch m;
+  matcher.propagate(mu, sigma, m);
+  const Eigen::Index e = m.mean.size();
+  const Eigen::Index d = mu.size();
+  Vector out(e + e * e + d * e);
+  out << m.mean, m.covariance.reshaped(), m.cross_covariance.reshaped();
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------------
+// 1. Deterministic input
+
+TEST(MomentMatching, DeterministicInputIsTheGpPosterior) {
+  const TestGp gp = make_gp(25, 4, 3, 11);
+  const SeArdMomentMatcher matcher = gp.matcher();
+  MomentMatch m;
+  const Matrix zero = Matrix::Zero(4, 4);
+  for (unsigned trial = 0; trial < 4; ++trial) {
+    // one test point far from the data, the rest inside it; one exactly at a training input
+    Vector mu = ::gpilqg::test::random_vector(4, -1.0, 1.0, 100 + trial);
+    if (trial == 2) mu = gp.inputs.row(5).transpose();
+    if (trial == 3) mu *= 3.0;
+    matcher.propagate(mu, zero, m, MomentDerivatives::All);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(m.mean(a), gp.posterior_mean(a, mu), 1e-12) << "output " << a << ", trial " << trial;
+      EXPECT_NEAR(m.covariance(a, a), gp.posterior_variance(a, mu), 1e-12) << "output " << a;
+      for (int b = 0; b < 3; ++b)
+        if (b != a) {
+          EXPECT_NEAR(m.covariance(a, b), 0.0, 1e-12) << a << ", " << b;
+        }
+    }
+    EXPECT_TRUE(m.cross_covariance.isZero(0.0));
+    // dM/dmu at Sigma = 0 is the GP mean gradient sum_i beta_i k_i W (x_i - mu).
+    for (int a = 0; a < 3; ++a) {
+      const Vector k = gp.kernel_column(a, mu);
+      const Vector w = (-2.0 * gp.outputs[a].log_lengthscales.array()).exp().matrix();
+      const Vector grad = w.asDiagonal() *
+                          ((gp.inputs.rowwise() - mu.transpose()).transpose() * gp.outputs[a].beta.cwiseProduct(k));
+      EXPECT_TRUE(matrices_near(m.dmean_dmu.row(a).transpose(), grad, 1e-12));
+    }
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// 2. Monte Carlo
+
+struct MonteCarloCheck {
+  double worst_z = 0.0;  ///< largest |analytic - MC| / SE seen
+};
+
+/// Compares the moments at (mu, Sigma) with `samples` draws z ~ N(mu, Sigma), each quantity within
+/// 4 standard errors (SE from the sample variance of the per-sample terms). Prints the numbers.
+MonteCarloCheck check_against_monte_carlo(const TestGp& gp, const Vector& mu, const Matrix& sigma, int samples,
+                                          const std::string& label) {
+  const int d = static_cast<int>(mu.size());
+  const int e = static_cast<int>(gp.outputs.size());
+  MomentMatch m;
+  gp.matcher().propagate(mu, sigma, m);
+
+  // Sample with a factor that tolerates singular Sigma: eigen-decomposition, negative rounding clamped.
+  const Eigen::SelfAdjointEigenSolver<Matrix> eig(sigma);
+  const Matrix root = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+  std::mt19937_64 gen(2024);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Matrix dz(samples, d);      // z - mu
+  Matrix means(samples, e);   // posterior means m_a(z)
+  Matrix vars(samples, e);    // posterior variances v_a(z)
+  Vector xi(d);
+  for (int s = 0; s < samples; ++s) {
+    for (int j = 0; j < d; ++j) xi(j) = normal(gen);
+    const Vector delta = root * xi;
+    dz.row(s) = delta.transpose();
+    const Vector z = mu + delta;
+    for (int a = 0; a < e; ++a) {
+      const Vector k = gp.kernel_column(a, z);
+      means(s, a) = gp.outputs[a].beta.dot(k);
+      vars(s, a) = std::exp(2.0 * gp.outputs[a].log_signal_std) - k.dot(gp.outputs[a].Kinv * k);
+    }
+  }
+  const double count = samples;
+  const auto mean_and_se = [count](const Vector& terms) {
+    const double mean = terms.mean();
+    const double var = (terms.array() - mean).square().sum() / (count - 1.0);
+    return std::pair<double, double>{mean, std::sqrt(var / count)};
+  };
+  MonteCarloCheck check;
+  const auto compare = [&](const std::string& name, double analytic, const Vector& terms) {
+    const auto [mc, se] = mean_and_se(terms);
+    const double z = se > 0.0 ? (analytic - mc) / se : (analytic == mc ? 0.0 : INFINITY);
+    std::printf("  [%s] %-8s analytic % .6f  MC % .6f  SE %.2e  z % .2f\n", label.c_str(), name.c_str(), analytic,
+                mc, se, z);
+    if (se == 0.0) {
+      EXPECT_NEAR(analytic, mc, 1e-12) << label << " " << name;  // deterministic quantity
+    } else {
+      EXPECT_LE(std::abs(z), 4.0) << label << " " << name << ": analytic " << analytic << ", MC " << mc
+                                  << " +- " << se;
+    }
+    check.worst_z = std::max(check.worst_z, std::abs(z));
+  };
+  const Vector sample_means = means.colwise().mean().transpose();
+  for (int a = 0; a < e; ++a) compare("M" + std::to_string(a), m.mean(a), means.col(a));
+  // S_ab = Cov[m_a, m_b] + delta_ab E[v_a]; per-sample term (m_a - mbar_a)(m_b - mbar_b) + delta_ab v_a.
+  for (int a = 0; a < e; ++a)
+    for (int b = a; b < e; ++b) {
+      Vector terms = (means.col(a).array() - sample_means(a)) * (means.col(b).array() - sample_means(b));
+      terms *= count / (count - 1.0);
+      if (a == b) terms += vars.col(a);
+      compare("S" + std::to_string(a) + std::to_string(b), m.covariance(a, b), terms);
+    }
+  // C_ka = E[(z_k - mu_k) m_a(z)] (E[z - mu] = 0 exactly, mu known).
+  for (int k = 0; k < d; ++k)
+    for (int a = 0; a < e; ++a)
+      compare("C" + std::to_string(k) + std::to_string(a), m.cross_covariance(k, a),
+              dz.col(k).cwiseProduct(means.col(a)));
+  return check;
+}
+
+TEST(MomentMatching, AgreesWithMonteCarlo) {
+  const TestGp gp = make_gp(20, 3, 2, 5);
+  Vector mu(3);
+  mu << 0.2, -0.3, 0.1;
+  const Matrix sigma = make_sigma(3, 0.45, 7);
+  const MonteCarloCheck check = check_against_monte_carlo(gp, mu, sigma, 100000, "full Sigma");
+  std::printf("  worst |z| = %.2f\n", check.worst_z);
+}
+
+TEST(MomentMatching, AgreesWithMonteCarloWithADeterministicInput) {
+  const TestGp gp = make_gp(20, 3, 2, 5);
+  Vector mu(3);
+  mu << -0.1, 0.4, 0.3;
+  const Matrix sigma = make_sigma(3, 0.5, 8, /*zero_index=*/2);
+  const MonteCarloCheck check = check_against_monte_carlo(gp, mu, sigma, 100000, "zero row 2");
+  std::printf("  worst |z| = %.2f\n", check.worst_z);
+  MomentMatch m;
+  gp.matcher().propagate(mu, sigma, m);
+  EXPECT_TRUE(m.cross_covariance.row(2).isZero(1e-15));
+}
+
+// ------------------------------------------------------------------------------------------------
+// 3. Derivatives against central differences
+
+void check_derivatives(const TestGp& gp, const Vector& mu, const Matrix& sigma, const std::string& label) {
+  const SeArdMomentMatcher matcher = gp.matcher();
+  const int d = static_cast<int>(mu.size());
+  const int e = static_cast<int>(gp.outputs.size());
+  MomentMatch m;
+  matcher.propagate(mu, sigma, m, MomentDerivatives::All);
+  ASSERT_TRUE(m.has_derivatives);
+
+  Matrix analytic_mu(e + e * e + d * e, d);
+  analytic_mu << m.dmean_dmu, m.dcovariance_dmu, m.dcross_dmu;
+  Matrix analytic_sigma(e + e * e + d * e, d * d);
+  analytic_sigma << m.dmean_dsigma, m.dcovariance_dsigma, m.dcross_dsigma;
+
+  const double h = 1e-5;
+  const Matrix numeric_mu =
+      numeric_jacobian([&](const Vector& x) { return stacked_moments(matcher, x, sigma); }, mu, h);
+  EXPECT_TRUE(matrices_near(analytic_mu, numeric_mu, 1e-8, 1e-6)) << label << ": d/dmu";
+
+  // One entry of Sigma at a time (unsymmetric perturbations).
+  const Vector flat = sigma.reshaped();
+  const Matrix numeric_sigma = numeric_jacobian(
+      [&](const Vector& x) { return stacked_moments(matcher, mu, x.reshaped(d, d)); }, flat, h);
+  EXPECT_TRUE(matrices_near(analytic_sigma, numeric_sigma, 1e-8, 1e-6)) << label << ": d/dSigma_ij";
+  std::printf("  [%s] max |analytic - central difference|: d/dmu %.1e (largest entry %.2f), d/dSigma %.1e "
+              "(largest entry %.2f)\n",
+              label.c_str(), (analytic_mu - numeric_mu).cwiseAbs().maxCoeff(), analytic_mu.cwiseAbs().maxCoeff(),
+              (analytic_sigma - numeric_sigma).cwiseAbs().maxCoeff(), analytic_sigma.cwiseAbs().maxCoeff());
+
+  // Symmetric perturbations Sigma_ij = Sigma_ji = p (a packed covariance): d/dp = d/dSigma_ij + d/dSigma_ji.
+  for (int j = 0; j < d; ++j)
+    for (int i = j; i < d; ++i) {
+      Matrix direction = Matrix::Zero(d, d);
+      direction(i, j) = direction(j, i) = 1.0;
+      const Vector numeric = (stacked_moments(matcher, mu, sigma + h * direction) -
+                              stacked_moments(matcher, mu, sigma - h * direction)) /
+                             (2.0 * h);
+      Vector expected = analytic_sigma.col(i + d * j);
+      if (i != j) expected += analytic_sigma.col(j + d * i);
+      EXPECT_TRUE(matrices_near(expected, numeric, 1e-8, 1e-6)) << label << ": packed (" << i << ", " << j << ")";
+    }
+  // d/dSigma_ij == d/dSigma_ji, and S's derivative blocks are symmetric in (a, b).
+  for (int j = 0; j < d; ++j)
+    for (int i = 0; i < d; ++i)
+      EXPECT_TRUE(matrices_near(analytic_sigma.col(i + d * j), analytic_sigma.col(j + d * i), 1e-14, 1e-12));
+  for (int a = 0; a < e; ++a)
+    for (int b = 0; b < e; ++b) {
+      EXPECT_EQ(m.dcovariance_dmu.row(a + e * b), m.dcovariance_dmu.row(b + e * a));
+      EXPECT_EQ(m.dcovariance_dsigma.row(a + e * b), m.dcovariance_dsigma.row(b + e * a));
+    }
+}
+
+TEST(MomentMatching, DerivativesMatchCentralDifferences) {
+  const TestGp gp = make_gp(15, 4, 3, 21);
+  Vector mu(4);
+  mu << 0.3, -0.2, 0.5, 0.1;
+  check_derivatives(gp, mu, make_sigma(4, 0.4, 3), "full Sigma");
+}
+
+TEST(MomentMatching, DerivativesMatchCentralDifferencesWithADeterministicInput) {
+  const TestGp gp = make_gp(15, 4, 3, 22);
+  Vector mu(4);
+  mu << -0.4, 0.1, 0.2, 0.6;
+  check_derivatives(gp, mu, make_sigma(4, 0.4, 4, /*zero_index=*/3), "zero row 3");
+}
+
+TEST(MomentMatching, DerivativesMatchCentralDifferencesAtSigmaZero) {
+  const TestGp gp = make_gp(12, 3, 2, 23);
+  Vector mu(3);
+  mu << 0.1, 0.2, -0.3;
+  check_derivatives(gp, mu, Matrix::Zero(3, 3), "Sigma = 0");
+}
+
+TEST(MomentMatching, DerivativesMatchCentralDifferencesOneInputOneOutput) {
+  const TestGp gp = make_gp(10, 1, 1, 24);
+  check_derivatives(gp, Vector::Constant(1, 0.2), Matrix::Constant(1, 1, 0.3), "D = E = 1");
+}
+
+TEST(MomentMatching, LargeTrainingSetsGoThroughTheTiledProducts) {
+  // N > 128: every N-sized product is split into 128-tiles (moment_matching_internal.hpp).
+  // Spread out so that K + sn^2 I stays well conditioned: with 300 points in [-1, 1]^3 the cancellation
+  // in sf^2 - tr(Kinv Q) leaves ~1e-12 of rounding in S, i.e. ~1e-7 in a central difference with
+  // h = 1e-5 (checked: the difference then grows again for smaller h), which is noise, not a bug.
+  const TestGp gp = make_gp(300, 3, 2, 25, /*spread=*/3.0);
+  Vector mu(3);
+  mu << 0.2, 0.1, -0.1;
+  check_derivatives(gp, mu, make_sigma(3, 0.3, 6, /*zero_index=*/2), "N = 300");
+  MomentMatch m;
+  gp.matcher().propagate(mu, Matrix::Zero(3, 3), m);
+  for (int a = 0; a < 2; ++a) {
+    EXPECT_NEAR(m.mean(a), gp.posterior_mean(a, mu), 1e-10);
+    EXPECT_NEAR(m.covariance(a, a), gp.posterior_variance(a, mu), 1e-10);
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Workspace reuse, skipping derivatives, the conditioning helper
+
+TEST(MomentMatching, ReusedResultMatchesAFreshOneAndDerivativesCanBeSkipped) {
+  const TestGp gp = make_gp(18, 3, 3, 31);
+  const SeArdMomentMatcher matcher = gp.matcher();
+  const Vector mu1 = ::gpilqg::test::random_vector(3, -0.5, 0.5, 1);
+  const Vector mu2 = ::gpilqg::test::random_vector(3, -0.5, 0.5, 2);
+  const Matrix sigma1 = make_sigma(3, 0.3, 1);
+  const Matrix sigma2 = make_sigma(3, 0.5, 2, 0);
+
+  MomentMatch reused;
+  matcher.propagate(mu1, sigma1, reused, MomentDerivatives::All);
+  matcher.propagate(mu2, sigma2, reused, MomentDerivatives::None);
+  EXPECT_FALSE(reused.has_derivatives);
+  MomentMatch fresh;
+  matcher.propagate(mu2, sigma2, fresh, MomentDerivatives::All);
+  EXPECT_EQ(reused.mean, fresh.mean);
+  EXPECT_EQ(reused.covariance, fresh.covariance);
+  EXPECT_EQ(reused.cross_covariance, fresh.cross_covariance);
+  matcher.propagate(mu2, sigma2, reused, MomentDerivatives::All);
+  EXPECT_TRUE(reused.has_derivatives);
+  EXPECT_EQ(reused.dcovariance_dsigma, fresh.dcovariance_dsigma);
+  EXPECT_EQ(reused.dcross_dsigma, fresh.dcross_dsigma);
+  EXPECT_EQ(reused.dmean_dsigma, fresh.dmean_dsigma);
+  EXPECT_EQ(reused.covariance, reused.covariance.transpose());
+}
+
+TEST(MomentMatching, OnlyTheSymmetricPartOfSigmaIsRead) {
+  const TestGp gp = make_gp(12, 3, 2, 32);
+  const SeArdMomentMatcher matcher = gp.matcher();
+  const Vector mu = Vector::Constant(3, 0.1);
+  const Matrix sigma = make_sigma(3, 0.4, 5);
+  Matrix skewed = sigma;
+  skewed(0, 1) += 0.05;
+  skewed(1, 0) -= 0.05;
+  MomentMatch a, b;
+  matcher.propagate(mu, sigma, a);
+  matcher.propagate(mu, skewed, b);
+  EXPECT_TRUE(matrices_near(a.covariance, b.covariance, 1e-15, 1e-13));
+  EXPECT_TRUE(matrices_near(a.cross_covariance, b.cross_covariance, 1e-15, 1e-13));
+}
+
+TEST(MomentMatching, ConditioningHelperAgreesWithDirectConstruction) {
+  const TestGp gp = make_gp(15, 2, 1, 33);
+  // Recover y from beta: y = (K + sn^2 I) beta, then condition again with the helper.
+  const SeArdOutput& o = gp.outputs[0];
+  const Eigen::LLT<Matrix> kinv_factor(o.Kinv);
+  const Vector y = kinv_factor.solve(o.beta);
+  const SeArdOutput helper = condition_se_ard_output(gp.inputs, y, o.log_lengthscales, o.log_signal_std,
+                                                     std::log(0.1));
+  EXPECT_TRUE(matrices_near(helper.beta, o.beta, 1e-8, 1e-8));
+  EXPECT_TRUE(matrices_near(helper.Kinv, o.Kinv, 1e-8, 1e-8));
+}
+
+// ------------------------------------------------------------------------------------------------
+// 4. Validation
+
+template <class F>
+void expect_invalid(F&& f, const std::string& fragment) {
+  try {
+    f();
+    ADD_FAILURE() << "no exception; expected one mentioning '" << fragment << "'";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find(fragment), std::string::npos)
+        << "message '" << error.what() << "' does not mention '" << fragment << "'";
+  }
+}
+
+TEST(MomentMatching, ConstructionValidatesSizesAndValues) {
+  const TestGp gp = make_gp(8, 3, 2, 41);
+  expect_invalid([&] { SeArdMomentMatcher(Matrix(0, 3), gp.outputs); }, "inputs");
+  expect_invalid([&] { SeArdMomentMatcher(gp.inputs, {}); }, "outputs is empty");
+  {
+    auto outputs = gp.outputs;
+    outputs[1].log_lengthscales.resize(2);
+    expect_invalid([&] { SeArdMomentMatcher(gp.inputs, outputs); }, "outputs[1].log_lengthscales");
+  }
+  {
+    auto outputs = gp.outputs;
+    outputs[0].beta.resize(7);
+    expect_invalid([&] { SeArdMomentMatcher(gp.inputs, outputs); }, "outputs[0].beta");
+  }
+  {
+    auto outputs = gp.outputs;
+    outputs[1].Kinv.resize(8, 7);
+    expect_invalid([&] { SeArdMomentMatcher(gp.inputs, outputs); }, "outputs[1].Kinv");
+  }
+  {
+    auto outputs = gp.outputs;
+    outputs[1].beta(3) = NAN;
+    expect_invalid([&] { SeArdMomentMatcher(gp.inputs, outputs); }, "outputs[1].beta");
+  }
+  {
+    auto outputs = gp.outputs;
+    outputs[0].log_signal_std = INFINITY;
+    expect_invalid([&] { SeArdMomentMatcher(gp.inputs, outputs); }, "outputs[0].log_signal_std");
+  }
+  {
+    Matrix inputs = gp.inputs;
+    inputs(2, 1) = NAN;
+    expect_invalid([&] { SeArdMomentMatcher(inputs, gp.outputs); }, "inputs");
+  }
+}
+
+TEST(MomentMatching, PropagateValidatesSizesAndValues) {
+  const TestGp gp = make_gp(8, 3, 2, 42);
+  const SeArdMomentMatcher matcher = gp.matcher();
+  MomentMatch m;
+  const Vector mu = Vector::Zero(3);
+  const Matrix sigma = 0.1 * Matrix::Identity(3, 3);
+  expect_invalid([&] { matcher.propagate(Vector::Zero(2), sigma, m); }, "mu has 2 entries");
+  expect_invalid([&] { matcher.propagate(mu, Matrix::Zero(3, 2), m); }, "Sigma is 3 x 2");
+  expect_invalid([&] { matcher.propagate(Vector::Constant(3, NAN), sigma, m); }, "mu has a non-finite");
+  Matrix bad = sigma;
+  bad(1, 2) = INFINITY;
+  expect_invalid([&] { matcher.propagate(mu, bad, m, MomentDerivatives::All); }, "Sigma has a non-finite");
+  expect_invalid([&] { matcher.propagate(mu, -100.0 * Matrix::Identity(3, 3), m); }, "positive semidefinite");
+  // Still usable after the errors.
+  matcher.propagate(mu, sigma, m, MomentDerivatives::All);
+  EXPECT_TRUE(m.covariance.allFinite());
+}
+
+}  // namespace
+}  // namespace gpilqg::gp::test
