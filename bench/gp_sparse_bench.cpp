@@ -1,16 +1,27 @@
-// Cost of the sparse GP backends' two hot paths: one negative log marginal likelihood with its full
-// analytic gradient (what every optimiser iteration pays), and one prediction of mean and variance
-// with their gradients w.r.t. the test input (what every DDP step pays per output).
+// Cost of the sparse GP backends' units of work: one negative log marginal likelihood with its full
+// analytic gradient (what every optimiser iteration pays), a whole fit, and one prediction of mean
+// and variance with their gradients w.r.t. the test input (what every DDP step pays per output).
+// D = 5, synthetic data with a fixed seed.
 //
-// FITC: N = 5000, D = 5, M = 100 (reference: GPML 4.2 in Octave, 0.058 s per NLML + gradient), and an
-// M sweep 50..1000. SSGP: N = 5000, D = 5, m = 100 (reference: ssgpr.m, 0.024 s).
-// Run: build/bench/gpilqg_gp_sparse_bench --benchmark_min_time=0.5
-// (FitcLikelihood / SsgpLikelihood directly for the NLML; predictions through FittedGp::predict.)
+//  - N sweep 300, 1000, 5000, 20000, 100000 at M = m = 100 (NLML + gradient and prediction);
+//    references at N = 5000: GPML 4.2 in Octave, 0.058 s per FITC NLML + gradient; ssgpr.m, 0.024 s.
+//  - M / m sweep 50, 100, 200, 500, 1000 at N = 5000.
+//  - A whole fit at N = 5000, M = m = 100: one start (the data-driven initial values, no restarts),
+//    capped at kFitEvaluations = 100 NLML + gradient evaluations (FitOptions::max_evaluations).
+//    FITC's includes the k-means++ initialisation of the pseudo-inputs, SSGP's the 50 draws of W
+//    it tries at the start.
+// Run times are fixed in the code (MinTime / Iterations / Repetitions), so no flags are needed:
+//   build/bench/gpilqg_gp_sparse_bench
+// The cheap cases run 3 repetitions and report, besides the built-in aggregates, "min" (best of 3).
+// (FitcLikelihood / SsgpLikelihood directly for the NLML; fits through GpBackend::fit; predictions
+// through FittedGp::predict.)
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "gpilqg/gp/fitc.hpp"
 #include "gpilqg/gp/ssgp.hpp"
@@ -22,6 +33,10 @@ using gpilqg::Vector;
 namespace gp = gpilqg::gp;
 
 constexpr int kD = 5;
+constexpr int kFitEvaluations = 100;
+
+/// Best of the repetitions (the built-in aggregates are mean, median, stddev and cv).
+double minimum(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
 
 /// N points uniform in [-3, 3]^D with targets sum_d sin(x_d) + 0.1 noise (fixed seed).
 gp::TrainingSet make_data(int N) {
@@ -130,35 +145,89 @@ void BM_SsgpPredictWithGradients(benchmark::State& state) {
   predict_loop(state, *model);
 }
 
+/// One start, at most kFitEvaluations evaluations; counters: evaluations used, NLML before and after.
+void fit_loop(benchmark::State& state, const gp::GpBackend& backend, const gp::TrainingSet& data) {
+  gp::FitOptions options;
+  options.restarts = 0;
+  options.max_evaluations = kFitEvaluations;
+  gp::FitSummary summary;
+  for (auto _ : state) {
+    const gp::FitResult fit = backend.fit(data, options);
+    summary = fit.summary;
+    benchmark::DoNotOptimize(fit.model.get());
+  }
+  state.counters["evaluations"] = summary.evaluations;
+  state.counters["nlml_start"] = summary.initial_nlml;
+  state.counters["nlml_end"] = summary.nlml;
+}
+
+void BM_FitcWholeFit(benchmark::State& state) {
+  const gp::TrainingSet data = make_data(static_cast<int>(state.range(0)));
+  gp::FitcOptions options;
+  options.inducing = static_cast<int>(state.range(1));
+  fit_loop(state, gp::FitcBackend(options), data);
+}
+
+void BM_SsgpWholeFit(benchmark::State& state) {
+  const gp::TrainingSet data = make_data(static_cast<int>(state.range(0)));
+  gp::SsgpOptions options;
+  options.frequencies = static_cast<int>(state.range(1));
+  fit_loop(state, gp::SsgpBackend(options), data);
+}
+
+/// N sweep at M = 100 (threads = 1), M sweep at N = 5000, and threads = 2 at N = 5000, 100000.
+void nlml_arguments(benchmark::internal::Benchmark* b) {
+  for (const int N : {300, 1000, 5000, 20000, 100000}) b->Args({N, 100, 1});
+  for (const int M : {50, 200, 500, 1000}) b->Args({5000, M, 1});
+  b->Args({5000, 100, 2});
+  b->Args({100000, 100, 2});
+}
+
+void predict_arguments(benchmark::internal::Benchmark* b) {
+  for (const int N : {300, 1000, 5000, 20000, 100000}) b->Args({N, 100});
+  for (const int M : {50, 200, 500, 1000}) b->Args({5000, M});
+}
+
 }  // namespace
 
 // Wall-clock time (UseRealTime): with threads = 2 the CPU time of the calling thread alone would
 // understate the cost.
 BENCHMARK(BM_FitcNlmlGradient)
     ->ArgNames({"N", "M", "threads"})
-    ->Args({5000, 100, 1})
-    ->Args({5000, 100, 2})
-    ->Args({5000, 50, 1})
-    ->Args({5000, 200, 1})
-    ->Args({5000, 500, 1})
-    ->Args({5000, 1000, 1})
+    ->Apply(nlml_arguments)
+    ->MinTime(0.3)
+    ->Repetitions(3)
+    ->ComputeStatistics("min", minimum)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FitcNlmlOnly)->ArgNames({"N", "M"})->Args({5000, 100})->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FitcPredictWithGradients)
+BENCHMARK(BM_FitcNlmlOnly)
     ->ArgNames({"N", "M"})
     ->Args({5000, 100})
-    ->Args({5000, 50})
-    ->Args({5000, 500})
-    ->Args({5000, 1000})
+    ->MinTime(0.3)
+    ->Repetitions(3)
+    ->ComputeStatistics("min", minimum)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FitcWholeFit)->ArgNames({"N", "M"})->Args({5000, 100})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FitcPredictWithGradients)
+    ->ArgNames({"N", "M"})
+    ->Apply(predict_arguments)
+    ->MinTime(0.2)
+    ->Repetitions(3)
+    ->ComputeStatistics("min", minimum)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SsgpNlmlGradient)
     ->ArgNames({"N", "m", "threads"})
-    ->Args({5000, 100, 1})
-    ->Args({5000, 100, 2})
+    ->Apply(nlml_arguments)
+    ->MinTime(0.3)
+    ->Repetitions(3)
+    ->ComputeStatistics("min", minimum)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SsgpWholeFit)->ArgNames({"N", "m"})->Args({5000, 100})->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SsgpPredictWithGradients)
     ->ArgNames({"N", "m"})
-    ->Args({5000, 100})
+    ->Apply(predict_arguments)
+    ->MinTime(0.2)
+    ->Repetitions(3)
+    ->ComputeStatistics("min", minimum)
     ->Unit(benchmark::kMicrosecond);
