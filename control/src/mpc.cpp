@@ -60,33 +60,20 @@ Vector MpcController::control(int t, const VectorCRef& x) {
 
 MpcRun run_mpc(const StepModel& world, MpcController& controller, const Cost& task, const VectorCRef& x0,
                int steps, const PolicyRolloutSettings& settings, std::mt19937_64& rng) {
-  const int n = world.state_dim(), m = world.control_dim();
-  if (x0.size() != n)
-    throw std::invalid_argument("mpc run: x0 has " + std::to_string(x0.size()) + " entries; expected " +
-                                std::to_string(n));
   if (steps < 1) throw std::invalid_argument("mpc run: steps = " + std::to_string(steps) + "; expected >= 1");
   MpcRun run;
-  run.trajectory = Trajectory(n, m, steps);
-  run.trajectory.x.col(0) = x0;
-  Vector observed(n), next(n);
-  DiffusionColumns columns;
-  for (int t = 0; t < steps; ++t) {
-    const auto x = run.trajectory.x.col(t);
-    observed = x;
-    add_observation_noise(settings.observation_std, rng, observed);
-    const Vector u = controller.control(t, observed);
+  const Controller replan = [&](int t, const VectorCRef& observed, VectorRef u) {
+    u = controller.control(t, observed);
     run.solve_seconds += controller.last_solution().summary.timings.total_s;
-    run.trajectory.u.col(t) = u;
-    run.cost += task.stage(t, x, u);
-    if (!sample_step(world, x, u, settings.noise(), columns, &rng, next)) {
-      run.finite = false;
-      for (int s = t + 1; s <= steps; ++s) run.trajectory.x.col(s) = x;
-      return run;
-    }
-    run.trajectory.x.col(t + 1) = next;
-    run.steps_completed = t + 1;
-  }
-  run.cost += task.terminal_at(steps, run.trajectory.x.col(steps));
+  };
+  const RolloutResult r =
+      closed_loop_rollout(world, x0, steps, replan, settings.noise(), settings.observation_std, &rng);
+  run.trajectory = r.trajectory;
+  run.steps_completed = r.steps_completed;
+  run.finite = r.finite;
+  for (int t = 0; t < r.steps_completed; ++t)
+    run.cost += task.stage(t, run.trajectory.x.col(t), run.trajectory.u.col(t));
+  if (r.finite) run.cost += task.terminal_at(steps, run.trajectory.x.col(steps));
   return run;
 }
 

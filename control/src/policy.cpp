@@ -32,36 +32,12 @@ RolloutNoise PolicyRolloutSettings::noise() const {
 
 PolicyRollout rollout_policy(const StepModel& world, const AffinePolicy& policy, const VectorCRef& x0,
                              const PolicyRolloutSettings& settings, std::mt19937_64& rng) {
-  const int n = world.state_dim(), m = world.control_dim(), T = policy.horizon();
-  if (x0.size() != n)
-    throw std::invalid_argument("policy rollout: x0 has " + std::to_string(x0.size()) + " entries; expected " +
-                                std::to_string(n));
-  if (policy.u_bar.rows() != m || policy.x_bar.rows() != n)
+  if (policy.u_bar.rows() != world.control_dim() || policy.x_bar.rows() != world.state_dim())
     throw std::invalid_argument("policy rollout: the policy does not fit the world's dimensions");
-  if (settings.observation_std.size() != 0 && settings.observation_std.size() != n)
-    throw std::invalid_argument("policy rollout: observation_std has " +
-                                std::to_string(settings.observation_std.size()) + " entries; expected " +
-                                std::to_string(n));
-  PolicyRollout out;
-  out.trajectory = Trajectory(n, m, T);
-  out.trajectory.x.col(0) = x0;
-  Vector observed(n), next(n);
-  DiffusionColumns columns;
-  for (int t = 0; t < T; ++t) {
-    const auto x = out.trajectory.x.col(t);
-    observed = x;
-    add_observation_noise(settings.observation_std, rng, observed);
-    auto u = out.trajectory.u.col(t);
+  const Controller feedback = [&policy](int t, const VectorCRef& observed, VectorRef u) {
     policy.control(t, observed, u);
-    if (!sample_step(world, x, u, settings.noise(), columns, &rng, next)) {
-      out.finite = false;
-      for (int s = t + 1; s <= T; ++s) out.trajectory.x.col(s) = x;
-      return out;
-    }
-    out.trajectory.x.col(t + 1) = next;
-    out.steps_completed = t + 1;
-  }
-  return out;
+  };
+  return closed_loop_rollout(world, x0, policy.horizon(), feedback, settings.noise(), settings.observation_std, &rng);
 }
 
 }  // namespace gpilqg

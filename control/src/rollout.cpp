@@ -33,37 +33,51 @@ void add_observation_noise(const Vector& std, std::mt19937_64& rng, VectorRef x)
   for (Eigen::Index i = 0; i < std.size(); ++i) x(i) += std(i) * normal(rng);
 }
 
-RolloutResult rollout(const StepModel& model, const VectorCRef& x0, const Matrix& u, RolloutNoise noise,
-                      std::mt19937_64* rng) {
-  const int n = model.state_dim();
-  const int m = model.control_dim();
+RolloutResult closed_loop_rollout(const StepModel& world, const VectorCRef& x0, int steps,
+                                  const Controller& controller, RolloutNoise noise,
+                                  const Vector& observation_std, std::mt19937_64* rng) {
+  const int n = world.state_dim();
+  const int m = world.control_dim();
   if (x0.size() != n)
     throw std::invalid_argument("rollout: x0 has " + std::to_string(x0.size()) + " entries; expected " +
                                 std::to_string(n));
-  if (u.rows() != m)
-    throw std::invalid_argument("rollout: controls have " + std::to_string(u.rows()) +
-                                " rows; expected " + std::to_string(m));
-  if (noise != RolloutNoise::None && rng == nullptr)
+  if (steps < 0) throw std::invalid_argument("rollout: steps = " + std::to_string(steps) + "; expected >= 0");
+  if (observation_std.size() != 0 && observation_std.size() != n)
+    throw std::invalid_argument("rollout: observation_std has " + std::to_string(observation_std.size()) +
+                                " entries; expected " + std::to_string(n));
+  if ((noise != RolloutNoise::None || observation_std.size() != 0) && rng == nullptr)
     throw std::invalid_argument("rollout: a random generator is needed to sample noise");
 
-  const int T = static_cast<int>(u.cols());
   RolloutResult result;
-  result.trajectory = Trajectory(n, m, T);
-  result.trajectory.u = u;
+  result.trajectory = Trajectory(n, m, steps);
   result.trajectory.x.col(0) = x0;
-  DiffusionColumns terms;
-  Vector next(n);
-  for (int t = 0; t < T; ++t) {
+  DiffusionColumns scratch;
+  Vector observed(n), next(n);
+  for (int t = 0; t < steps; ++t) {
     const auto x = result.trajectory.x.col(t);
-    if (!sample_step(model, x, u.col(t), noise, terms, rng, next)) {
+    observed = x;
+    if (observation_std.size() != 0) add_observation_noise(observation_std, *rng, observed);
+    auto u = result.trajectory.u.col(t);
+    controller(t, observed, u);
+    if (!sample_step(world, x, u, noise, scratch, rng, next)) {
+      // Diverged: keep the result NaN-free (the last finite state repeated) and say so.
       result.finite = false;
-      for (int s = t + 1; s <= T; ++s) result.trajectory.x.col(s) = x;
+      for (int s = t + 1; s <= steps; ++s) result.trajectory.x.col(s) = x;
       return result;
     }
     result.trajectory.x.col(t + 1) = next;
     result.steps_completed = t + 1;
   }
   return result;
+}
+
+RolloutResult rollout(const StepModel& model, const VectorCRef& x0, const Matrix& u, RolloutNoise noise,
+                      std::mt19937_64* rng) {
+  if (u.rows() != model.control_dim())
+    throw std::invalid_argument("rollout: controls have " + std::to_string(u.rows()) + " rows; expected " +
+                                std::to_string(model.control_dim()));
+  const Controller open_loop = [&u](int t, const VectorCRef&, VectorRef out) { out = u.col(t); };
+  return closed_loop_rollout(model, x0, static_cast<int>(u.cols()), open_loop, noise, Vector(), rng);
 }
 
 }  // namespace gpilqg

@@ -18,6 +18,10 @@
 ///                                              + 1/2 sum_n gamma_n (Sigma t_n)_k t_ni t_nj,
 /// using I - Sigma P_a = Lambda_a P_a. Because the moments are functions of sym(Sigma), the reported
 /// derivative is the symmetric part of this partial derivative (header comment).
+///
+/// Kept for the covariance (moment_matching_covariance.cpp): q_a, log|Rt_a|, A_a = V W_a,
+/// B_a = W_a - P_a = W^1/2 (I - Rt_a^-1) W^1/2 (formed from I - Rt_a^-1, so exactly 0 at Sigma = 0),
+/// c_ai = 1/2 nu_i' B_a nu_i, and with derivatives u_a = A_a' gamma_a and E_a = A_a' diag(gamma_a) A_a.
 
 #include "gpilqg/gp/moment_matching.hpp"
 
@@ -167,8 +171,11 @@ void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives) const {
   size_all(s.scaled, n, d);
   size_all(s.hessian, d, d);
   size_all_vectors(s.weighted, n);
-  size_all_vectors(s.log_kernel, n);
+  size_all_vectors(s.kernel_mean, n);
+  size_all_vectors(s.log_shift, n);
+  size_all(s.shrink, d, d);
   size_all_vectors(s.gradient, d);
+  s.log_det.resize(e);
   for (Matrix* m : {&s.rt, &s.rt_inverse, &s.xi, &s.gain, &s.pair_precision, &s.dd, &s.dd2, &s.inner})
     m->resize(d, d);
   s.nd.resize(n, d);
@@ -179,6 +186,9 @@ void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives) const {
   if (derivatives) {
     s.outer.resize(n, d * d);
     s.third.resize(d, d * d);
+    size_all_vectors(s.scaled_sum, d);
+    size_all(s.scaled_scatter, d, d);
+    for (Matrix* m : {&s.pair_shrink, &s.delta_a, &s.delta_b}) m->resize(d, d);
   }
 }
 
@@ -243,6 +253,7 @@ void SeArdMomentMatcher::propagate_mean(MomentMatch& out, bool derivatives) cons
     const OutputData& o = outputs_[a];
     const auto ai = static_cast<Eigen::Index>(a);
     const double log_det = factor_scaled(s, o.sqrt_w, a, a);
+    s.log_det(ai) = log_det;
 
     Matrix& p = s.precision[a];
     p.noalias() = o.sqrt_w.asDiagonal() * s.rt_inverse * o.sqrt_w.asDiagonal();
@@ -253,21 +264,34 @@ void SeArdMomentMatcher::propagate_mean(MomentMatch& out, bool derivatives) cons
     tiled_product(v, p, t);
     // gamma_i = beta_i q_i, q_i = exp(log sf^2 - 1/2 log|Rt| - 1/2 nu_i' P nu_i)
     const double log_c = o.log_signal_variance - 0.5 * log_det;
+    Vector& q = s.kernel_mean[a];
+    q = t.cwiseProduct(v).rowwise().sum();
+    q = (log_c - 0.5 * q.array()).exp().matrix();
     Vector& gamma = s.weighted[a];
-    gamma = t.cwiseProduct(v).rowwise().sum();
-    gamma = (log_c - 0.5 * gamma.array()).exp() * o.beta.array();
+    gamma = q.cwiseProduct(o.beta);
     const double m = gamma.sum();
     out.mean(ai) = m;
     Vector& g = s.gradient[a];
     g.noalias() = t.transpose() * gamma;
     out.cross_covariance.col(ai).noalias() = s.sigma * g;
 
-    // For the pairs: A_a = V W_a and -1/2 nu_i' W_a nu_i = log k_a(x_i, mu) - log sf^2.
+    // For the pairs: A_a = V W_a, B_a = W_a - P_a = W_a^1/2 (I - Rt_a^-1) W_a^1/2 formed without the
+    // subtraction W_a - P_a (exactly 0 at Sigma = 0), and c_ai = 1/2 nu_i' B_a nu_i.
     Matrix& scaled = s.scaled[a];
     scaled.noalias() = v * o.inverse_squared_lengthscales.asDiagonal();
-    s.log_kernel[a] = -0.5 * scaled.cwiseProduct(v).rowwise().sum();
+    s.dd = -s.rt_inverse;
+    s.dd.diagonal().array() += 1.0;
+    Matrix& shrink = s.shrink[a];
+    shrink.noalias() = o.sqrt_w.asDiagonal() * s.dd * o.sqrt_w.asDiagonal();
+    tiled_product(v, shrink, s.nd);
+    s.log_shift[a] = 0.5 * s.nd.cwiseProduct(v).rowwise().sum();
 
     if (!derivatives) continue;
+    // u_a = A_a' gamma_a and E_a = A_a' diag(gamma_a) A_a for the covariance derivatives.
+    s.scaled_sum[a].noalias() = scaled.transpose() * gamma;
+    s.nd = scaled;
+    s.nd.array().colwise() *= gamma.array();
+    tiled_product(scaled.transpose(), s.nd, s.scaled_scatter[a]);
     Matrix& h = s.hessian[a];
     s.nd = t;
     s.nd.array().colwise() *= gamma.array();

@@ -7,35 +7,85 @@
 ///   P  = (Sigma + Lambda)^-1      = W^1/2 Rt^-1 W^1/2,
 ///   Xi = R^-1 Sigma = Lambda - Lambda P Lambda = Lambda^1/2 (I - Rt^-1) Lambda^1/2   (symmetric PSD),
 ///   G  = P Lambda                 = W^1/2 Rt^-1 Lambda^1/2,
+///   B  = W - P = W Xi W           = W^1/2 (I - Rt^-1) W^1/2,
 ///
-/// the log of Q_ij = E[k_a(x_i, z) k_b(x_j, z)] is assembled in one sum (no separate kernel values):
+/// and the same for one output a (P_a, G_a = P_a Lambda_a, B_a = W_a - P_a; moment_matching.cpp),
 ///
 ///   log Q_ij = log sf_a^2 + log sf_b^2 - 1/2 log|Rt|
-///              + [-1/2 nu_i' W_a nu_i + 1/2 a_i' Xi a_i] + [-1/2 nu_j' W_b nu_j + 1/2 b_j' Xi b_j]
-///              + a_i' Xi b_j,                       a_i = W_a nu_i, b_j = W_b nu_j,
+///              - 1/2 nu_i' W_a nu_i - 1/2 nu_j' W_b nu_j + 1/2 z_ij' Xi z_ij,   z_ij = a_i + b_j,
+///   log q_ai = log sf_a^2 - 1/2 log|Rt_a| - 1/2 nu_i' W_a nu_i + c_ai,   c_ai = 1/2 nu_i' B_a nu_i,
 ///
-/// (the cross term is one N x N GEMM, (A_a Xi) A_b'), and with Omega = diag(beta_a) Q diag(beta_b)
-/// - delta_ab Kinv_a .* Q:
+/// with a_i = W_a nu_i, b_j = W_b nu_j (-1/2 nu' P_a nu = -1/2 nu' W_a nu + 1/2 nu' B_a nu).
 ///
-///   S_ab = sum_ij Omega_ij - M_a M_b + delta_ab sf_a^2.
+/// Centred form. Q_ij = q_ai q_bj exp(D_ij), where the kernel terms -1/2 nu' W nu and log sf^2 cancel
+/// exactly and are never formed:
+///
+///   D_ij = -1/2 (log|Rt| - log|Rt_a| - log|Rt_b|) + [1/2 a_i' Xi a_i - c_ai] + [1/2 b_j' Xi b_j - c_bj]
+///          + a_i' Xi b_j
+///
+/// (the cross term is one N x N GEMM, (A_a Xi) A_b'). Every term is O(Sigma) and is formed from
+/// I - Rt^-1 (exactly 0 at Sigma = 0), so D = 0 exactly at Sigma = 0. Since sum_i beta_ai q_ai = M_a,
+/// beta_a' (q_a q_b') beta_b = M_a M_b exactly, and the covariance is
+///
+///   S_ab = sum_ij gamma_ai gamma_bj expm1(D_ij) + delta_ab V_a,          gamma_a = beta_a .* q_a,
+///   V_a  = sf_a^2 - tr(Kinv_a Q_aa) = sf_a^2 - q_a' Kinv_a q_a - sum_ij Kinv_a,ij q_ai q_aj expm1(D_ij),
+///
+/// V_a = E[sf^2 - k(z)' Kinv k(z)] >= 0, which at Sigma = 0 is the latent variance at mu. Rounding
+/// error: instead of ~eps N |gamma|^2 for beta' Q beta - M_a M_b, the first sum carries ~eps N |gamma|^2
+/// |D| (|D| ~ |Sigma W|), and V_a ~eps |q|' |Kinv| |q| (the limit set by the rounding of Kinv itself).
+/// V_a is clamped at 0; where it is, it contributes nothing to the derivatives (a one-sided, zero
+/// derivative at the kink). D is capped at 700 before expm1: D_ij > 700 requires
+/// max(q_ai, q_bj) < sf^2 e^-700, where Q_ij is negligible, and the cap avoids 0 * inf.
 ///
 /// Derivatives. d log Q_ij / dmu = G z_ij and d log Q_ij / dSigma = -1/2 P + 1/2 y_ij y_ij' with
-/// z_ij = a_i + b_j and y_ij = G z_ij (from d log|R| / dSigma = P, dXi = Lambda P dSigma P Lambda and
-/// I - W Xi = P Lambda). Summing with the weights Omega_ij, r = Omega 1, c = Omega' 1:
+/// y_ij = G z_ij (from d log|R| / dSigma = P, dXi = Lambda P dSigma P Lambda and I - W Xi = P Lambda);
+/// likewise d log q_ai / dmu = G_a a_i (= t_ai) and d log q_ai / dSigma = -1/2 P_a + 1/2 G_a a_i a_i' G_a'.
+/// By the product rule, beta_ai beta_bj Q_ij = Omega_ij + gamma_ai gamma_bj with
 ///
-///   dS_ab/dmu    = G (W_a V' r + W_b V' c) - (M_b g_a + M_a g_b)
-///   dS_ab/dSigma = -1/2 (1' r) P + 1/2 G J G' - 1/2 (M_b H_a + M_a H_b),
-///   J = W_a V' diag(r) V W_a + W_b V' diag(c) V W_b + W_a (V' Omega V) W_b + W_b (V' Omega' V) W_a,
+///   Omega = gamma_a gamma_b' .* expm1(D) - delta_ab [V_a not clamped] Kinv_a .* Q_aa,
+///   dS_ab = sum_ij Omega_ij d log Q_ij + sum_ij gamma_ai gamma_bj dD_ij,
 ///
-/// where g_a = dM_a/dmu and H_a / 2 = dM_a/dSigma come from moment_matching.cpp. The only O(N^2 D)
-/// step of the derivatives is Omega V (one GEMM), so they cost about as much as S itself.
+/// (the second sum is d(sum beta beta' .* Q) - d(M_a M_b) for the rank-one part), and
+/// dD_ij = d log Q_ij - d log q_ai - d log q_bj is small with Sigma: with Delta_a = G - G_a =
+/// (P_a - P) Sigma (0 at Sigma = 0), P - P_a - P_b = B_a + B_b - B, u_a = A_a' gamma_a and
+/// E_a = A_a' diag(gamma_a) A_a,
+///
+///   sum gamma gamma' dD / dmu    = M_b Delta_a u_a + M_a Delta_b u_b,
+///   sum gamma gamma' dD / dSigma = -1/2 M_a M_b (B_a + B_b - B) + 1/2 G (u_a u_b' + u_b u_a') G'
+///                                  + 1/2 M_b (G E_a G' - G_a E_a G_a') + 1/2 M_a (G E_b G' - G_b E_b G_b'),
+///   G E_a G' - G_a E_a G_a' = Delta_a E_a G' + G_a E_a Delta_a'.
+///
+/// Summing the first part with r = Omega 1, c = Omega' 1:
+///
+///   dS_ab/dmu    = G (W_a V' r + W_b V' c) + M_b Delta_a u_a + M_a Delta_b u_b,
+///   dS_ab/dSigma = -1/2 (1'r) P + 1/2 G J G' - 1/2 M_a M_b (B_a + B_b - B)
+///                  + 1/2 M_b (Delta_a E_a G' + G_a E_a Delta_a') + 1/2 M_a (Delta_b E_b G' + G_b E_b Delta_b'),
+///   J = W_a V' diag(r) V W_a + W_b V' diag(c) V W_b + W_a (V' Omega V) W_b + W_b (V' Omega' V) W_a
+///       + u_a u_b' + u_b u_a'.
+///
+/// (The uncentred form used Omega = diag(beta_a) Q diag(beta_b) - delta_ab Kinv .* Q and subtracted
+/// M_b g_a + M_a g_b and 1/2 (M_b H_a + M_a H_b): O(|beta|^2) cancellations that the centred form
+/// replaces with the rank-one part summed analytically.)
+/// The only O(N^2 D) step of the derivatives is Omega V (one GEMM), so they cost about as much as S.
 
 #include "gpilqg/gp/moment_matching.hpp"
+
+#include <algorithm>
+#include <cmath>
+
 #include "moment_matching_internal.hpp"
 
 namespace gpilqg::gp {
 
 using detail::tiled_product;
+
+namespace {
+
+/// D_ij is capped here before expm1: D_ij > 700 needs max(q_ai, q_bj) < sf^2 e^-700, so Q_ij (<= sf_a^2
+/// sf_b^2 e^-700) is negligible, and the cap keeps q_ai q_bj expm1(D_ij) from becoming 0 * inf.
+constexpr double kMaxLogRatio = 700.0;
+
+}  // namespace
 
 void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives) const {
   MomentMatchScratch& s = out.scratch;
@@ -51,72 +101,102 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives
       const auto ai = static_cast<Eigen::Index>(a);
       const auto bi = static_cast<Eigen::Index>(b);
       const bool same = a == b;
+      const Vector& gamma_a = s.weighted[a];
+      const Vector& gamma_b = s.weighted[b];
 
       s.sqrt_w_pair = (oa.inverse_squared_lengthscales + ob.inverse_squared_lengthscales).cwiseSqrt();
       s.lengthscale_pair = s.sqrt_w_pair.cwiseInverse();
       const double log_det = factor_scaled(s, s.sqrt_w_pair, a, b);
-      s.dd = -s.rt_inverse;
+      s.dd = -s.rt_inverse;  // I - Rt^-1, exactly 0 at Sigma = 0
       s.dd.diagonal().array() += 1.0;
       s.xi.noalias() = s.lengthscale_pair.asDiagonal() * s.dd * s.lengthscale_pair.asDiagonal();
+      if (derivatives)
+        s.pair_shrink.noalias() = s.sqrt_w_pair.asDiagonal() * s.dd * s.sqrt_w_pair.asDiagonal();
 
-      // Row and column parts of log Q, then the cross term and the exponential, column by column.
+      // D = log(Q / (q_a q_b')): row and column parts, then the cross term, all O(Sigma).
       const Matrix& scaled_a = s.scaled[a];
       const Matrix& scaled_b = s.scaled[b];
       tiled_product(scaled_a, s.xi, s.nd);
-      s.row_term = s.log_kernel[a] + 0.5 * s.nd.cwiseProduct(scaled_a).rowwise().sum();
+      s.row_term = 0.5 * s.nd.cwiseProduct(scaled_a).rowwise().sum() - s.log_shift[a];
       if (same) {
         s.col_term = s.row_term;
       } else {
         tiled_product(scaled_b, s.xi, s.nd2);
-        s.col_term = s.log_kernel[b] + 0.5 * s.nd2.cwiseProduct(scaled_b).rowwise().sum();
+        s.col_term = 0.5 * s.nd2.cwiseProduct(scaled_b).rowwise().sum() - s.log_shift[b];
       }
-      s.row_term.array() += oa.log_signal_variance + ob.log_signal_variance - 0.5 * log_det;
+      s.row_term.array() += -0.5 * (log_det - s.log_det(ai) - s.log_det(bi));
       tiled_product(s.nd, scaled_b.transpose(), s.nn);
-      if (same) {
-        // Q_aa is symmetric: exponentiate the lower triangle (the exponentials dominate the cost) and mirror.
-        for (Eigen::Index j = 0; j < n; ++j) {
-          const Eigen::Index len = n - j;
-          s.nn.col(j).tail(len) =
-              ((s.nn.col(j).tail(len) + s.row_term.tail(len)).array() + s.col_term(j)).exp().matrix();
-        }
-        for (Eigen::Index j = 0; j + 1 < n; ++j) s.nn.row(j).tail(n - j - 1) = s.nn.col(j).tail(n - j - 1).transpose();
-      } else {
-        for (Eigen::Index j = 0; j < n; ++j)
-          s.nn.col(j) = ((s.nn.col(j) + s.row_term).array() + s.col_term(j)).exp().matrix();
-      }
+      const auto centred_exp = [&](Eigen::Index j, Eigen::Index start) {
+        const Eigen::Index len = n - start;
+        auto col = s.nn.col(j).tail(len);
+        for (Eigen::Index i = 0; i < len; ++i)
+          col(i) = std::expm1(std::min(col(i) + s.row_term(start + i) + s.col_term(j), kMaxLogRatio));
+      };
 
-      // Omega in place of Q.
-      if (same) {
-        for (Eigen::Index j = 0; j < n; ++j)
-          s.nn.col(j) = s.nn.col(j).cwiseProduct(oa.beta * ob.beta(j) - oa.Kinv.col(j));
-      } else {
-        for (Eigen::Index j = 0; j < n; ++j) s.nn.col(j) = s.nn.col(j).cwiseProduct(oa.beta) * ob.beta(j);
-      }
-      const double total = s.nn.sum();
       const double ma = out.mean(ai);
       const double mb = out.mean(bi);
-      double sab = total - ma * mb;
-      if (same) sab += oa.signal_variance;
-      out.covariance(ai, bi) = sab;
-      out.covariance(bi, ai) = sab;
+      double total = 0.0;  // 1' Omega 1
+      if (same) {
+        // expm1(D) is symmetric: the lower triangle (the exponentials dominate the cost), mirrored.
+        for (Eigen::Index j = 0; j < n; ++j) centred_exp(j, j);
+        for (Eigen::Index j = 0; j + 1 < n; ++j) s.nn.row(j).tail(n - j - 1) = s.nn.col(j).tail(n - j - 1).transpose();
+        const Vector& q = s.kernel_mean[a];
+        double centred = 0.0;      // gamma' expm1(D) gamma = beta' (Q - q q') beta
+        double kinv_centred = 0.0;  // <Kinv, Q - q q'>
+        for (Eigen::Index j = 0; j < n; ++j) {
+          const auto col = s.nn.col(j);
+          centred += gamma_a(j) * col.dot(gamma_a);
+          kinv_centred += q(j) * col.cwiseProduct(oa.Kinv.col(j)).dot(q);
+        }
+        s.row_sums.noalias() = oa.Kinv * q;
+        const double expected_variance = oa.signal_variance - q.dot(s.row_sums) - kinv_centred;
+        const bool clamped = !(expected_variance > 0.0);
+        const double sab = centred + (clamped ? 0.0 : expected_variance);
+        out.covariance(ai, ai) = sab;
+        if (!derivatives) continue;
+        // Omega = gamma gamma' .* expm1(D) - Kinv .* Q (the second term dropped when clamped).
+        if (clamped) {
+          for (Eigen::Index j = 0; j < n; ++j) s.nn.col(j) = s.nn.col(j).cwiseProduct(gamma_a) * gamma_a(j);
+        } else {
+          for (Eigen::Index j = 0; j < n; ++j)
+            s.nn.col(j) = s.nn.col(j).cwiseProduct(gamma_a) * gamma_a(j) -
+                          (s.nn.col(j).array() + 1.0).matrix().cwiseProduct(oa.Kinv.col(j)).cwiseProduct(q) * q(j);
+        }
+        total = s.nn.sum();
+      } else {
+        for (Eigen::Index j = 0; j < n; ++j) centred_exp(j, 0);
+        // Omega = gamma_a gamma_b' .* expm1(D) = diag(beta_a) (Q - q_a q_b') diag(beta_b).
+        for (Eigen::Index j = 0; j < n; ++j) s.nn.col(j) = s.nn.col(j).cwiseProduct(gamma_a) * gamma_b(j);
+        total = s.nn.sum();
+        out.covariance(ai, bi) = total;
+        out.covariance(bi, ai) = total;
+        if (!derivatives) continue;
+      }
 
-      if (!derivatives) continue;
       s.row_sums = s.nn.rowwise().sum();
       s.col_sums = s.nn.colwise().sum().transpose();
       s.gain.noalias() = s.sqrt_w_pair.asDiagonal() * s.rt_inverse * s.lengthscale_pair.asDiagonal();
       s.pair_precision.noalias() = s.sqrt_w_pair.asDiagonal() * s.rt_inverse * s.sqrt_w_pair.asDiagonal();
+      // Delta_a = G - G_a = (P_a - P) Sigma, exactly 0 at Sigma = 0.
+      s.dd = s.precision[a] - s.pair_precision;
+      s.delta_a.noalias() = s.dd * s.sigma;
+      s.dd = s.precision[b] - s.pair_precision;
+      s.delta_b.noalias() = s.dd * s.sigma;
+      const Vector& u_a = s.scaled_sum[a];
+      const Vector& u_b = s.scaled_sum[b];
 
-      // d/dmu
+      // d/dmu = G (W_a V' r + W_b V' c) + M_b Delta_a u_a + M_a Delta_b u_b
       s.dvec.noalias() = v.transpose() * s.row_sums;
       s.dvec2.noalias() = v.transpose() * s.col_sums;
       s.dvec = oa.inverse_squared_lengthscales.cwiseProduct(s.dvec) +
                ob.inverse_squared_lengthscales.cwiseProduct(s.dvec2);
       s.dvec2.noalias() = s.gain * s.dvec;
-      s.dvec2 -= mb * s.gradient[a] + ma * s.gradient[b];
+      s.dvec2.noalias() += mb * (s.delta_a * u_a);
+      s.dvec2.noalias() += ma * (s.delta_b * u_b);
       out.dcovariance_dmu.row(ai + e * bi) = s.dvec2.transpose();
       out.dcovariance_dmu.row(bi + e * ai) = s.dvec2.transpose();
 
-      // d/dSigma: J, then -1/2 (1'r) P + 1/2 G J G' - 1/2 (M_b H_a + M_a H_b).
+      // d/dSigma: J, then -1/2 (1'r) P + 1/2 G J G' + the rank-one correction (file comment).
       s.nd = v;
       s.nd.array().colwise() *= s.row_sums.array();
       tiled_product(v.transpose(), s.nd, s.dd);
@@ -132,9 +212,22 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives
       s.dd2.noalias() = oa.inverse_squared_lengthscales.asDiagonal() * s.dd *
                         ob.inverse_squared_lengthscales.asDiagonal();
       s.inner += s.dd2 + s.dd2.transpose();
+      // 1/2 (u_a u_b' + u_b u_a') joins J: G J G' then carries 1/2 G (u_a u_b' + u_b u_a') G'.
+      s.inner.noalias() += u_a * u_b.transpose();
+      s.inner.noalias() += u_b * u_a.transpose();
       s.dd2.noalias() = s.gain * s.inner;
       s.dd.noalias() = s.dd2 * s.gain.transpose();
-      s.dd = 0.5 * s.dd - (0.5 * total) * s.pair_precision - 0.5 * (mb * s.hessian[a] + ma * s.hessian[b]);
+      s.dd = 0.5 * s.dd - (0.5 * total) * s.pair_precision -
+             (0.5 * ma * mb) * (s.shrink[a] + s.shrink[b] - s.pair_shrink);
+      // + 1/2 M_b (Delta_a E_a G' + G_a E_a Delta_a') + 1/2 M_a (Delta_b E_b G' + G_b E_b Delta_b')
+      s.dd2.noalias() = s.delta_a * s.scaled_scatter[a];
+      s.dd.noalias() += (0.5 * mb) * (s.dd2 * s.gain.transpose());
+      s.dd2.noalias() = s.precision_lambda[a] * s.scaled_scatter[a];
+      s.dd.noalias() += (0.5 * mb) * (s.dd2 * s.delta_a.transpose());
+      s.dd2.noalias() = s.delta_b * s.scaled_scatter[b];
+      s.dd.noalias() += (0.5 * ma) * (s.dd2 * s.gain.transpose());
+      s.dd2.noalias() = s.precision_lambda[b] * s.scaled_scatter[b];
+      s.dd.noalias() += (0.5 * ma) * (s.dd2 * s.delta_b.transpose());
       for (Eigen::Index j = 0; j < d; ++j)
         for (Eigen::Index i = 0; i < j; ++i) s.dd(i, j) = s.dd(j, i) = 0.5 * (s.dd(i, j) + s.dd(j, i));
       const auto flat = Eigen::Map<const Vector>(s.dd.data(), d * d).transpose();

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -341,6 +342,159 @@ TEST(MomentMatching, LargeTrainingSetsGoThroughTheTiledProducts) {
     EXPECT_NEAR(m.mean(a), gp.posterior_mean(a, mu), 1e-10);
     EXPECT_NEAR(m.covariance(a, a), gp.posterior_variance(a, mu), 1e-10);
   }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Ill-conditioned GPs: nearly noise-free data (regression test for the cancellation in S)
+
+/// E = 2 GPs on N = 300 inputs in [-2, 2] x [-2, 2] x [-1, 1] (angle, rate, torque) with smooth
+/// pendulum-like targets plus N(0, (1e-3 std y)^2), sn = 1e-3 std(y), sf = std(y), length-scales ~1.
+/// K + sn^2 I then has a condition number ~1e9 and |beta| reaches ~1e5 / sf: the old evaluation
+/// beta' Q beta - M_a M_b lost everything (off-diagonals ~1e-4 at Sigma = 0, negative variances).
+/// Keeps the Cholesky factors for the reference latent variance sf^2 - ||L^-1 k||^2.
+struct IllConditionedGp {
+  TestGp gp;
+  std::vector<Matrix> factors;  // L_a, K_a + sn_a^2 I = L_a L_a'
+};
+
+IllConditionedGp make_ill_conditioned_gp() {
+  const int n = 300;
+  const int d = 3;
+  std::mt19937 gen(77);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  IllConditionedGp out;
+  TestGp& gp = out.gp;
+  gp.inputs.resize(n, d);
+  for (int i = 0; i < n; ++i) gp.inputs.row(i) << unit(gen), unit(gen), unit(gen);
+  for (int a = 0; a < 2; ++a) {
+    Vector y(n);
+    for (int i = 0; i < n; ++i) {
+      const double theta = gp.inputs(i, 0), rate = gp.inputs(i, 1), torque = gp.inputs(i, 2);
+      y(i) = a == 0 ? 0.1 * rate - 0.05 * std::sin(theta)
+                    : -0.9 * std::sin(theta) - 0.1 * rate + 0.5 * torque;  // one damped-pendulum step
+    }
+    const double sd = std::sqrt((y.array() - y.mean()).square().sum() / (n - 1.0));
+    for (int i = 0; i < n; ++i) y(i) += 1e-3 * sd * normal(gen);
+    SeArdOutput o;
+    o.log_lengthscales = Vector::Constant(d, 0.0);
+    o.log_lengthscales(a) = std::log(0.9);
+    o.log_signal_std = std::log(sd);
+    Matrix k(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        k(i, j) = se_ard(gp.inputs.row(i).transpose(), gp.inputs.row(j).transpose(), o.log_lengthscales,
+                         o.log_signal_std);
+    k.diagonal().array() += (1e-3 * sd) * (1e-3 * sd);
+    const Eigen::LLT<Matrix> llt(k);
+    EXPECT_EQ(llt.info(), Eigen::Success);
+    o.beta = llt.solve(y);
+    o.Kinv = llt.solve(Matrix::Identity(n, n));
+    out.factors.push_back(llt.matrixL());
+    gp.outputs.push_back(o);
+  }
+  return out;
+}
+
+TEST(MomentMatching, NearlyNoiseFreeGpsGiveAnExactlyDiagonalCovarianceAtSigmaZero) {
+  const IllConditionedGp ill = make_ill_conditioned_gp();
+  const TestGp& gp = ill.gp;
+  const SeArdMomentMatcher matcher = gp.matcher();
+  std::printf("  max |beta| %.2e, %.2e; max |Kinv| %.2e, %.2e\n", gp.outputs[0].beta.cwiseAbs().maxCoeff(),
+              gp.outputs[1].beta.cwiseAbs().maxCoeff(), gp.outputs[0].Kinv.cwiseAbs().maxCoeff(),
+              gp.outputs[1].Kinv.cwiseAbs().maxCoeff());
+  MomentMatch m;
+  const double eps = std::numeric_limits<double>::epsilon();
+  for (unsigned trial = 0; trial < 6; ++trial) {
+    Vector mu = ::gpilqg::test::random_vector(3, -1.0, 1.0, 300 + trial);
+    if (trial == 5) mu = gp.inputs.row(17).transpose();  // at a training input
+    matcher.propagate(mu, Matrix::Zero(3, 3), m, MomentDerivatives::All);
+    std::printf("  mu %u: S = [% .6e % .6e; % .6e % .6e]\n", trial, m.covariance(0, 0), m.covariance(0, 1),
+                m.covariance(1, 0), m.covariance(1, 1));
+    EXPECT_LT(std::abs(m.covariance(0, 1)), 1e-10) << "trial " << trial;
+    EXPECT_EQ(m.covariance(0, 1), m.covariance(1, 0));
+    for (int a = 0; a < 2; ++a) {
+      // Reference: the stable latent variance sf^2 - ||L^-1 k||^2. The matcher only sees Kinv, whose
+      // entries (up to ~1e8 / sf^2 here) already carry rounding: one ulp on each entry moves
+      // k' Kinv k by up to ~eps |k|' |Kinv| |k|, so that is the accuracy any method reading Kinv can
+      // reach (it is 1e3..1e4 x the latent variance's own size scale 1e-12 here, and ~1e-10 in
+      // absolute terms); before the fix the error was ~1e-4.
+      const Vector k = gp.kernel_column(a, mu);
+      const double sf2 = std::exp(2.0 * gp.outputs[a].log_signal_std);
+      const Vector lk = ill.factors[a].triangularView<Eigen::Lower>().solve(k);
+      const double reference = sf2 - lk.squaredNorm();
+      const double from_kinv = sf2 - k.dot(gp.outputs[a].Kinv * k);
+      const double data_limit = eps * k.cwiseAbs().dot(gp.outputs[a].Kinv.cwiseAbs() * k.cwiseAbs());
+      std::printf("    output %d: S_aa %.10e, Cholesky %.10e (diff % .1e), sf^2 - k'Kinv k diff % .1e, "
+                  "Kinv data limit %.1e\n",
+                  a, m.covariance(a, a), reference, m.covariance(a, a) - reference,
+                  m.covariance(a, a) - from_kinv, data_limit);
+      EXPECT_GE(m.covariance(a, a), 0.0);
+      const double tolerance = 1e-12 + 1e-8 * std::abs(reference) + data_limit;
+      EXPECT_NEAR(m.covariance(a, a), reference, tolerance) << "output " << a << ", trial " << trial;
+      EXPECT_NEAR(m.covariance(a, a), std::max(from_kinv, 0.0), tolerance) << "output " << a;
+      EXPECT_NEAR(m.mean(a), gp.posterior_mean(a, mu), 1e-9 * std::sqrt(sf2));
+    }
+    // The derivatives of the off-diagonal entry vanish too at Sigma = 0 for d/dmu (S_01 = 0 for all mu).
+    EXPECT_LT(m.dcovariance_dmu.row(1).cwiseAbs().maxCoeff(), 1e-10);
+    EXPECT_LT(m.dcovariance_dmu.row(2).cwiseAbs().maxCoeff(), 1e-10);
+  }
+}
+
+TEST(MomentMatching, NearlyNoiseFreeGpsGiveAPositiveSemidefiniteCovarianceForASmallSigma) {
+  const IllConditionedGp ill = make_ill_conditioned_gp();
+  const TestGp& gp = ill.gp;
+  const SeArdMomentMatcher matcher = gp.matcher();
+  MomentMatch m;
+  for (unsigned trial = 0; trial < 6; ++trial) {
+    const Vector mu = ::gpilqg::test::random_vector(3, -1.0, 1.0, 400 + trial);
+    Matrix sigma = (trial == 2 ? 1e-7 : 1e-3) * Matrix::Identity(3, 3);
+    if (trial >= 3) sigma = make_sigma(3, 0.03, 500 + trial, /*zero_index=*/trial == 5 ? 2 : -1);
+    matcher.propagate(mu, sigma, m, MomentDerivatives::All);
+    const Eigen::SelfAdjointEigenSolver<Matrix> eig(m.covariance);
+    // First order in Sigma, S_ab ~ g_a' Sigma g_b + delta_ab E[v_a]: the cross term must agree with it.
+    const double first_order = m.dmean_dmu.row(0).dot(sigma * m.dmean_dmu.row(1).transpose());
+    std::printf("  trial %u: S = [% .6e % .6e; % .6e % .6e], eigenvalues %.3e %.3e, g0' Sigma g1 % .6e\n", trial,
+                m.covariance(0, 0), m.covariance(0, 1), m.covariance(1, 0), m.covariance(1, 1),
+                eig.eigenvalues()(0), eig.eigenvalues()(1), first_order);
+    EXPECT_GE(eig.eigenvalues()(0), -1e-12) << "trial " << trial;
+    EXPECT_NEAR(m.covariance(0, 1), first_order, 0.05 * std::abs(first_order) + 1e-9) << "trial " << trial;
+    // The off-diagonal entry's derivatives against central differences (the diagonal's differences are
+    // dominated by the Kinv rounding above, ~1e-10 / h). S_01 itself carries ~4e-12 of rounding
+    // (~eps N |gamma|^2 |D|), i.e. ~4e-7 in a difference with h = 1e-5 (checked: the gap scales as 1/h
+    // from h = 1e-6 to 1e-4), so the steps are larger: 1e-3 for mu, 1e-4 for Sigma (~1e-3 here).
+    if (trial == 2) continue;  // the steps would exceed Sigma = 1e-7 I itself
+    const auto s01 = [&](const Vector& x, const Matrix& sig) {
+      MomentMatch r;
+      matcher.propagate(x, sig, r);
+      return Vector::Constant(1, r.covariance(0, 1));
+    };
+    const Matrix numeric_mu = numeric_jacobian([&](const Vector& x) { return s01(x, sigma); }, mu, 1e-3);
+    const Matrix numeric_sigma = numeric_jacobian(
+        [&](const Vector& x) { return s01(mu, x.reshaped(3, 3)); }, sigma.reshaped(), 1e-4);
+    EXPECT_TRUE(matrices_near(m.dcovariance_dmu.row(1), numeric_mu, 1e-8, 1e-4)) << "trial " << trial;
+    EXPECT_TRUE(matrices_near(m.dcovariance_dsigma.row(1), numeric_sigma, 1e-7, 1e-5)) << "trial " << trial;
+    std::printf("    dS_01: max |analytic - central difference| d/dmu %.1e (largest %.2e), d/dSigma %.1e "
+                "(largest %.2e)\n",
+                (m.dcovariance_dmu.row(1) - numeric_mu).cwiseAbs().maxCoeff(),
+                m.dcovariance_dmu.row(1).cwiseAbs().maxCoeff(),
+                (m.dcovariance_dsigma.row(1) - numeric_sigma).cwiseAbs().maxCoeff(),
+                m.dcovariance_dsigma.row(1).cwiseAbs().maxCoeff());
+  }
+}
+
+TEST(MomentMatching, ANegativeExpectedVarianceIsClampedWithZeroDerivatives) {
+  // Kinv tripled: sf^2 - tr(Kinv Q) ~ -2 sf^2 < 0, so V_0 is clamped at 0 and S_00 is the covariance of
+  // the posterior mean alone, with its derivatives (V_0 contributes none).
+  TestGp gp = make_gp(12, 3, 2, 26);
+  gp.outputs[0].Kinv *= 3.0;
+  Vector mu(3);
+  mu << 0.1, -0.2, 0.3;
+  MomentMatch m;
+  gp.matcher().propagate(mu, Matrix::Zero(3, 3), m);
+  EXPECT_EQ(m.covariance(0, 0), 0.0);
+  EXPECT_NEAR(m.covariance(1, 1), gp.posterior_variance(1, mu), 1e-12);
+  check_derivatives(gp, mu, make_sigma(3, 0.3, 9), "clamped V_0");
 }
 
 // ------------------------------------------------------------------------------------------------

@@ -42,11 +42,7 @@ struct PolicyRolloutSettings {
 /// Runs the policy in closed loop on `world` from x0 (the world may differ from the model the policy
 /// was computed on, e.g. the real-world preset, and may be integrated with sub-steps). The trajectory
 /// holds the true states and the applied controls. A diverging rollout stops and says so.
-struct PolicyRollout {
-  Trajectory trajectory;
-  int steps_completed = 0;
-  bool finite = true;
-};
+using PolicyRollout = RolloutResult;
 PolicyRollout rollout_policy(const StepModel& world, const AffinePolicy& policy, const VectorCRef& x0,
                              const PolicyRolloutSettings& settings, std::mt19937_64& rng);
 

@@ -5,6 +5,7 @@
 /// With noise, each step draws xi ~ N(0, I_p) and xi_G ~ N(0, I_q) and applies the paper's
 ///   x' = phi(x, u) + F(x, u) xi sqrt(dt) + G(x, u) xi_G sqrt(dt).
 
+#include <functional>
 #include <random>
 
 #include "gpilqg/control/trajectory.hpp"
@@ -33,6 +34,17 @@ struct RolloutResult {
 
 RolloutResult rollout(const StepModel& model, const VectorCRef& x0, const Matrix& u,
                       RolloutNoise noise = RolloutNoise::None, std::mt19937_64* rng = nullptr);
+
+/// The control at step t from the state the controller observes, written into u (size m).
+using Controller = std::function<void(int t, const VectorCRef& observed, VectorRef u)>;
+
+/// The one closed-loop simulation loop of the project (open-loop rollouts, policy rollouts and MPC
+/// all run through it): at each step the controller sees x_t plus N(0, diag(observation_std^2))
+/// (no noise when empty), chooses u_t, and sample_step draws x_{t+1}. Divergence is handled as in
+/// rollout(). `rng` may be null only when there is no noise of either kind.
+RolloutResult closed_loop_rollout(const StepModel& world, const VectorCRef& x0, int steps,
+                                  const Controller& controller, RolloutNoise noise,
+                                  const Vector& observation_std, std::mt19937_64* rng);
 
 /// One sampled step, the shared mechanism of every simulated rollout in the project:
 ///   x' = phi(x, u) [+ sqrt(dt) F(x, u) xi] [+ sqrt(dt) G(x, u) xi_G]

@@ -28,8 +28,23 @@
 /// Evaluation (documented in moment_matching.cpp): every determinant and inverse comes from the
 /// Cholesky factor of a scaled matrix Rt = W^1/2 Sigma W^1/2 + I (W = W_a, or W_a + W_b for a pair),
 /// whose eigenvalues are >= 1 for a PSD Sigma, so a singular Sigma (e.g. zero rows and columns for
-/// deterministic controls, or Sigma = 0) is fine. log Q_ab,ij is assembled as one sum before
-/// exponentiating, so the kernel values never underflow separately.
+/// deterministic controls, or Sigma = 0) is fine.
+///
+/// S is never formed as beta_a' Q_ab beta_b - M_a M_b: with nearly noise-free data (sn ~ 1e-3 std y)
+/// |beta| reaches 1e4..1e6 and that difference of two O(|beta|^2) numbers loses every digit (negative
+/// variances, off-diagonals ~1e-4 at Sigma = 0). Instead (moment_matching_covariance.cpp)
+///
+///   Q_ab,ij = q_ai q_bj exp(D_ij),   D_ij = log Q_ab,ij - log q_ai - log q_bj   (D = 0 at Sigma = 0),
+///   S_ab    = beta_a' (Q_ab - q_a q_b') beta_b + delta_ab V_a,
+///             (Q_ab - q_a q_b')_ij = q_ai q_bj expm1(D_ij),
+///   V_a     = max(0, sf_a^2 - q_a' Kinv_a q_a - <Kinv_a, Q_aa - q_a q_a'>)  (= E[latent variance]),
+///
+/// with D_ij assembled directly from O(Sigma) terms (never as a difference of logs or exponentials),
+/// so at Sigma = 0 the off-diagonal entries are exactly 0 and V_a is the plain latent variance
+/// sf^2 - k(mu)' Kinv k(mu). V_a can be no more accurate than Kinv allows: one rounding of each entry
+/// of Kinv already moves k' Kinv k by up to eps |k|' |Kinv| |k| (~1e-9 sf^2 when K + sn^2 I has a
+/// condition number ~1e9); the clamp at 0 keeps that rounding from making S indefinite, and where it
+/// acts V_a's derivatives are 0.
 ///
 /// Sigma: only its symmetric part sym(Sigma) = (Sigma + Sigma') / 2 is read, and the moments are
 /// defined as functions of sym(Sigma) for any square Sigma. Consequently the derivatives with respect
@@ -53,12 +68,12 @@
 ///
 /// Cost per call (N training points, D inputs, E outputs), dominated by the E(E+1)/2 output pairs,
 /// each of which needs an N x N matrix of exponentials:
-///   moments only      E(E+1)/2 (2 N^2 D flops (one GEMM) + N^2 exp (N^2/2 when a = b)) + E O(N D^2)
+///   moments only      E(E+1)/2 (2 N^2 D flops (one GEMM) + N^2 expm1 (N^2/2 when a = b)) + E O(N D^2)
 ///   with derivatives  adds E(E+1)/2 (2 N^2 D flops (one more GEMM) + O(N^2)) + E O(N D^3)
 /// The derivatives with respect to Sigma cost no more than the moments: d log Q_ij / dSigma is
 /// -1/2 P + 1/2 y_ij y_ij' with y_ij = G (W_a nu_i + W_b nu_j) affine in separate i and j terms, so
 /// sum_ij Omega_ij y_ij y_ij' reduces to V' diag(r) V, V' diag(c) V and V' Omega V (V = X - 1 mu').
-/// Without derivatives, about half the time goes into exp and a third into the GEMM
+/// Without derivatives, most of the time goes into expm1 and the GEMM
 /// (bench/moment_matching_bench.cpp has the figures).
 ///
 /// Threading and allocation: SeArdMomentMatcher is immutable after construction and may be shared
@@ -106,13 +121,19 @@ struct MomentMatchScratch {
   std::vector<Matrix> scaled;            ///< A_a = V W_a (N x D) per output
   std::vector<Matrix> hessian;           ///< H_a = T_a' diag(gamma_a) T_a - M_a P_a (D x D) per output
   std::vector<Vector> weighted;          ///< gamma_a = beta_a .* q_a (N) per output
-  std::vector<Vector> log_kernel;        ///< -1/2 nu_i' W_a nu_i (N) per output
+  std::vector<Vector> kernel_mean;       ///< q_a (N) per output
+  std::vector<Vector> log_shift;         ///< c_ai = 1/2 nu_i' B_a nu_i (N) per output
+  std::vector<Matrix> shrink;            ///< B_a = W_a - P_a = W_a^1/2 (I - Rt_a^-1) W_a^1/2 (D x D) per output
   std::vector<Vector> gradient;          ///< g_a = dM_a/dmu = T_a' gamma_a (D) per output
+  std::vector<Vector> scaled_sum;        ///< u_a = A_a' gamma_a (D) per output, derivatives only
+  std::vector<Matrix> scaled_scatter;    ///< E_a = A_a' diag(gamma_a) A_a (D x D) per output, derivatives only
+  Vector log_det;                        ///< log|Rt_a| (E)
   Eigen::LLT<Matrix> llt;                ///< factor of the current scaled matrix Rt (D x D)
   Matrix rt, rt_inverse, xi, gain, pair_precision, dd, dd2, inner;  ///< D x D
+  Matrix pair_shrink, delta_a, delta_b;                            ///< D x D, derivatives only
   Matrix nd, nd2;                                                  ///< N x D
   Vector row_term, col_term, row_sums, col_sums;                   ///< N
-  Matrix nn;                             ///< log Q, Q, then Omega of one pair (N x N)
+  Matrix nn;                             ///< D, expm1(D), then Omega of one pair (N x N)
   Matrix outer;                          ///< t_ni t_nj (N x D*D), derivatives only
   Matrix third;                          ///< sum_n gamma_n (Sigma t_n)_k t_ni t_nj (D x D*D), derivatives only
   Vector sqrt_w_pair, lengthscale_pair, dvec, dvec2;               ///< D
