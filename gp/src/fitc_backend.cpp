@@ -35,13 +35,10 @@ struct FitcTraits {
   static constexpr std::string_view name = "fitc";
   static constexpr const char* label = "FITC";
   static constexpr const char* condition_who = "FitcBackend::condition";
+  static int cross_size(const FitcPredictor& p) { return p.inducing(); }
   static void predict(const FitcPredictor& p, const VectorCRef& z, PredictionWorkspace& w, double& mean,
                       double* variance, double* dmean, double* dvariance) {
-    const int D = p.input_dim();
-    const int M = p.inducing();
-    if (w.cross.size() != M) w.cross.resize(M);
-    if (w.weighted.size() != M) w.weighted.resize(M);
-    if (w.extra.size() != D) w.extra.resize(D);
+    if (w.extra.size() != p.input_dim()) w.extra.resize(p.input_dim());
     p.predict(z, w.cross.data(), w.weighted.data(), w.extra.data(), mean, variance, dmean, dvariance);
   }
 };

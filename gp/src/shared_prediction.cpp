@@ -55,28 +55,28 @@ SharedExactPrediction::Cache& SharedExactPrediction::at(const VectorCRef& z) con
   return cache;
 }
 
-void SharedExactPrediction::means(const VectorCRef& z, Vector& mean, Matrix* gradient) const {
+template <class Stage>
+void SharedExactPrediction::each_output(const VectorCRef& z, Vector& values, Matrix* gradient, Stage&& stage) const {
   Cache& c = at(z);
   const auto n = static_cast<Eigen::Index>(predictors_.size());
-  mean.resize(n);
+  values.resize(n);
   if (gradient != nullptr) gradient->resize(n, z.size());
   for (Eigen::Index a = 0; a < n; ++a) {
-    mean(a) = predictors_[static_cast<std::size_t>(a)]->mean(z, c.cross.col(a), gradient ? &c.gradient : nullptr,
-                                                            c.scratch);
+    values(a) = stage(*predictors_[static_cast<std::size_t>(a)], c, c.cross.col(a), gradient ? &c.gradient : nullptr);
     if (gradient != nullptr) gradient->row(a) = c.gradient.transpose();
   }
 }
 
+void SharedExactPrediction::means(const VectorCRef& z, Vector& mean, Matrix* gradient) const {
+  each_output(z, mean, gradient, [&z](const ExactPredictor& p, Cache& c, const auto& k, Vector* g) {
+    return p.mean(z, k, g, c.scratch);
+  });
+}
+
 void SharedExactPrediction::variances(const VectorCRef& z, Vector& variance, Matrix* gradient) const {
-  Cache& c = at(z);
-  const auto n = static_cast<Eigen::Index>(predictors_.size());
-  variance.resize(n);
-  if (gradient != nullptr) gradient->resize(n, z.size());
-  for (Eigen::Index a = 0; a < n; ++a) {
-    variance(a) = predictors_[static_cast<std::size_t>(a)]->variance(
-        z, c.cross.col(a), gradient ? &c.gradient : nullptr, c.weighted, c.scratch);
-    if (gradient != nullptr) gradient->row(a) = c.gradient.transpose();
-  }
+  each_output(z, variance, gradient, [&z](const ExactPredictor& p, Cache& c, const auto& k, Vector* g) {
+    return p.variance(z, k, g, c.weighted, c.scratch);
+  });
 }
 
 }  // namespace gpilqg::gp::detail

@@ -44,6 +44,10 @@ class SharedExactPrediction {
                         std::vector<const ExactPredictor*> predictors);
   /// The calling thread's cache, holding k_a (column a) at z.
   Cache& at(const VectorCRef& z) const;
+  /// values(a) = stage(predictor a, cache, k_a, gradient buffer or null) for every output at z, and the
+  /// gradient buffer into row a of `gradient` when not null.
+  template <class Stage>
+  void each_output(const VectorCRef& z, Vector& values, Matrix* gradient, Stage&& stage) const;
 
   std::vector<std::shared_ptr<const FittedGp>> outputs_;  // keeps the predictors alive
   std::vector<const ExactPredictor*> predictors_;

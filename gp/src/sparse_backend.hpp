@@ -9,9 +9,12 @@
 ///     static constexpr std::string_view name;     // registry name ("fitc")
 ///     static constexpr const char* label;         // for messages ("FITC")
 ///     static constexpr const char* condition_who; // "FitcBackend::condition"
+///     static int cross_size(const Predictor&);    // entries of k (FITC: M, SSGP: 2m features)
 ///     static void predict(const Predictor&, const VectorCRef& z, PredictionWorkspace&, double& mean,
-///                         double* variance, double* dmean, double* dvariance);   // sizes the workspace
+///                         double* variance, double* dmean, double* dvariance);
 ///   };
+///
+/// Traits::predict receives the workspace with `cross` and `weighted` sized to cross_size.
 
 #include <memory>
 #include <stdexcept>
@@ -67,6 +70,10 @@ class FittedSparseGp final : public FittedGp {
     if (z.size() != D)
       throw std::invalid_argument(std::string(Traits::label) + " prediction: the input has " +
                                   std::to_string(z.size()) + " entries; expected " + std::to_string(D));
+    const int size = Traits::cross_size(predictor_);
+    PredictionWorkspace& w = out.workspace;
+    if (w.cross.size() != size) w.cross.resize(size);
+    if (w.weighted.size() != size) w.weighted.resize(size);
     double* dmean = nullptr;
     double* dvariance = nullptr;
     if (request.gradients) {
@@ -77,7 +84,7 @@ class FittedSparseGp final : public FittedGp {
         dvariance = out.variance_gradient.data();
       }
     }
-    Traits::predict(predictor_, z, out.workspace, out.mean, request.variance ? &out.variance : nullptr, dmean,
+    Traits::predict(predictor_, z, w, out.mean, request.variance ? &out.variance : nullptr, dmean,
                     dvariance);
   }
 

@@ -34,11 +34,9 @@ struct SsgpTraits {
   static constexpr std::string_view name = "ssgp";
   static constexpr const char* label = "SSGP";
   static constexpr const char* condition_who = "SsgpBackend::condition";
+  static int cross_size(const SsgpPredictor& p) { return 2 * p.frequencies(); }
   static void predict(const SsgpPredictor& p, const VectorCRef& z, PredictionWorkspace& w, double& mean,
                       double* variance, double* dmean, double* dvariance) {
-    const int features = 2 * p.frequencies();
-    if (w.cross.size() != features) w.cross.resize(features);
-    if (w.weighted.size() != features) w.weighted.resize(features);
     p.predict(z, w.cross.data(), w.weighted.data(), mean, variance, dmean, dvariance);
   }
 };
