@@ -168,7 +168,7 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     const int D = static_cast<int>(all.inputs.cols());
     for (int i = 0; i < model->state_dim(); ++i) record.hyperparameters.push_back(model->output(i).parameters().head(D + 2));
     last = model;
-    return plan_with_ddp(c, model, DdpVariant::RobustILQG, warm_start(previous));
+    return plan_with_ddp(c, model, c.config.gp_variant, warm_start(previous));
   };
   return learning_loop(c, name, std::move(initial), seed, planner);
 }

@@ -72,11 +72,12 @@ Vector non_negative(const TomlFields& f, const std::string& path, int size, std:
   return v;
 }
 
-RunConfig read_run_config(const toml::table& root, const std::string& source) {
+RunConfig read_run_config(const toml::table& root, const std::string& source, const std::string& system) {
   const TomlFields f(root, source);
   f.only_keys("", {"system", "noise", "control", "tasks", "loop", "gp", "solver", "mpc", "pddp"});
   RunConfig c;
   c.system = f.string("system.name");
+  if (c.system != system) f.fail("system.name", fmt::format("is '{}' but the command runs '{}'", c.system, system));
   SystemSignature signature;
   try {
     signature = system_signature(c.system);
@@ -127,6 +128,10 @@ RunConfig read_run_config(const toml::table& root, const std::string& source) {
   c.solver.max_iterations = positive_integer(f, "solver.max_iterations", 1);
   c.solver.cost_tolerance = f.number("solver.tolerance");
   c.solver.gradient_tolerance = f.number("solver.gradient_tolerance");
+  const std::string gp_algorithm = f.string("solver.gp_algorithm");
+  if (gp_algorithm == "robust_ilqg") c.gp_variant = DdpVariant::RobustILQG;
+  else if (gp_algorithm == "ilqg") c.gp_variant = DdpVariant::ILQG;
+  else f.fail("solver.gp_algorithm", fmt::format("'{}'; expected \"robust_ilqg\" (the paper) or \"ilqg\" (GP mean only)", gp_algorithm));
   try {
     c.solver.validate();
   } catch (const std::invalid_argument& e) {
@@ -164,15 +169,11 @@ const std::string& default_run_config_text(const std::string& system) {
 
 RunConfig parse_run_config(const std::string& system, const std::string& override_text, const std::string& source) {
   const std::string defaults_source = fmt::format("<embedded defaults of run {}>", system);
-  toml::table root = TomlFields::parse_text(default_run_config_text(system), defaults_source);
-  if (!override_text.empty()) {
-    const toml::table overrides = TomlFields::parse_text(override_text, source);
-    TomlFields::merge(root, overrides);
-  }
-  const RunConfig config = read_run_config(root, source.empty() ? defaults_source : source);
-  if (config.system != system)
-    throw InputError(fmt::format("{}: field 'system.name' is '{}' but the command runs '{}'", source, config.system, system));
-  return config;
+  const toml::table defaults = TomlFields::parse_text(default_run_config_text(system), defaults_source);
+  if (override_text.empty()) return read_run_config(defaults, defaults_source, system);
+  toml::table root = TomlFields::parse_text(override_text, source);
+  TomlFields::merge(root, defaults);
+  return read_run_config(root, source, system);
 }
 
 RunConfig load_run_config(const std::string& system, const std::optional<std::filesystem::path>& override_file) {

@@ -100,9 +100,10 @@ ModelSlice model_slice(const StepModel& world, const StepModel& model, const Tra
   s.base = z.row(nearest).transpose();
 
   const double lo = z.col(s.input).minCoeff(), hi = z.col(s.input).maxCoeff();
-  const double width = std::max(hi - lo, 1e-3);
+  // Out to where the kernel has forgotten the data: two data widths or six length-scales, whichever is more.
+  const double margin = std::max(2.0 * std::max(hi - lo, 1e-3), 6.0 * std::exp(log_l(s.input)));
   constexpr int kPoints = 401;
-  s.grid = Vector::LinSpaced(kPoints, lo - 2.0 * width, hi + 2.0 * width);
+  s.grid = Vector::LinSpaced(kPoints, lo - margin, hi + margin);
   s.simulator.resize(kPoints), s.mean.resize(kPoints), s.std.resize(kPoints), s.truth.resize(kPoints);
   Vector x_next(n);
   DiffusionColumns columns;

@@ -34,25 +34,30 @@ std::string keys_of(const toml::table& table) {
   return list;
 }
 
-void merge_level(toml::table& base, const toml::table& overrides, const std::string& prefix) {
+/// Fills `overrides` with every entry of `base` it lacks, recursing into tables both have. The
+/// user's nodes stay where they were parsed, so they keep their source lines for later errors.
+void merge_level(toml::table& overrides, const toml::table& base, const std::string& prefix) {
   for (const auto& [key, node] : overrides) {
     const std::string name(key.str());
     const std::string path = prefix.empty() ? name : prefix + "." + name;
-    toml::node* existing = base.get(name);
-    if (existing == nullptr) {
+    if (base.get(name) == nullptr) {
       const auto& source = node.source();
       throw InputError(fmt::format("{}:line {}: unknown field '{}'; expected one of: {}",
                                    source.path ? *source.path : std::string("<config>"), source.begin.line, path,
                                    keys_of(base)));
     }
-    if (existing->is_table() && node.is_table()) merge_level(*existing->as_table(), *node.as_table(), path);
-    else base.insert_or_assign(name, node);
+  }
+  for (const auto& [key, node] : base) {
+    toml::node* mine = overrides.get(key.str());
+    if (mine == nullptr) overrides.insert(key.str(), node);
+    else if (mine->is_table() && node.is_table())
+      merge_level(*mine->as_table(), *node.as_table(), prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str()));
   }
 }
 
 }  // namespace
 
-void TomlFields::merge(toml::table& base, const toml::table& overrides) { merge_level(base, overrides, ""); }
+void TomlFields::merge(toml::table& overrides, const toml::table& base) { merge_level(overrides, base, ""); }
 
 const toml::node* TomlFields::find(const std::string& path) const {
   return root_.at_path(path).node();

@@ -11,7 +11,7 @@
 ///   [[tasks]] name, x0, goal, horizon, Q, R, Qf, track_line, transfer
 ///   [loop]    iterations, rollouts, exploration (m), policy_tolerance, evaluation_rollouts
 ///   [gp]      backend, exact_points, inducing, frequencies, restarts, max_evaluations
-///   [solver]  max_iterations, tolerance, gradient_tolerance
+///   [solver]  max_iterations, tolerance, gradient_tolerance, gp_algorithm ("robust_ilqg"|"ilqg")
 ///   [mpc]     enabled, horizon, first_solve_iterations, iterations_per_step
 ///   [pddp]    enabled, max_iterations, own, own_initial_rollouts, own_amplitude (m)
 
@@ -63,6 +63,9 @@ struct RunConfig {
   int max_evaluations = 150;
   // [solver]
   DdpOptions solver;  ///< variant chosen per algorithm
+  /// The variant GP-ILQG solves with: RobustILQG (the paper: F and the GP's G) or ILQG (an ablation
+  /// that ignores the GP's uncertainty and plans on its mean).
+  DdpVariant gp_variant = DdpVariant::RobustILQG;
   // [mpc]
   bool mpc = false;
   MpcOptions mpc_options;

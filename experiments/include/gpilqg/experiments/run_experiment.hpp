@@ -23,7 +23,8 @@ struct RunOptions {
 };
 
 /// A 1-D picture of the learned model (the paper's Figure 1): one state output of the GP-corrected
-/// step against one input, the other inputs held at a measured point, far beyond the data on both sides.
+/// step against one input, the other inputs held at a measured point, out to two data widths or six length-scales
+/// (whichever is more) beyond the data on both sides.
 struct ModelSlice {
   int output = 0, input = 0;
   Vector base;        ///< the measured point z* the slice goes through

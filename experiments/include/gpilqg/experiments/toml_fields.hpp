@@ -21,10 +21,11 @@ class TomlFields {
   static toml::table parse(const std::filesystem::path& file);
   /// Parses TOML text; `source` names it in errors (and in the nodes' source regions).
   static toml::table parse_text(const std::string& text, const std::string& source);
-  /// Overrides `base` with `overrides`: tables merge key by key, every other value (arrays included)
-  /// replaces the base's. A key `base` does not have is an InputError naming the overriding source,
-  /// its line and the keys that exist there.
-  static void merge(toml::table& base, const toml::table& overrides);
+  /// Completes `overrides` with `base` (the defaults): tables merge key by key, every other value the
+  /// user gave (arrays included) replaces the default. A key `base` does not have is an InputError
+  /// naming the overriding source, its line and the keys that exist there. The user's nodes are kept
+  /// in place, so later errors still name their file and line.
+  static void merge(toml::table& overrides, const toml::table& base);
 
   TomlFields(const toml::table& root, std::filesystem::path file) : root_(root), file_(std::move(file)) {}
 

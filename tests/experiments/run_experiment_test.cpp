@@ -1,0 +1,225 @@
+/// `gpilqg run` end to end on a tiny cart-pole configuration: the evaluation agrees with the solver
+/// where it must (no noise, true model), seeded runs repeat bit for bit, every algorithm sees the data
+/// the protocol promises (PDDP the data of gp_ilqg, a transfer task the previous task's data), the
+/// result file has the documented layout, and the plot script draws it.
+
+#include "gpilqg/experiments/run_experiment.hpp"
+
+#include <fstream>
+#include <unistd.h>
+
+#include <H5Cpp.h>
+#include <gtest/gtest.h>
+
+#include "gpilqg/experiments/plot_script.hpp"
+#include "gpilqg/experiments/run_results_io.hpp"
+#include "gpilqg/gp/residual_model.hpp"
+#include "test_support.hpp"
+
+namespace gpilqg {
+namespace {
+
+/// Two 15-step tasks, one data round, small GPs and short PDDP solves: seconds, not minutes.
+const char* const kTinyRun = R"(
+[noise]
+actuator_multiplicative = [0.02]
+observation = [0.001, 0.001, 0.001, 0.001]
+[loop]
+iterations = 2
+rollouts = 1
+evaluation_rollouts = 2
+[gp]
+exact_points = 40
+restarts = 0
+max_evaluations = 40
+[solver]
+max_iterations = 30
+[pddp]
+max_iterations = 2
+own_initial_rollouts = 1
+[[tasks]]
+name = "first"
+x0 = [0.0, 0.0, 0.3, 0.0]
+goal = [0.0, 0.0, 0.0, 0.0]
+horizon = 15
+Q = [1.0, 1.0, 1.0, 1.0]
+R = [0.1]
+Qf = [10.0, 10.0, 10.0, 10.0]
+track_line = false
+transfer = false
+[[tasks]]
+name = "second"
+x0 = [0.0, 0.0, -0.3, 0.0]
+goal = [0.0, 0.0, 0.0, 0.0]
+horizon = 15
+Q = [1.0, 1.0, 1.0, 1.0]
+R = [0.1]
+Qf = [10.0, 10.0, 10.0, 10.0]
+track_line = false
+transfer = true
+)";
+
+RunResults tiny_run(std::vector<std::uint64_t> seeds) {
+  RunOptions options;
+  options.seeds = std::move(seeds);
+  return run_experiment(parse_run_config("cartpole", kTinyRun, "tiny.toml"), options);
+}
+
+const AlgorithmRun& find(const TaskResults& task, std::size_t seed, const std::string& name) {
+  for (const auto& run : task.seeds.at(seed))
+    if (run.name == name) return run;
+  throw std::runtime_error("no algorithm " + name);
+}
+
+TEST(RunExperiment, WithoutNoiseTheTrueModelsPolicyCostsWhatItsSolverPredicted) {
+  // With no process or observation noise, the closed loop on the world retraces the plan made on the
+  // world, so the evaluated cost (rollout code) equals the solver's predicted cost (DDP code).
+  RunConfig config = parse_run_config("cartpole", kTinyRun, "tiny.toml");
+  config.noise.multiplicative_std = Vector::Zero(1);
+  config.observation_std = Vector::Zero(4);
+  const RunModels models = make_run_models(config);
+  const QuadraticCost cost = make_task_cost(config, config.tasks[0]);
+  const TaskContext context{config, config.tasks[0], 0, models, cost, nullptr};
+  const AlgorithmRun run = run_fixed_model(context, "ilqg_real", models.world, 1);
+  const IterationRecord& r = run.iterations.front();
+  EXPECT_NEAR(r.evaluation.mean_cost, r.plan.predicted_cost, 1e-9 * r.plan.predicted_cost);
+  EXPECT_EQ(r.evaluation.costs[0], r.evaluation.costs[1]);
+  ASSERT_EQ(run.iterations.size(), 3u);
+  EXPECT_TRUE(run.iterations[2].repeated);
+}
+
+TEST(RunExperiment, AlgorithmsSeeTheDataTheProtocolPromisesAndSeedsRepeat) {
+  const RunResults a = tiny_run({5});
+  const RunResults b = tiny_run({5, 6});
+  ASSERT_EQ(a.tasks.size(), 2u);
+  const std::vector<std::string> expected = {"ilqg_real", "ilqg_sim", "gp_ilqg", "pddp", "pddp_own"};
+  EXPECT_EQ(a.tasks[0].algorithms, expected);
+
+  for (std::size_t t = 0; t < 2; ++t) {
+    // The same seed gives the same run, bit for bit (seed 5 is the first seed of both runs).
+    for (std::size_t alg = 0; alg < expected.size(); ++alg)
+      for (std::size_t k = 0; k < 3; ++k)
+        EXPECT_EQ(a.tasks[t].seeds[0][alg].iterations[k].evaluation.costs,
+                  b.tasks[t].seeds[0][alg].iterations[k].evaluation.costs)
+            << expected[alg] << " task " << t << " iteration " << k;
+    // PDDP is trained at every iteration on exactly the data gp_ilqg had.
+    const auto& gp = find(a.tasks[t], 0, "gp_ilqg");
+    const auto& pddp = find(a.tasks[t], 0, "pddp");
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(pddp.iterations[k].data_rows, gp.iterations[k].data_rows);
+  }
+  // Another seed collects other data.
+  const auto& gp5 = find(b.tasks[0], 0, "gp_ilqg");
+  const auto& gp6 = find(b.tasks[0], 1, "gp_ilqg");
+  ASSERT_EQ(gp5.data.size(), gp6.data.size());
+  EXPECT_GT((gp5.data.x - gp6.data.x).cwiseAbs().maxCoeff(), 0.0);
+
+  // Task 1: gp_ilqg starts with no data (iLQG on the simulator = ilqg_sim), then one rollout of 15
+  // transitions per round. Task 2 starts from all of task 1's data (transfer).
+  const auto& first = find(a.tasks[0], 0, "gp_ilqg");
+  EXPECT_EQ(first.iterations[0].data_rows, 0);
+  EXPECT_EQ(first.iterations[0].evaluation.costs, find(a.tasks[0], 0, "ilqg_sim").iterations[0].evaluation.costs);
+  if (first.converged_at < 0) {
+    EXPECT_EQ(first.data.size(), 2 * 15);
+  }
+  const auto& second = find(a.tasks[1], 0, "gp_ilqg");
+  EXPECT_EQ(second.iterations[0].data_rows, first.data.size());
+  EXPECT_FALSE(second.iterations[0].hyperparameters.empty());  // it starts with a learned model
+  EXPECT_EQ(find(a.tasks[0], 0, "pddp_own").iterations[0].data_rows, 15);  // its random episode
+  for (const auto& run : a.tasks[1].seeds[0])
+    for (const auto& record : run.iterations) EXPECT_TRUE(std::isfinite(record.evaluation.mean_cost)) << run.name;
+}
+
+TEST(RunExperiment, ModelSliceReturnsToTheSimulatorFarFromTheData) {
+  const RunResults r = tiny_run({2});
+  const ModelSlice& s = r.tasks[0].slice;
+  ASSERT_EQ(s.grid.size(), 401);
+  const auto& gp = find(r.tasks[0], 0, "gp_ilqg");
+  const auto* model = dynamic_cast<const gp::ResidualModel*>(gp.final_model.get());
+  ASSERT_NE(model, nullptr);
+  // Six length-scales beyond the data on either side: the corrected model is the simulator and the
+  // standard deviation is the prior's sf (the paper's Figure 1).
+  const double sf = std::sqrt(model->output(s.output).prior_variance());
+  for (const Eigen::Index end : {Eigen::Index{0}, s.grid.size() - 1}) {
+    EXPECT_NEAR(s.mean(end), s.simulator(end), 1e-3 * sf);
+    EXPECT_NEAR(s.std(end), sf, 1e-3 * sf);
+  }
+  EXPECT_LT(s.std.minCoeff(), 0.5 * sf);  // and it is corrected near the data
+}
+
+std::vector<hsize_t> shape_of(const H5::H5File& file, const std::string& path) {
+  const H5::DataSpace space = file.openDataSet(path).getSpace();
+  std::vector<hsize_t> dims(static_cast<std::size_t>(space.getSimpleExtentNdims()));
+  space.getSimpleExtentDims(dims.data());
+  return dims;
+}
+
+TEST(RunExperiment, ResultFileHasTheDocumentedLayoutAndPlots) {
+  const RunResults r = tiny_run({3, 4});
+  const auto dir = test::temporary_dir("run_results");
+  const auto file = dir / "run.h5";
+  write_run_results(file, r);
+  H5::H5File h5(file.string(), H5F_ACC_RDONLY);
+  for (const char* attribute : {"schema_version", "gpilqg_version", "config", "seed", "created", "system"})
+    EXPECT_TRUE(h5.attrExists(attribute)) << attribute;
+  using Shape = std::vector<hsize_t>;
+  EXPECT_EQ(shape_of(h5, "/seeds"), Shape({2}));
+  EXPECT_EQ(shape_of(h5, "/first/gp_ilqg/cost"), Shape({3, 2}));
+  EXPECT_EQ(shape_of(h5, "/first/pddp/normalised_cost"), Shape({3, 2}));
+  EXPECT_EQ(shape_of(h5, "/first/gp_ilqg/evaluation_costs"), Shape({3, 2, 2}));
+  EXPECT_EQ(shape_of(h5, "/first/gp_ilqg/iter_1/x"), Shape({2, 4, 16}));
+  EXPECT_EQ(shape_of(h5, "/first/gp_ilqg/iter_1/u"), Shape({2, 1, 15}));
+  EXPECT_EQ(shape_of(h5, "/first/gp_ilqg/iter_1/K"), Shape({2, 15, 1, 4}));
+  EXPECT_EQ(shape_of(h5, "/first/gp_ilqg/iter_2/predicted_cost"), Shape({2}));
+  EXPECT_EQ(shape_of(h5, "/first/gp_ilqg/gp/theta_dot/hyper"), Shape({3, 2, 7}));
+  EXPECT_EQ(shape_of(h5, "/second/figure1/grid"), Shape({401}));
+  const hsize_t rows = static_cast<hsize_t>(find(r.tasks[1], 0, "gp_ilqg").data.size() +
+                                            find(r.tasks[1], 1, "gp_ilqg").data.size());
+  EXPECT_EQ(shape_of(h5, "/second/data/dx"), Shape({rows, 4}));
+  Matrix normalised(3, 2);
+  {
+    RowMajorMatrix buffer(3, 2);
+    h5.openDataSet("/first/ilqg_real/normalised_cost").read(buffer.data(), H5::PredType::NATIVE_DOUBLE);
+    normalised = buffer;
+  }
+  EXPECT_MATRIX_NEAR(normalised, Matrix::Ones(3, 2), 0.0);
+  h5.close();
+  EXPECT_FALSE(std::filesystem::exists(file.string() + ".tmp-" + std::to_string(::getpid())));
+
+  // The figures come from the file alone (skipped where Debian's matplotlib is missing).
+  if (std::system("/usr/bin/python3 -c 'import matplotlib, h5py' 2>/dev/null") != 0)
+    GTEST_SKIP() << "/usr/bin/python3 lacks matplotlib or h5py";
+  run_plot_script("plot_run.py", file, dir / "figures");
+  for (const char* png : {"first_cost.png", "second_cost.png", "first_controls.png", "first_gp_slice.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "figures" / png)) << png;
+}
+
+TEST(RunCli, RunsFromAConfigFileAndRejectsBadOptions) {
+  const auto dir = test::temporary_dir("run_cli");
+  {
+    std::ofstream(dir / "tiny.toml") << kTinyRun << "[pddp]\n";
+  }
+  // A repeated table is a TOML error: named with its file and line.
+  const auto bad = test::run_cli("run cartpole --config " + (dir / "tiny.toml").string() + " --no-plots");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("tiny.toml:line"), std::string::npos) << bad.err;
+  {
+    std::ofstream(dir / "tiny.toml") << kTinyRun;
+  }
+  const auto ok = test::run_cli("run cartpole --config " + (dir / "tiny.toml").string() + " --iterations 1 --out " +
+                                (dir / "r.h5").string() + " --no-plots");
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "r.h5"));
+  EXPECT_NE(ok.out.find("gp_ilqg"), std::string::npos) << ok.out;
+  EXPECT_NE(ok.err.find("first gp_ilqg iteration 1/1"), std::string::npos) << ok.err;  // progress on stderr
+
+  const auto backends = test::run_cli("run cartpole --backends exact,gpflow --no-plots");
+  EXPECT_EQ(backends.status, 2);
+  EXPECT_NE(backends.err.find("unknown backend 'gpflow'"), std::string::npos) << backends.err;
+  const auto seeds = test::run_cli("run cartpole --seeds 0 --no-plots");
+  EXPECT_EQ(seeds.status, 2);
+  const auto system = test::run_cli("run pendulum");
+  EXPECT_EQ(system.status, 2);
+}
+
+}  // namespace
+}  // namespace gpilqg
