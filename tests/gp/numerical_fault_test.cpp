@@ -94,7 +94,9 @@ TEST_P(NumericalFault, DuplicatedInputsWithoutANoiseFloorGetReportedJitter) {
   const ConditioningReport& report = model->conditioning();
   EXPECT_NE(report.status, FactorStatus::Failed);
   EXPECT_EQ(report.status == FactorStatus::JitterAdded, report.jitter > 0.0);
-  if (GetParam() == "exact") EXPECT_EQ(report.status, FactorStatus::JitterAdded);
+  if (GetParam() == "exact") {
+    EXPECT_EQ(report.status, FactorStatus::JitterAdded);
+  }
   EXPECT_TRUE(std::isfinite(report.negative_log_marginal_likelihood));
   EXPECT_TRUE(predictions_finite(*model, grid(21, -4.0, 4.0)));
 }
