@@ -74,9 +74,7 @@ class MpcController {
 /// if the world diverges (rollout.hpp).
 struct MpcRun {
   Trajectory trajectory;  ///< true states and applied controls
-  /// The task cost of the run (stages plus terminal); of a run that diverged, only the stages completed
-  /// (no terminal cost), so it is not comparable with a completed run's: check `finite` first.
-  double cost = 0.0;
+  double cost = 0.0;      ///< the task cost of the run (stages plus terminal)
   int steps_completed = 0;
   bool finite = true;
   RolloutStatus status = RolloutStatus::Completed;
