@@ -63,12 +63,23 @@ std::string normalised(const std::string& group) {
 
 namespace {
 
+/// Whether the absolute path exists; H5Lexists fails (rather than saying no) when an intermediate
+/// group is missing, so the path is checked one component at a time.
+bool path_exists(const H5::H5File& h5, const std::string& path) {
+  for (std::size_t end = path.find('/', 1);; end = path.find('/', end + 1)) {
+    if (!h5.nameExists(path.substr(0, end))) return false;
+    if (end == std::string::npos) return true;
+  }
+}
+
 /// Writes `model` to `group_path` of the open file, replacing a group of that name.
 void write_fitted_gp(H5::H5File& h5, const std::string& group_path, const FittedGp& model) {
-  if (h5.nameExists(group_path)) h5.unlink(group_path);
+  if (path_exists(h5, group_path)) h5.unlink(group_path);
   H5::LinkCreatPropList intermediate;
   H5Pset_create_intermediate_group(intermediate.getId(), 1);
-  H5::Group group(H5Gcreate2(h5.getId(), group_path.c_str(), intermediate.getId(), H5P_DEFAULT, H5P_DEFAULT));
+  // (Not H5::Group(H5Gcreate2(...)): that constructor takes a second reference to the id, so the group
+  // and with it the file stayed open after close(), unflushed.)
+  H5::Group group = h5.createGroup(group_path, intermediate);
   write_string_attribute(group, "backend", std::string(model.backend_name()));
   write_scalar_attribute(group, "format_version", H5::PredType::STD_I32LE, H5::PredType::NATIVE_INT, kFormatVersion);
   write_scalar_attribute(group, "input_dim", H5::PredType::STD_I32LE, H5::PredType::NATIVE_INT, model.input_dim());
@@ -93,6 +104,7 @@ void edit_atomically(const std::filesystem::path& file, const std::string& objec
         const bool exists = std::filesystem::exists(temporary);
         H5::H5File h5(temporary.c_str(), exists ? H5F_ACC_RDWR : H5F_ACC_EXCL);
         edit(h5);
+        h5.flush(H5F_SCOPE_GLOBAL);
         h5.close();
         return 0;
       });
