@@ -54,11 +54,12 @@ for target in "${targets[@]}"; do
     -timeout=20 -rss_limit_mb=4096 -max_len=16384 -print_final_stats=1 -artifact_prefix="$findings/" >"$log" 2>&1
   code=$?
   set -e
-  runs="$(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$log" | grep -oE '[0-9]+$' | tail -1)"
-  time="$(grep -oE 'Done [0-9]+ runs in [0-9]+ second' "$log" | grep -oE 'in [0-9]+' | grep -oE '[0-9]+' | tail -1)"
-  if [ -n "${upstream[*]}" ]; then  # fork mode: "#RUNS: ... time: Ss"
-    runs="$(grep -oE '^#[0-9]+:' "$log" | tr -d '#:' | tail -1)"
-    time="$(grep -oE 'time: [0-9]+s' "$log" | grep -oE '[0-9]+' | tail -1)"
+  # (|| true: a log without the line leaves the field empty instead of ending the script)
+  runs="$(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$log" | grep -oE '[0-9]+$' | tail -1 || true)"
+  time="$(grep -oE 'Done [0-9]+ runs in [0-9]+ second' "$log" | grep -oE 'in [0-9]+' | grep -oE '[0-9]+' | tail -1 || true)"
+  if [ -n "${upstream[*]}" ]; then  # fork mode: "#RUNS: ... time: Ss" and "INFO: exiting: N time: Ss"
+    runs="$(grep -oE '^#[0-9]+:' "$log" | tr -d '#:' | tail -1 || true)"
+    time="$(grep -oE 'time: [0-9]+s' "$log" | grep -oE '[0-9]+' | tail -1 || true)"
   fi
   units="$(ls "$corpus" | wc -l)"
   found=$(( $(ls "$findings" | wc -l) - before ))
