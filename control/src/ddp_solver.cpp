@@ -162,11 +162,13 @@ double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
         merit += trace_term(ws_.candidate_columns, S_next, ws_.Sc);
       }
     }
-    model_.step(x_out.col(t), u_out.col(t), x_out.col(t + 1));
-    if (!x_out.col(t + 1).allFinite()) {
-      // Diverged: keep the candidate NaN-free (the last finite state repeated) and reject it.
+    const bool control_finite = u_out.col(t).allFinite();
+    if (control_finite) model_.step(x_out.col(t), u_out.col(t), x_out.col(t + 1));
+    if (!control_finite || check_divergence(x_out.col(t + 1)) != RolloutStatus::Completed) {
+      // Diverged (rollout.hpp's test, shared with every rollout): keep the candidate free of NaN and
+      // inf (the last state within the bound repeated, the nominal controls after it) and reject it.
       for (int s = t + 1; s <= T; ++s) x_out.col(s) = x_out.col(t);
-      for (int s = t + 1; s < T; ++s) u_out.col(s) = u_out.col(t);
+      for (int s = t; s < T; ++s) u_out.col(s) = ws_.policy.u_bar.col(s);
       return std::numeric_limits<double>::infinity();
     }
   }
@@ -290,6 +292,8 @@ bool Engine::backward(double lambda) {
       w.llt.solveInPlace(k);
       K = -w.Qux_reg;
       w.llt.solveInPlace(K);
+      // Eigen's LLT reports success on a NaN matrix: non-finite derivatives must fail here too.
+      if (!k.allFinite() || !K.allFinite()) return false;
     } else {
       // Limits on the step: lower - u_bar <= du <= upper - u_bar, warm-started from the previous k.
       w.qp_warm = k;
@@ -307,6 +311,7 @@ bool Engine::backward(double lambda) {
         w.qp.free_factor.solveInPlace(w.free_rows);
         for (Eigen::Index a = 0; a < idx.size(); ++a) K.row(idx(a)) = w.free_rows.row(a);
       }
+      if (!k.allFinite() || !K.allFinite()) return false;
     }
 
     // Value update with the unregularised blocks (Tassa et al. 2012, eq. 11).
@@ -365,12 +370,18 @@ DdpResult Engine::run(const Matrix& initial_controls) {
   w.policy.x_bar.setZero();
   double merit = forward(0.0, w.x_new, w.u_new);
   if (!std::isfinite(merit)) {
+    // The costs of a diverging rollout are +infinity (documented in DdpResult); everything else is
+    // finite: the states reached (the last one repeated) and the clamped initial controls, open loop.
     summary.termination = DdpTermination::InitialRolloutDiverged;
     summary.initial_cost = summary.final_cost = merit;
     summary.timings.total_s = seconds_since(start);
     result.trajectory.x = w.x_new;
     result.trajectory.u = w.u_new;
     result.policy = w.policy;
+    result.policy.x_bar = w.x_new;
+    result.nominal_cost = result.expected_cost = merit;
+    result.value_hessians.assign(static_cast<std::size_t>(T) + 1, Matrix::Zero(n, n));
+    result.gradient = Matrix::Zero(m, T);
     return result;
   }
   w.policy.x_bar = w.x_new;
@@ -475,9 +486,25 @@ DdpResult Engine::run(const Matrix& initial_controls) {
   summary.timings.derivatives_s += seconds_since(t0);
   t0 = Clock::now();
   double final_lambda = 0.0;
-  while (!backward(final_lambda) && final_lambda <= opt_.lambda_max)
+  bool final_ok = backward(final_lambda);
+  while (!final_ok && final_lambda <= opt_.lambda_max) {
     final_lambda = std::max(final_lambda * 10.0, opt_.lambda_min);
+    final_ok = backward(final_lambda);
+  }
   summary.timings.backward_s += seconds_since(t0);
+  if (!final_ok) {
+    // No backward pass works at the returned trajectory (non-finite or hopelessly indefinite
+    // derivatives there): what the failed pass left is partial, so return an open-loop policy, the
+    // nominal cost summed directly, the merit of the last accepted iterate and no value Hessians.
+    for (auto& K : w.policy.K) K.setZero();
+    for (auto& S : w.S) S.setZero();
+    w.gradient.setZero();
+    nominal_cost_ = cost_.terminal(w.policy.x_bar.col(T));
+    for (int t = 0; t < T; ++t) nominal_cost_ += cost_.stage(t, w.policy.x_bar.col(t), w.policy.u_bar.col(t));
+    merit_at_nominal_ = std::max(merit, nominal_cost_);
+    gradient_norm_ = summary.trace.empty() ? 0.0 : summary.trace.back().gradient_norm;
+    summary.final_backward_failed = true;
+  }
   summary.final_gradient_norm = gradient_norm_;
   summary.final_cost = merit_at_nominal_;
 

@@ -71,6 +71,7 @@ MpcRun run_mpc(const StepModel& world, MpcController& controller, const Cost& ta
   run.trajectory = r.trajectory;
   run.steps_completed = r.steps_completed;
   run.finite = r.finite;
+  run.status = r.status;
   run.cost = trajectory_cost(task, run.trajectory);  // a diverged run is scored at its last finite state
   return run;
 }

@@ -6,6 +6,22 @@
 
 namespace gpilqg {
 
+std::string_view to_string(RolloutStatus status) {
+  switch (status) {
+    case RolloutStatus::Completed: return "completed";
+    case RolloutStatus::StateBoundExceeded: return "state_bound_exceeded";
+    case RolloutStatus::NonFiniteState: return "non_finite_state";
+    case RolloutStatus::NonFiniteControl: return "non_finite_control";
+  }
+  return "unknown";
+}
+
+RolloutStatus check_divergence(const VectorCRef& x, double max_magnitude) {
+  if (!x.allFinite()) return RolloutStatus::NonFiniteState;
+  if (x.size() > 0 && x.cwiseAbs().maxCoeff() > max_magnitude) return RolloutStatus::StateBoundExceeded;
+  return RolloutStatus::Completed;
+}
+
 bool sample_step(const StepModel& model, const VectorCRef& x, const VectorCRef& u, RolloutNoise noise,
                  DiffusionColumns& scratch, std::mt19937_64* rng, VectorRef x_next) {
   model.step(x, u, x_next);
@@ -35,12 +51,17 @@ void add_observation_noise(const Vector& std, std::mt19937_64& rng, VectorRef x)
 
 RolloutResult closed_loop_rollout(const StepModel& world, const VectorCRef& x0, int steps,
                                   const Controller& controller, RolloutNoise noise,
-                                  const Vector& observation_std, std::mt19937_64* rng) {
+                                  const Vector& observation_std, std::mt19937_64* rng,
+                                  double max_state_magnitude) {
   const int n = world.state_dim();
   const int m = world.control_dim();
   if (x0.size() != n)
     throw std::invalid_argument("rollout: x0 has " + std::to_string(x0.size()) + " entries; expected " +
                                 std::to_string(n));
+  if (!x0.allFinite()) throw std::invalid_argument("rollout: x0 has non-finite entries; expected a finite state");
+  if (!(max_state_magnitude > 0.0))
+    throw std::invalid_argument("rollout: max_state_magnitude = " + std::to_string(max_state_magnitude) +
+                                "; expected > 0");
   if (steps < 0) throw std::invalid_argument("rollout: steps = " + std::to_string(steps) + "; expected >= 0");
   if (observation_std.size() != 0 && observation_std.size() != n)
     throw std::invalid_argument("rollout: observation_std has " + std::to_string(observation_std.size()) +
@@ -59,9 +80,17 @@ RolloutResult closed_loop_rollout(const StepModel& world, const VectorCRef& x0, 
     if (observation_std.size() != 0) add_observation_noise(observation_std, *rng, observed);
     auto u = result.trajectory.u.col(t);
     controller(t, observed, u);
-    if (!sample_step(world, x, u, noise, scratch, rng, next)) {
-      // Diverged: keep the result NaN-free (the last finite state repeated) and say so.
+    RolloutStatus status = u.allFinite() ? RolloutStatus::Completed : RolloutStatus::NonFiniteControl;
+    if (status == RolloutStatus::Completed) {
+      sample_step(world, x, u, noise, scratch, rng, next);
+      status = check_divergence(next, max_state_magnitude);
+    }
+    if (status != RolloutStatus::Completed) {
+      // Diverged: stop, keep the result free of NaN and inf (the last state within the bound
+      // repeated, controls not applied zero) and say why.
       result.finite = false;
+      result.status = status;
+      if (status == RolloutStatus::NonFiniteControl) u.setZero();
       for (int s = t + 1; s <= steps; ++s) result.trajectory.x.col(s) = x;
       return result;
     }

@@ -4,15 +4,14 @@
 #include "gpilqg/core/measurements.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <set>
 #include <stdexcept>
-#include <system_error>
 
+#include "gpilqg/core/atomic_file.hpp"
 #include "measurements_internal.hpp"
 
 namespace gpilqg {
@@ -167,27 +166,13 @@ void check_writable(const MeasurementSet& set) {
   }
 }
 
-std::filesystem::path temporary_path_for(const std::filesystem::path& file) {
-  std::filesystem::path temporary = file;
-  temporary += fmt::format(".tmp-{}", static_cast<long>(::getpid()));
-  return temporary;
-}
-
-void commit_temporary(const std::filesystem::path& temporary, const std::filesystem::path& file) {
-  std::error_code error;
-  std::filesystem::rename(temporary, file, error);
-  if (error) {
-    discard_temporary(temporary);
-    throw DataError(
-        file, "",
-        "cannot rename the temporary file " + temporary.string() + " into place (" + error.message() + ")",
-        "a writable destination");
+void write_via_temporary(const std::filesystem::path& file,
+                         const std::function<void(const std::filesystem::path& temporary)>& write) {
+  try {
+    write_atomically(file, write);
+  } catch (const AtomicWriteError& e) {
+    throw DataError(file, "", e.problem());
   }
-}
-
-void discard_temporary(const std::filesystem::path& temporary) noexcept {
-  std::error_code ignored;
-  std::filesystem::remove(temporary, ignored);
 }
 
 }  // namespace measurements_detail

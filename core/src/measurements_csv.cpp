@@ -97,8 +97,7 @@ class CsvReader {
         n_(system.states.size()),
         m_(system.controls.size()) {}
 
-  MeasurementSet read() {
-    const std::string text = read_whole_file(file_);
+  MeasurementSet read(std::string_view text) {
     std::string_view view = text;
     constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
     if (view.substr(0, kByteOrderMark.size()) == kByteOrderMark) view.remove_prefix(kByteOrderMark.size());
@@ -262,7 +261,12 @@ class CsvReader {
 }  // namespace
 
 MeasurementSet read_measurements_csv(const std::filesystem::path& file, const SystemSignature& system) {
-  return CsvReader(file, system).read();
+  return CsvReader(file, system).read(read_whole_file(file));
+}
+
+MeasurementSet parse_measurements_csv(std::string_view text, const std::filesystem::path& file,
+                                      const SystemSignature& system) {
+  return CsvReader(file, system).read(text);
 }
 
 void write_measurements_csv(const std::filesystem::path& file, const MeasurementSet& set) {

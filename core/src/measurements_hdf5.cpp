@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 
 #include "gpilqg/core/measurements.hpp"
 #include "measurements_internal.hpp"
@@ -86,6 +87,7 @@ class Hdf5Reader {
     const bool is_hdf5 = guarded(file_, "", "opening the file", "a readable HDF5 file",
                                  [&] { return H5::H5File::isHdf5(file_.c_str()); });
     if (!is_hdf5) throw DataError(file_, "", "not an HDF5 file", "an HDF5 file (a CSV file must end in .csv)");
+    file_size_ = std::filesystem::file_size(file_, error);
     h5_ = guarded(file_, "", "opening the file", "a readable HDF5 file",
                   [&] { return H5::H5File(file_.c_str(), H5F_ACC_RDONLY); });
   }
@@ -108,6 +110,8 @@ class Hdf5Reader {
         throw DataError(file_, location, fmt::format("has rank {}, not a 1-D array of strings", rank),
                         expected);
       const auto count = static_cast<std::size_t>(space.getSimpleExtentNpoints());
+      if (scalar && count != 1)
+        throw DataError(file_, location, "holds no value (an empty dataspace), not a single string", expected);
       const H5::StrType type = attribute.getStrType();
       std::vector<std::string> strings;
       if (type.isVariableStr()) {
@@ -211,6 +215,14 @@ class Hdf5Reader {
         if (rank > 2) shape = fmt::format("rank {}", rank);
         throw DataError(file_, location, "has " + shape, expected);
       }
+      // A damaged file can declare any extent: refuse more values than its bytes could hold (deflate
+      // expands at most about 1032:1) instead of failing in the allocation with std::bad_alloc.
+      const double declared = static_cast<double>(dims[0]) * static_cast<double>(rank == 2 ? dims[1] : 1);
+      const double capacity = 1100.0 * static_cast<double>(std::max<std::uintmax_t>(file_size_, 1u << 20)) / 8.0;
+      if (declared > capacity)
+        throw DataError(file_, location,
+                        fmt::format("declares {} values, more than a file of {} bytes can hold", declared, file_size_),
+                        expected);
       RowMajor values(found_rows, cols < 0 ? 1 : cols);
       if (values.size() > 0) data.read(values.data(), H5::PredType::NATIVE_DOUBLE);
       return values;
@@ -265,6 +277,7 @@ class Hdf5Reader {
   const std::filesystem::path& file_;
   const SystemSignature& system_;
   H5::H5File h5_;
+  std::uintmax_t file_size_ = 0;
 };
 
 H5::StrType variable_string_type() {

@@ -1,9 +1,10 @@
 #pragma once
 /// @file measurements_internal.hpp
 /// Pieces shared by the CSV and HDF5 readers and writers of measurement data (private to core):
-/// the checks of one episode's values, the expected column names, and the temporary-file dance.
+/// the checks of one episode's values, the expected column names, and atomic writing.
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,29 +53,11 @@ std::string format_number(double value);
 /// file that the readers would reject.
 void check_writable(const MeasurementSet& set);
 
-/// Writes a file safely: `write` fills "<file>.tmp-<pid>", which is then renamed onto `file`; on any
-/// exception the temporary file is removed and the exception propagates. A failed rename is a
-/// DataError naming `file`.
-template <class WriteFunction>
-void write_via_temporary(const std::filesystem::path& file, WriteFunction&& write);
-
-/// The temporary path used by write_via_temporary: "<file>.tmp-<pid>".
-std::filesystem::path temporary_path_for(const std::filesystem::path& file);
-/// Renames `temporary` onto `file` (removing `temporary` and throwing DataError on failure).
-void commit_temporary(const std::filesystem::path& temporary, const std::filesystem::path& file);
-/// Removes `temporary` if it exists, ignoring errors (cleanup after a failed write).
-void discard_temporary(const std::filesystem::path& temporary) noexcept;
-
-template <class WriteFunction>
-void write_via_temporary(const std::filesystem::path& file, WriteFunction&& write) {
-  const std::filesystem::path temporary = temporary_path_for(file);
-  try {
-    write(temporary);
-  } catch (...) {
-    discard_temporary(temporary);
-    throw;
-  }
-  commit_temporary(temporary, file);
-}
+/// Writes `file` through write_atomically (atomic_file.hpp): `write` fills a temporary file beside it,
+/// which is flushed and renamed onto `file`; on any exception the temporary file is removed, the
+/// previous `file` is left as it was and the exception propagates. A failure of the atomic-write
+/// machinery (e.g. `file` is a folder) is a DataError naming `file`.
+void write_via_temporary(const std::filesystem::path& file,
+                         const std::function<void(const std::filesystem::path& temporary)>& write);
 
 }  // namespace gpilqg::measurements_detail

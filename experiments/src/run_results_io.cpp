@@ -2,10 +2,10 @@
 
 #include <chrono>
 #include <ctime>
-#include <unistd.h>
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
 #include "gpilqg/core/systems.hpp"
 
@@ -216,16 +216,7 @@ void write_file(const std::filesystem::path& file, const RunResults& results) {
 }  // namespace
 
 void write_run_results(const std::filesystem::path& file, const RunResults& results) {
-  std::filesystem::path temporary = file;
-  temporary += fmt::format(".tmp-{}", static_cast<long>(::getpid()));
-  try {
-    write_file(temporary, results);
-    std::filesystem::rename(temporary, file);
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw;
-  }
+  write_atomically(file, [&](const std::filesystem::path& temporary) { write_file(temporary, results); });
 }
 
 }  // namespace gpilqg

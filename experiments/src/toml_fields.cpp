@@ -131,6 +131,12 @@ long TomlFields::integer(const std::string& path, std::optional<long> fallback) 
   fail(path, "is not an integer");
 }
 
+int TomlFields::integer_in(const std::string& path, int min, int max, std::optional<int> fallback) const {
+  const long value = integer(path, fallback);
+  if (value < min || value > max) fail(path, fmt::format("is {}; expected an integer from {} to {}", value, min, max));
+  return static_cast<int>(value);
+}
+
 Vector TomlFields::vector(const std::string& path, int size, std::optional<Vector> fallback) const {
   const toml::node* node = find(path);
   if (node == nullptr) {

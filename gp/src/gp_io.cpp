@@ -1,8 +1,11 @@
 #include "gpilqg/gp/gp_io.hpp"
 
+#include "gpilqg/core/atomic_file.hpp"
+
 #include <H5Cpp.h>
 
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -58,28 +61,65 @@ std::string normalised(const std::string& group) {
 
 }  // namespace
 
+namespace {
+
+/// Whether the absolute path exists; H5Lexists fails (rather than saying no) when an intermediate
+/// group is missing, so the path is checked one component at a time.
+bool path_exists(const H5::H5File& h5, const std::string& path) {
+  for (std::size_t end = path.find('/', 1);; end = path.find('/', end + 1)) {
+    if (!h5.nameExists(path.substr(0, end))) return false;
+    if (end == std::string::npos) return true;
+  }
+}
+
+/// Writes `model` to `group_path` of the open file, replacing a group of that name.
+void write_fitted_gp(H5::H5File& h5, const std::string& group_path, const FittedGp& model) {
+  if (path_exists(h5, group_path)) h5.unlink(group_path);
+  H5::LinkCreatPropList intermediate;
+  H5Pset_create_intermediate_group(intermediate.getId(), 1);
+  // (Not H5::Group(H5Gcreate2(...)): that constructor takes a second reference to the id, so the group
+  // and with it the file stayed open after close(), unflushed.)
+  H5::Group group = h5.createGroup(group_path, intermediate);
+  write_string_attribute(group, "backend", std::string(model.backend_name()));
+  write_scalar_attribute(group, "format_version", H5::PredType::STD_I32LE, H5::PredType::NATIVE_INT, kFormatVersion);
+  write_scalar_attribute(group, "input_dim", H5::PredType::STD_I32LE, H5::PredType::NATIVE_INT, model.input_dim());
+  write_scalar_attribute(group, "jitter", H5::PredType::IEEE_F64LE, H5::PredType::NATIVE_DOUBLE,
+                         model.conditioning().jitter);
+  write_scalar_attribute(group, "negative_log_marginal_likelihood", H5::PredType::IEEE_F64LE,
+                         H5::PredType::NATIVE_DOUBLE, model.negative_log_marginal_likelihood());
+  write_dataset(group, "parameters", model.parameters().transpose(), true);
+  write_dataset(group, "inputs", model.training_set().inputs, false);
+  write_dataset(group, "targets", model.training_set().targets.transpose(), true);
+}
+
+/// Runs `edit` on `file` opened for writing (created when missing) as one atomic update: the edit
+/// happens on a copy that replaces `file` only when it succeeded (atomic_file.hpp), so a failure
+/// half-way never leaves a damaged file behind.
+void edit_atomically(const std::filesystem::path& file, const std::string& object, const std::string& what,
+                     const std::function<void(H5::H5File&)>& edit) {
+  H5::Exception::dontPrint();
+  try {
+    update_atomically(file, [&](const std::filesystem::path& temporary) {
+      guarded(file, object, what, [&] {
+        const bool exists = std::filesystem::exists(temporary);
+        H5::H5File h5(temporary.c_str(), exists ? H5F_ACC_RDWR : H5F_ACC_EXCL);
+        edit(h5);
+        h5.flush(H5F_SCOPE_GLOBAL);
+        h5.close();
+        return 0;
+      });
+    });
+  } catch (const AtomicWriteError& e) {
+    throw std::runtime_error(where(file, object) + ": " + what + " failed: " + e.problem());
+  }
+}
+
+}  // namespace
+
 void save_fitted_gp(const std::filesystem::path& file, const std::string& group_name, const FittedGp& model) {
   const std::string group_path = normalised(group_name);
-  H5::Exception::dontPrint();
-  guarded(file, group_path, "writing the fitted GP", [&] {
-    const bool exists = std::filesystem::exists(file);
-    H5::H5File h5(file.c_str(), exists ? H5F_ACC_RDWR : H5F_ACC_TRUNC);
-    if (exists && h5.nameExists(group_path)) h5.unlink(group_path);
-    H5::LinkCreatPropList intermediate;
-    H5Pset_create_intermediate_group(intermediate.getId(), 1);
-    H5::Group group(H5Gcreate2(h5.getId(), group_path.c_str(), intermediate.getId(), H5P_DEFAULT, H5P_DEFAULT));
-    write_string_attribute(group, "backend", std::string(model.backend_name()));
-    write_scalar_attribute(group, "format_version", H5::PredType::STD_I32LE, H5::PredType::NATIVE_INT, kFormatVersion);
-    write_scalar_attribute(group, "input_dim", H5::PredType::STD_I32LE, H5::PredType::NATIVE_INT, model.input_dim());
-    write_scalar_attribute(group, "jitter", H5::PredType::IEEE_F64LE, H5::PredType::NATIVE_DOUBLE,
-                           model.conditioning().jitter);
-    write_scalar_attribute(group, "negative_log_marginal_likelihood", H5::PredType::IEEE_F64LE,
-                           H5::PredType::NATIVE_DOUBLE, model.negative_log_marginal_likelihood());
-    write_dataset(group, "parameters", model.parameters().transpose(), true);
-    write_dataset(group, "inputs", model.training_set().inputs, false);
-    write_dataset(group, "targets", model.training_set().targets.transpose(), true);
-    return 0;
-  });
+  edit_atomically(file, group_path, "writing the fitted GP",
+                  [&](H5::H5File& h5) { write_fitted_gp(h5, group_path, model); });
 }
 
 std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, const std::string& group_name,
@@ -144,10 +184,9 @@ std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, cons
 
 void save_residual_model(const std::filesystem::path& file, const std::string& group_name, const ResidualModel& model) {
   const std::string group_path = normalised(group_name);
-  for (int i = 0; i < model.state_dim(); ++i) save_fitted_gp(file, group_path + "/" + std::to_string(i), model.output(i));
-  H5::Exception::dontPrint();
-  guarded(file, group_path, "writing the residual model's attributes", [&] {
-    H5::H5File h5(file.c_str(), H5F_ACC_RDWR);
+  edit_atomically(file, group_path, "writing the residual model", [&](H5::H5File& h5) {
+    for (int i = 0; i < model.state_dim(); ++i)
+      write_fitted_gp(h5, group_path + "/" + std::to_string(i), model.output(i));
     H5::Group group = h5.openGroup(group_path);
     for (const char* name : {"state_dim", "control_dim", "dt"})
       if (group.attrExists(name)) group.removeAttr(name);
@@ -155,7 +194,6 @@ void save_residual_model(const std::filesystem::path& file, const std::string& g
     write_scalar_attribute(group, "control_dim", H5::PredType::STD_I32LE, H5::PredType::NATIVE_INT,
                            model.control_dim());
     write_scalar_attribute(group, "dt", H5::PredType::IEEE_F64LE, H5::PredType::NATIVE_DOUBLE, model.dt());
-    return 0;
   });
 }
 

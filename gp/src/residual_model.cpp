@@ -103,7 +103,7 @@ ResidualModel ResidualModel::fit(SimulatorPtr simulator, const ResidualData& dat
   r.outputs.resize(static_cast<std::size_t>(n));
   if (validation != nullptr) r.resampling.resize(static_cast<std::size_t>(n));
 
-  run_parallel(n, options.threads, [&](int i) {
+  const auto fit_output = [&](int i) {
     const auto index = static_cast<std::size_t>(i);
     FitOptions fit_options = options.fit;
     // Warm start from the previous learner of the same backend (the GP-ILQG loop refits every iteration).
@@ -123,6 +123,16 @@ ResidualModel ResidualModel::fit(SimulatorPtr simulator, const ResidualData& dat
     }
     r.outputs[index] = result.summary;
     outputs[index] = std::move(result.model);
+  };
+  run_parallel(n, options.threads, [&](int i) {
+    try {
+      fit_output(i);
+    } catch (const std::invalid_argument& e) {
+      // Name the output: degenerate data (e.g. constant residuals of a state the simulator predicts
+      // exactly) is a property of one state, not of the whole data set.
+      throw std::invalid_argument("ResidualModel::fit: state " + std::to_string(i) + " of " + std::to_string(n) +
+                                  ": " + e.what());
+    }
   });
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return ResidualModel(std::move(simulator), std::move(outputs));

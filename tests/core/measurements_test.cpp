@@ -499,6 +499,24 @@ const std::vector<BadHdf5Case> kBadHdf5Cases = {
            .write(values, H5::PredType::NATIVE_INT);
      },
      {":/episodes/2/t: does not hold floating-point numbers"}},
+    // A damaged or hostile file can declare any extent (chunked, nothing stored): refused before the
+    // reader allocates 8e11 doubles.
+    {"extent_beyond_the_file",
+     [](H5::H5File& h5) {
+       h5.unlink("/episodes/2/t");
+       const hsize_t dims[1] = {800'000'000'000ull}, chunk[1] = {1024};
+       H5::DSetCreatPropList properties;
+       properties.setChunk(1, chunk);
+       h5.createDataSet("/episodes/2/t", H5::PredType::IEEE_F64LE, H5::DataSpace(1, dims), properties);
+     },
+     {":/episodes/2/t: declares 800000000000 values, more than a file of "}},
+    {"system_attribute_without_value",
+     [](H5::H5File& h5) {
+       H5::Group root = h5.openGroup("/");
+       root.removeAttr("system");
+       root.createAttribute("system", H5::StrType(H5::PredType::C_S1, H5T_VARIABLE), H5::DataSpace(H5S_NULL));
+     },
+     {":attribute 'system': "}},
 };
 
 class BadHdf5 : public ::testing::TestWithParam<BadHdf5Case> {};

@@ -80,7 +80,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadConfig{"missing_field", "Qf = [100, 100, 1000, 100]", "", "field 'problem.Qf': missing"},
         BadConfig{"limits_crossed", "Qf = [100, 100, 1000, 100]", "Qf = [100, 100, 1000, 100]\nu_min = [3]\nu_max = [2]",
                   "field 'problem.u_min': exceeds problem.u_max"},
-        BadConfig{"bad_solver_option", "max_iterations = 1000", "max_iterations = 0", "max_iterations"}),
+        BadConfig{"bad_solver_option", "max_iterations = 1000", "max_iterations = 0", "max_iterations"},
+        // Integers beyond an int were once cut to it: 4294967297 became a horizon of 1.
+        BadConfig{"horizon_beyond_int", "horizon = 100", "horizon = 4294967297",
+                  "field 'problem.horizon': is 4294967297; expected an integer from 1 to 1000000"},
+        BadConfig{"huge_iterations", "max_iterations = 1000", "max_iterations = 9223372036854775807",
+                  "field 'solver.max_iterations': is 9223372036854775807; expected an integer from 1 to"},
+        BadConfig{"huge_substeps", "dt = 0.05", "dt = 0.05\nsubsteps = -4294967295",
+                  "field 'system.substeps': is -4294967295; expected an integer from 1 to 10000"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(SolveCommand, AMissingFileIsBadInput) {

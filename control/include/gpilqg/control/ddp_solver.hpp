@@ -40,7 +40,11 @@ struct DdpResult {
   Trajectory trajectory;   ///< the optimised nominal trajectory
   AffinePolicy policy;     ///< feedback around it (k = 0), clamped to the problem's limits
   DdpSummary summary;
-  double nominal_cost = 0.0;    ///< l_T(x_T) + sum_t l_t(x_t, u_t) along the nominal trajectory
+  /// l_T(x_T) + sum_t l_t(x_t, u_t) along the nominal trajectory. +infinity (as is expected_cost) when
+  /// summary.termination == InitialRolloutDiverged: the initial controls drive the model beyond the
+  /// divergence bound of rollout.hpp; the trajectory then holds the states reached, the last one
+  /// repeated. Nothing in a result is ever NaN.
+  double nominal_cost = 0.0;
   double expected_cost = 0.0;   ///< nominal_cost plus the trace terms: the predicted E[J] of the policy
   std::vector<Matrix> value_hessians;  ///< S_t = V_xx at t = 0..T along the returned trajectory
   /// dM/du_t (m x T) at the returned trajectory, M the merit with S = value_hessians held fixed:

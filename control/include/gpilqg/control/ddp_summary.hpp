@@ -47,6 +47,10 @@ struct DdpSummary {
   double initial_cost = 0.0;
   double final_cost = 0.0;         ///< the merit at the returned trajectory
   double final_gradient_norm = 0.0;
+  /// True when no backward pass (lambda from 0 to lambda_max) succeeded at the returned trajectory:
+  /// the result's policy is then open loop (K = 0), its value Hessians and gradient are zero and its
+  /// expected cost is the last accepted merit. Only after termination RegularizationLimit.
+  bool final_backward_failed = false;
   std::vector<DdpIteration> trace;
   DdpTimings timings;
 

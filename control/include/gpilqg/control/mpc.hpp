@@ -70,12 +70,14 @@ class MpcController {
 };
 
 /// Closed-loop MPC on `world` for `steps` task steps from x0, sampling the world's noise (and
-/// observation noise) as in rollout_policy. Stops early, with finite = false, if the world diverges.
+/// observation noise) as in rollout_policy. Stops early, with finite = false and `status` saying why,
+/// if the world diverges (rollout.hpp).
 struct MpcRun {
   Trajectory trajectory;  ///< true states and applied controls
   double cost = 0.0;      ///< the task cost of the run (stages plus terminal)
   int steps_completed = 0;
   bool finite = true;
+  RolloutStatus status = RolloutStatus::Completed;
   double solve_seconds = 0.0;  ///< total time spent in the solver
 };
 MpcRun run_mpc(const StepModel& world, MpcController& controller, const Cost& task, const VectorCRef& x0,

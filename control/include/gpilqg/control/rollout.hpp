@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <random>
+#include <string_view>
 
 #include "gpilqg/control/trajectory.hpp"
 #include "gpilqg/core/step_model.hpp"
@@ -21,15 +22,37 @@ enum class RolloutNoise {
   UncertaintyOnly,         ///< the model-uncertainty columns G alone
 };
 
+/// How a rollout ended. Every rollout in the project (open loop, policy, MPC, synthetic data) runs
+/// through closed_loop_rollout and so through the same divergence test (check_divergence).
+enum class RolloutStatus {
+  Completed,           ///< every step was taken
+  StateBoundExceeded,  ///< a state entry exceeded the bound (default kDivergedStateMagnitude): diverging
+  NonFiniteState,      ///< a step produced NaN or inf (the model overflowed within one step)
+  NonFiniteControl,    ///< the controller returned NaN or inf (e.g. huge gains on a large state)
+};
+std::string_view to_string(RolloutStatus status);
+
+/// The bound on |x_i| beyond which a rollout counts as diverged: far above any physical state of the
+/// systems here, and far enough below overflow that quadratic costs of the states stay finite
+/// (1e12 squared is 1e24), so a diverging rollout is stopped before it poisons costs with inf or NaN.
+inline constexpr double kDivergedStateMagnitude = 1e12;
+
+/// The one divergence test: NonFiniteState when an entry of x is NaN or inf, StateBoundExceeded when
+/// some |x_i| > max_magnitude, else Completed (meaning "fine").
+RolloutStatus check_divergence(const VectorCRef& x, double max_magnitude = kDivergedStateMagnitude);
+
 /// Rolls `model` out from x0 under the controls u (m x T). `rng` must be non-null unless
-/// noise == None. Throws std::invalid_argument when sizes do not match the model. When a state becomes
-/// non-finite (a diverging rollout) it stops with finite = false: the states reached so far are kept,
-/// the remaining columns repeat the last finite state (so no NaN is ever returned), and
-/// `steps_completed` tells how far it went.
+/// noise == None. Throws std::invalid_argument when sizes do not match the model. When the rollout
+/// diverges (RolloutStatus) it stops with finite = false and the status says why: the states reached
+/// so far are kept, the remaining state columns repeat the last state within the bound, the controls
+/// after the stop are zero and a non-finite control is replaced by zero (so no NaN or inf is ever
+/// returned), and `steps_completed` tells how far it went: x(:, 0..steps_completed) were reached under
+/// u(:, 0..steps_completed-1).
 struct RolloutResult {
   Trajectory trajectory;
   int steps_completed = 0;
-  bool finite = true;
+  bool finite = true;  ///< status == Completed
+  RolloutStatus status = RolloutStatus::Completed;
 };
 
 RolloutResult rollout(const StepModel& model, const VectorCRef& x0, const Matrix& u,
@@ -41,10 +64,12 @@ using Controller = std::function<void(int t, const VectorCRef& observed, VectorR
 /// The one closed-loop simulation loop of the project (open-loop rollouts, policy rollouts and MPC
 /// all run through it): at each step the controller sees x_t plus N(0, diag(observation_std^2))
 /// (no noise when empty), chooses u_t, and sample_step draws x_{t+1}. Divergence is handled as in
-/// rollout(). `rng` may be null only when there is no noise of either kind.
+/// rollout(), with `max_state_magnitude` the bound of check_divergence. `rng` may be null only when
+/// there is no noise of either kind. Throws std::invalid_argument for a non-finite x0 or a bound <= 0.
 RolloutResult closed_loop_rollout(const StepModel& world, const VectorCRef& x0, int steps,
                                   const Controller& controller, RolloutNoise noise,
-                                  const Vector& observation_std, std::mt19937_64* rng);
+                                  const Vector& observation_std, std::mt19937_64* rng,
+                                  double max_state_magnitude = kDivergedStateMagnitude);
 
 /// One sampled step, the shared mechanism of every simulated rollout in the project:
 ///   x' = phi(x, u) [+ sqrt(dt) F(x, u) xi] [+ sqrt(dt) G(x, u) xi_G]

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gpilqg/core/quantity.hpp"
@@ -67,6 +68,11 @@ class DataError : public std::runtime_error {
 /// error, and fields are never trimmed (" 0.1" and "+0.1" are unparsable). Episodes keep file order.
 MeasurementSet read_measurements_csv(const std::filesystem::path& file, const SystemSignature& system);
 
+/// The same reader on CSV text already in memory (e.g. received over a pipe); `file` only names the
+/// source in the DataError messages.
+MeasurementSet parse_measurements_csv(std::string_view text, const std::filesystem::path& file,
+                                      const SystemSignature& system);
+
 /// Reads and validates an HDF5 measurement file: same checks, naming the dataset or attribute
 /// (e.g. "/episodes/3/x", "attribute 'state_names'"), plus missing groups, datasets or attributes,
 /// wrong shapes or types, a `system` attribute that differs from `system`, no episodes, and group
@@ -80,12 +86,13 @@ MeasurementSet read_measurements_hdf5(const std::filesystem::path& file, const S
 MeasurementSet read_measurements(const std::filesystem::path& file, const SystemSignature& system);
 
 /// Writes CSV with every number in its shortest round-trip form, so reading it back gives the same
-/// doubles bit for bit. Written to "<file>.tmp-<pid>" and renamed into place. Both writers first
+/// doubles bit for bit. Written atomically (atomic_file.hpp): a temporary file beside `file`, flushed
+/// and renamed into place, so a failed write leaves any previous `file` untouched. Both writers first
 /// check the set (shapes, finite values, distinct non-negative ids, valid times) and throw
 /// std::invalid_argument rather than write a file the readers would reject.
 void write_measurements_csv(const std::filesystem::path& file, const MeasurementSet& set);
 /// Writes HDF5 in the layout above (float64, variable-length UTF-8 strings), group names /episodes/<id>.
-/// Written to a temporary file and renamed into place.
+/// Written atomically like the CSV.
 void write_measurements_hdf5(const std::filesystem::path& file, const MeasurementSet& set);
 /// Chooses the writer by extension like read_measurements.
 void write_measurements(const std::filesystem::path& file, const MeasurementSet& set);

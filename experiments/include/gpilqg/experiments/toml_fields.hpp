@@ -37,6 +37,9 @@ class TomlFields {
   std::string string(const std::string& path, std::optional<std::string> fallback = std::nullopt) const;
   double number(const std::string& path, std::optional<double> fallback = std::nullopt) const;
   long integer(const std::string& path, std::optional<long> fallback = std::nullopt) const;
+  /// An integer within [min, max], as int (min and max must fit an int): a value outside fails naming
+  /// the field and the range, instead of being cut to an int.
+  int integer_in(const std::string& path, int min, int max, std::optional<int> fallback = std::nullopt) const;
   /// An array of numbers; `size` >= 0 requires that many entries.
   Vector vector(const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) const;
   bool has(const std::string& path) const;

@@ -21,7 +21,10 @@
 namespace gpilqg::gp {
 
 /// Writes `model` to group `group` of `file`, creating the file and intermediate groups when missing
-/// and replacing an existing group of that name. Throws std::runtime_error naming the file on failure.
+/// and replacing an existing group of that name; other objects of an existing file are kept. The edit
+/// is atomic (atomic_file.hpp, update_atomically): it happens on a copy that is renamed onto `file`
+/// only when complete, so a failure leaves `file` as it was. Throws std::runtime_error naming the
+/// file on failure.
 void save_fitted_gp(const std::filesystem::path& file, const std::string& group, const FittedGp& model);
 
 /// Reads group `group` of `file` and conditions `backend` on it. Throws std::runtime_error naming the
@@ -31,8 +34,8 @@ std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, cons
                                          const GpBackend& backend);
 
 /// Writes the GP of every state of a residual model to `<group>/<i>` (i = 0 .. n-1) in the layout
-/// above, plus the attributes `state_dim`, `control_dim` and `dt` on `group`. The simulator is code
-/// and is not saved.
+/// above, plus the attributes `state_dim`, `control_dim` and `dt` on `group`, as one atomic edit of
+/// `file` like save_fitted_gp. The simulator is code and is not saved.
 void save_residual_model(const std::filesystem::path& file, const std::string& group, const ResidualModel& model);
 
 /// Reads what save_residual_model wrote and rebuilds the model around `simulator` with `backend`.
