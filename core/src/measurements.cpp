@@ -167,6 +167,8 @@ void check_writable(const MeasurementSet& set) {
   }
 }
 
+}  // namespace measurements_detail
+
 std::filesystem::path temporary_path_for(const std::filesystem::path& file) {
   std::filesystem::path temporary = file;
   temporary += fmt::format(".tmp-{}", static_cast<long>(::getpid()));
@@ -189,8 +191,6 @@ void discard_temporary(const std::filesystem::path& temporary) noexcept {
   std::error_code ignored;
   std::filesystem::remove(temporary, ignored);
 }
-
-}  // namespace measurements_detail
 
 namespace {
 

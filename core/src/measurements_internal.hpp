@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 
 namespace gpilqg::measurements_detail {
@@ -52,29 +53,11 @@ std::string format_number(double value);
 /// file that the readers would reject.
 void check_writable(const MeasurementSet& set);
 
-/// Writes a file safely: `write` fills "<file>.tmp-<pid>", which is then renamed onto `file`; on any
-/// exception the temporary file is removed and the exception propagates. A failed rename is a
-/// DataError naming `file`.
-template <class WriteFunction>
-void write_via_temporary(const std::filesystem::path& file, WriteFunction&& write);
-
-/// The temporary path used by write_via_temporary: "<file>.tmp-<pid>".
-std::filesystem::path temporary_path_for(const std::filesystem::path& file);
-/// Renames `temporary` onto `file` (removing `temporary` and throwing DataError on failure).
-void commit_temporary(const std::filesystem::path& temporary, const std::filesystem::path& file);
-/// Removes `temporary` if it exists, ignoring errors (cleanup after a failed write).
-void discard_temporary(const std::filesystem::path& temporary) noexcept;
-
+/// Writes a file safely through a temporary file (atomic_file.hpp); a failed rename is a DataError
+/// naming `file`.
 template <class WriteFunction>
 void write_via_temporary(const std::filesystem::path& file, WriteFunction&& write) {
-  const std::filesystem::path temporary = temporary_path_for(file);
-  try {
-    write(temporary);
-  } catch (...) {
-    discard_temporary(temporary);
-    throw;
-  }
-  commit_temporary(temporary, file);
+  write_atomically(file, std::forward<WriteFunction>(write));
 }
 
 }  // namespace gpilqg::measurements_detail
