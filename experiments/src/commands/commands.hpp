@@ -21,4 +21,7 @@ void add_solve_command(CLI::App& app, CommandAction& action);
 /// `gpilqg simulate --system NAME --out FILE [...]`
 void add_simulate_command(CLI::App& app, CommandAction& action);
 
+/// `gpilqg diagnose --system NAME --data FILE [--model F.toml] [--add EFFECT[=VALUE]]... [...]`
+void add_diagnose_command(CLI::App& app, CommandAction& action);
+
 }  // namespace gpilqg::cli
