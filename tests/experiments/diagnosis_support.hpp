@@ -10,16 +10,16 @@
 
 namespace gpilqg::test {
 
-/// Small data sets keep the tests fast: 8 episodes of 150 samples (cart-pole) or 10 of 80 (quadrotor),
-/// observation noise 1e-3 on every state, additive actuator noise.
+/// Small data sets keep the tests fast: 7 episodes of 120 samples (cart-pole) or 8 of 70 (quadrotor),
+/// observation noise 1e-3 on every state (default_excitation), additive actuator noise.
 inline MeasurementSet hidden_effect_data(const DynamicsPtr& world, std::uint64_t seed) {
   ExcitationSettings settings = default_excitation(*world);
   if (world->name() == "cartpole") {
-    settings.episodes = 8;
-    settings.steps = 150;
+    settings.episodes = 7;
+    settings.steps = 120;
   } else {
-    settings.episodes = 10;
-    settings.steps = 80;
+    settings.episodes = 8;
+    settings.steps = 70;
   }
   settings.seed = seed;
   return simulate_measurements(world, settings).set;
@@ -35,8 +35,8 @@ inline ActuatorNoise actuator_noise(int controls, double std) {
 inline diagnosis::DiagnosisOptions fast_options(const std::string& system) {
   diagnosis::DiagnosisOptions o;
   o.model.system = system;
-  o.gp.points = 150;
-  o.gp.restarts = 1;
+  o.gp.points = system == "cartpole" ? 100 : 60;
+  o.gp.restarts = 0;
   o.gp.threads = 1;
   return o;
 }

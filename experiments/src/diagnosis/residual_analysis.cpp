@@ -176,7 +176,7 @@ Vector autocorrelation(const Vector& a, const std::vector<int>& episode, int max
 CrossCorrelation cross_correlation(const Transitions& data, const Matrix& residual, int max_lag) {
   const auto n = static_cast<int>(residual.cols());
   const auto m = static_cast<int>(data.u.cols());
-  const auto N = static_cast<double>(data.size());
+  const auto N = static_cast<double>(residual.rows());
   CrossCorrelation out;
   out.max_lag = max_lag;
   out.values.assign(static_cast<std::size_t>(n), std::vector<Vector>(static_cast<std::size_t>(m)));
