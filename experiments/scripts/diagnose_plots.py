@@ -113,11 +113,12 @@ def ranking(f, out):
 
 
 def residual_vs_input(f, out, states, inputs, shown):
-    relevance = f["where/relevance"][()]
+    has_add = "add" in f
+    relevance = f["add/relevance_before"][()] if has_add else f["where/relevance"][()]
     z = np.hstack([f["data/x"][()], f["data/u"][()]])
-    before = f["compare/residual"][()]
-    after = f["add/residual_after"][()] if "add" in f else None
-    effect = text(f["add"].attrs["effect"]) if "add" in f else None
+    before = f["add/residual_before"][()] if has_add else f["compare/residual"][()]
+    after = f["add/residual_after"][()] if has_add else None
+    effect = text(f["add"].attrs["effect"]) if has_add else None
     fig, axes = plt.subplots(len(shown), 1, figsize=(8, 2.8 * len(shown)), squeeze=False)
     for ax, i in zip(axes[:, 0], shown):
         j = int(np.argmax(relevance[i]))
@@ -145,6 +146,9 @@ def main():
         measured_vs_predicted(f, out, states, shown)
         residual_band(f, out, states, shown)
         ranking(f, out)
+        if "add" in f:  # the states the added (or proposed) effect changed most
+            rmse = f["add/heldout_rmse"][()]
+            shown = list(np.argsort(-(rmse[0] / np.maximum(rmse[1], 1e-300)))[: min(3, len(states))])
         residual_vs_input(f, out, states, inputs, shown)
     print(f"wrote 4 plots to {out}")
 

@@ -58,6 +58,15 @@ double weighted_heldout_explained(const Transitions& data, const Matrix& residua
   return before > 0.0 ? 1.0 - after / before : 0.0;
 }
 
+/// Rows normalised to sum 1 (rows of zeros stay zero).
+Matrix shares(Matrix sensitivity) {
+  for (Eigen::Index i = 0; i < sensitivity.rows(); ++i) {
+    const double total = sensitivity.row(i).sum();
+    if (total > 0.0) sensitivity.row(i) /= total;
+  }
+  return sensitivity;
+}
+
 Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   Verdict v;
   if (r.consistent) {
@@ -172,11 +181,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
 
   // 2. Where.
   R.sensitivity = gp_sensitivity(R.gp, data, data.rows(false));
-  R.relevance = R.sensitivity;
-  for (int i = 0; i < n; ++i) {
-    const double total = R.relevance.row(i).sum();
-    if (total > 0.0) R.relevance.row(i) /= total;
-  }
+  R.relevance = shares(R.sensitivity);
   R.bins = bin_residuals(data, R.residual, R.input_names, o.bins);
   R.xcorr = cross_correlation(data, R.residual, o.max_lag);
   R.episode_rms = episode_rms(data, R.residual, static_cast<int>(set.episodes.size()));
@@ -215,6 +220,8 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
                                     ? R.gp
                                     : fit_residual_gp(make_step_model(*with_effect, o.integrator, R.dt, o.substeps), data,
                                                       R.residual_after, o.gp);
+    R.residual_base = base_residual;
+    R.relevance_base = !o.add.empty() ? shares(gp_sensitivity(gp_before, data, data.rows(false))) : R.relevance;
     R.comparison.push_back({"sim", heldout_rmse(data, base_residual), Vector()});
     R.comparison.push_back({"sim+effect", heldout_rmse(data, R.residual_after), Vector()});
     R.comparison.push_back({"sim+GP", heldout_rmse(data, base_residual - base_gp->mean), base_gp->signal_variance});

@@ -185,7 +185,9 @@ void write_add(H5::Group root, const DiagnosisReport& r) {
   write_strings(g, "model", names, false);
   write_matrix(g, "heldout_rmse", rmse);
   write_matrix(g, "signal_variance", variance);
+  write_matrix(g, "residual_before", r.residual_base);
   write_matrix(g, "residual_after", r.residual_after);
+  write_matrix(g, "relevance_before", r.relevance_base);
 }
 
 std::string now_utc() {

@@ -134,7 +134,9 @@ struct DiagnosisReport {
   /// The "add" step (present when effects were added, or when a proposal exists): the four models.
   std::vector<ModelScore> comparison;
   std::string comparison_effect;         ///< what "effect" means in the four rows
+  Matrix residual_base;                  ///< N x n, one-step residual of "sim" in the comparison
   Matrix residual_after;                 ///< N x n, one-step residual of sim + effect (when comparison exists)
+  Matrix relevance_base;                 ///< n x (n + m), relevance of the "sim" model's GP
 };
 
 /// Runs the diagnosis. Throws std::invalid_argument for bad options or data that do not fit the model

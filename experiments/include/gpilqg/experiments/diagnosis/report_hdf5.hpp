@@ -17,7 +17,8 @@
 ///             z_score, heldout_rmse_before, heldout_rmse_after (G), aliases (G strings, comma-separated)}
 ///             attrs: heldout_state
 ///   /add/{model (4 strings), heldout_rmse (4 x n), signal_variance (2 x n: sim+GP, sim+effect+GP),
-///         residual_after (N x n)}  attrs: effect       (present when the report has the four models)
+///         residual_before, residual_after (N x n: "sim" and "sim+effect"), relevance_before (n x (n + m))}
+///         attrs: effect       (present when the report has the four models)
 
 #include <filesystem>
 
