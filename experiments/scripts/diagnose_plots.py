@@ -35,13 +35,19 @@ def worst_states(f, count):
     return list(np.argsort(-ratio)[:count])
 
 
-def measured_vs_predicted(f, out, states, shown):
+def heldout_episode_figure(f, panels):
+    """The first held-out episode (its index, rows and times) and a figure with one panel per state."""
     data = f["data"]
     held = np.flatnonzero(data["heldout"][()] == 1)
     episode = data["episode"][()][held[0]] if held.size else 0
     rows = np.flatnonzero(data["episode"][()] == episode)
-    t = data["t"][()][rows]
-    fig, axes = plt.subplots(len(shown), 1, figsize=(9, 2.4 * len(shown)), sharex=True, squeeze=False)
+    fig, axes = plt.subplots(panels, 1, figsize=(9, 2.4 * panels), sharex=True, squeeze=False)
+    return episode, rows, data["t"][()][rows], fig, axes
+
+
+def measured_vs_predicted(f, out, states, shown):
+    data = f["data"]
+    episode, rows, t, fig, axes = heldout_episode_figure(f, len(shown))
     ks = sorted((g for g in f["compare"] if g.startswith("k_")), key=lambda g: int(g[2:]))
     dt = float(json.loads(text(f.attrs["report"]))["dt"])
     for ax, i in zip(axes[:, 0], shown):
@@ -64,11 +70,7 @@ def measured_vs_predicted(f, out, states, shown):
 
 def residual_band(f, out, states, shown):
     data = f["data"]
-    held = np.flatnonzero(data["heldout"][()] == 1)
-    episode = data["episode"][()][held[0]] if held.size else 0
-    rows = np.flatnonzero(data["episode"][()] == episode)
-    t = data["t"][()][rows]
-    fig, axes = plt.subplots(len(shown), 1, figsize=(9, 2.4 * len(shown)), sharex=True, squeeze=False)
+    episode, rows, t, fig, axes = heldout_episode_figure(f, len(shown))
     for ax, i in zip(axes[:, 0], shown):
         r = f["compare/residual"][()][rows, i]
         mu = f["compare/gp_mean"][()][rows, i]
