@@ -119,6 +119,22 @@ TEST(DiagnoseCli, BadInputIsExitTwoNamingWhatIsWrong) {
   EXPECT_NE(missing.err.find("none.csv"), std::string::npos) << missing.err;
 }
 
+TEST(DiagnoseCli, SimulateAddsHiddenEffectsOfTheLibrary) {
+  const fs::path dir = test::temporary_dir("simulate_effect");
+  const std::string base = "simulate --system cartpole --episodes 2 --steps 20 --seed 3 --out ";
+  ASSERT_EQ(test::run_cli(base + quote(dir / "plain.csv")).status, 0);
+  const auto with = test::run_cli(base + quote(dir / "friction.csv") + " --effect cart_coulomb_friction=2");
+  ASSERT_EQ(with.status, 0) << with.err;
+  const auto plain = read_measurements(dir / "plain.csv", system_signature("cartpole"));
+  const auto friction = read_measurements(dir / "friction.csv", system_signature("cartpole"));
+  // Same seed, same excitation and noise: the first state agrees, the friction changes the rest.
+  EXPECT_EQ(plain.episodes[0].x.row(0), friction.episodes[0].x.row(0));
+  EXPECT_GT((plain.episodes[0].x - friction.episodes[0].x).cwiseAbs().maxCoeff(), 1e-3);
+  const auto bad = test::run_cli(base + quote(dir / "bad.csv") + " --effect wind=2");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("cart_coulomb_friction"), std::string::npos) << bad.err;
+}
+
 TEST(DiagnoseCli, PlotsNeedMatplotlibAndSayWhenItIsMissing) {
   const fs::path dir = test::temporary_dir("diagnose_plots");
   const fs::path data = friction_csv(dir);

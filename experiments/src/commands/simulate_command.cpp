@@ -69,7 +69,7 @@ int run_simulate(const SimulateOptions& o) {
   world.preset = *preset;
   world.parameters = parse_parameters(o.parameters);
   for (const std::string& text : o.effects) {
-    const diagnosis::EffectRequest request = diagnosis::parse_add_option(text, o.system);
+    const diagnosis::EffectRequest request = diagnosis::parse_add_option(text, o.system, "--effect");
     if (!request.values) throw InputError("--effect '" + text + "': expected EFFECT=VALUE, e.g. cart_coulomb_friction=1");
     world = world.with(find_effect(o.system, request.effect), *request.values);
   }

@@ -130,7 +130,7 @@ void write_model_file(const std::filesystem::path& file, const ModelSpec& model,
   });
 }
 
-EffectRequest parse_add_option(const std::string& text, const std::string& system) {
+EffectRequest parse_add_option(const std::string& text, const std::string& system, const std::string& option) {
   const auto eq = text.find('=');
   EffectRequest request;
   request.effect = text.substr(0, eq);
@@ -138,32 +138,30 @@ EffectRequest parse_add_option(const std::string& text, const std::string& syste
   try {
     effect = &find_effect(system, request.effect);
   } catch (const std::invalid_argument&) {
-    throw InputError(fmt::format("--add '{}': unknown effect '{}' for system '{}'; expected EFFECT or EFFECT=VALUE with EFFECT one of: {}",
-                                 text, request.effect, system, effect_names(system)));
+    throw InputError(fmt::format("{} '{}': unknown effect '{}' for system '{}'; expected EFFECT or EFFECT=VALUE with EFFECT one of: {}", option, text, request.effect, system, effect_names(system)));
   }
   if (eq == std::string::npos) return request;
   const std::string value_text = text.substr(eq + 1);
   if (effect->parameters.size() != 1)
-    throw InputError(fmt::format("--add '{}': '{}' has parameters {}; give no value and let the diagnosis fit them",
-                                 text, effect->name, parameter_names(*effect)));
+    throw InputError(fmt::format("{} '{}': '{}' has parameters {}; give no value and let the diagnosis fit them", option, text, effect->name, parameter_names(*effect)));
   double value = 0.0;
   try {
     std::size_t used = 0;
     value = std::stod(value_text, &used);
     if (used != value_text.size()) throw std::invalid_argument("trailing text");
   } catch (const std::exception&) {
-    throw InputError(fmt::format("--add '{}': '{}' is not a number; expected {}=<{} in {}>", text, value_text,
+    throw InputError(fmt::format("{} '{}': '{}' is not a number; expected {}=<{} in {}>", option, text, value_text,
                                  effect->name, effect->parameters[0].name, effect->parameters[0].unit));
   }
   if (!std::isfinite(value))
-    throw InputError(fmt::format("--add '{}': the value is not finite; expected a finite number", text));
+    throw InputError(fmt::format("{} '{}': the value is not finite; expected a finite number", option, text));
   request.values = Vector::Constant(1, value);
   ModelSpec probe;
   probe.system = system;
   try {
     static_cast<void>(probe.with(*effect, *request.values));
   } catch (const std::invalid_argument& e) {
-    throw InputError(fmt::format("--add '{}': {}", text, e.what()));
+    throw InputError(fmt::format("{} '{}': {}", option, text, e.what()));
   }
   return request;
 }

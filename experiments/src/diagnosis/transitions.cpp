@@ -1,5 +1,6 @@
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>

@@ -35,8 +35,8 @@ std::string model_file_text(const ModelSpec& model, const std::vector<std::strin
 /// Writes model_file_text to `file` atomically.
 void write_model_file(const std::filesystem::path& file, const ModelSpec& model, const std::vector<std::string>& comment = {});
 
-/// Parses "EFFECT" or "EFFECT=VALUE" for `system`. Throws InputError naming the option, the text and
-/// the valid effect names, or saying why VALUE is not acceptable.
-EffectRequest parse_add_option(const std::string& text, const std::string& system);
+/// Parses "EFFECT" or "EFFECT=VALUE" for `system`. Throws InputError naming `option` (e.g. "--add"),
+/// the text and the valid effect names, or saying why VALUE is not acceptable.
+EffectRequest parse_add_option(const std::string& text, const std::string& system, const std::string& option = "--add");
 
 }  // namespace gpilqg::diagnosis
