@@ -13,6 +13,7 @@
 #include "gpilqg/control/ddp_solver.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/systems.hpp"
+#include "ddp_pass_timing.hpp"
 
 namespace {
 
@@ -94,35 +95,13 @@ void BM_DdpIteration(benchmark::State& state, const char* system, DdpVariant var
   options.variant = variant;
   options.max_iterations = 10;
   DdpSolver solver(options);
-  DdpTimings sum;
-  long iterations = 0, derivative_passes = 0, backward_passes = 0, forward_passes = 0;
+  bench::DdpPassTiming timing;
   for (auto _ : state) {
     const DdpResult r = solver.solve(problem, task.u0);
-    sum.total_s += r.summary.timings.total_s;
-    sum.derivatives_s += r.summary.timings.derivatives_s;
-    sum.backward_s += r.summary.timings.backward_s;
-    sum.forward_s += r.summary.timings.forward_s;
-    iterations += r.summary.iterations;
-    // Passes actually run: one derivative pass per iteration plus the final one; backward passes
-    // including rejected ones and the final gain pass; forward passes including the initial rollout.
-    derivative_passes += r.summary.iterations + 1;
-    backward_passes += 1;
-    forward_passes += 1;
-    for (const auto& it : r.summary.trace) {
-      backward_passes += 1 + it.backward_failures;
-      forward_passes += it.line_search_trials;
-    }
+    timing.add(r);
     benchmark::DoNotOptimize(r.nominal_cost);
   }
-  // "One iteration" as the issue defines it: one derivative pass + one backward pass + one forward pass.
-  const double derivatives_us = 1e6 * sum.derivatives_s / static_cast<double>(derivative_passes);
-  const double backward_us = 1e6 * sum.backward_s / static_cast<double>(backward_passes);
-  const double forward_us = 1e6 * sum.forward_s / static_cast<double>(forward_passes);
-  state.counters["derivatives_us"] = derivatives_us;
-  state.counters["backward_us"] = backward_us;
-  state.counters["forward_us"] = forward_us;
-  state.counters["one_iteration_us"] = derivatives_us + backward_us + forward_us;
-  state.counters["solver_us_per_iteration"] = 1e6 * sum.total_s / static_cast<double>(std::max(iterations, 1L));
+  timing.report(state, 1e6, "us");
 }
 
 BENCHMARK_CAPTURE(BM_DdpIteration, cartpole_ilqr, "cartpole", DdpVariant::ILQR)->Unit(benchmark::kMicrosecond);

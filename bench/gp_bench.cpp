@@ -7,6 +7,7 @@
 //   build/bench/gpilqg_gp_bench
 // The cheap cases run 3 repetitions and report mean, median, stddev, cv and "min" (best of 3: the
 // figure least disturbed by other jobs on a shared machine).
+// The BM_Residual* cases time the residual model of GP-ILQG per DDP step (see their comment below).
 
 #include <benchmark/benchmark.h>
 
@@ -15,7 +16,11 @@
 #include <random>
 #include <vector>
 
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/systems.hpp"
 #include "gpilqg/gp/exact_gp.hpp"
+#include "gpilqg/gp/residual_model.hpp"
+#include "system_samples.hpp"
 
 namespace {
 
@@ -150,5 +155,86 @@ BENCHMARK(BM_ExactPredictionMeanOnly)
     ->Repetitions(3)
     ->ComputeStatistics("min", minimum)
     ->Unit(benchmark::kMicrosecond);
+
+// ------------------------------------------------------------------------------------------------
+// The GP-ILQG residual model: what one DDP step pays for the learned part. Cart-pole (n = 4, D = 5,
+// dt = 0.05) and quadrotor (n = 12, D = 16, dt = 0.02), simulator against the real-world parameters
+// (Euler), residuals with measurement noise 1e-3, N = 300 exact GPs, one per state, with the fixed hyperparameters of system_samples.hpp.
+// A "derivative step" is what the DDP engine's derivative pass calls per time step: step with A, B and
+// uncertainty with its column derivatives, at the same (x, u); a "forward step" what its forward pass
+// calls: uncertainty and step without derivatives. The queries cycle through 64 points of the task's box.
+
+gpilqg::gp::ResidualModel residual_model(const std::string& system, gpilqg::gp::OutputSharing sharing) {
+  using namespace gpilqg;
+  const double dt = system == "cartpole" ? 0.05 : 0.02;
+  auto simulator = std::make_shared<IntegratedStepModel>(make_system(system, Preset::Simulator), Integrator::Euler, dt);
+  const IntegratedStepModel real(make_system(system, Preset::RealWorld), Integrator::Euler, dt);
+  const int n = simulator->state_dim(), m = simulator->control_dim();
+  const Matrix inputs = bench::draw_inputs(bench::system_box(system), 300);
+  // Measurement noise 1e-3 on the residuals (the position residuals of an Euler step are otherwise 0).
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 1e-3);
+  Matrix residuals(inputs.rows(), n);
+  for (Eigen::Index i = 0; i < inputs.rows(); ++i) {
+    const Vector x = inputs.row(i).head(n).transpose(), u = inputs.row(i).tail(m).transpose();
+    residuals.row(i) = (real.next(x, u) - simulator->next(x, u)).transpose();
+    for (int a = 0; a < n; ++a) residuals(i, a) += noise(rng);
+  }
+  const auto hyperparameters = bench::fixed_hyperparameters(inputs, residuals);
+  std::vector<std::unique_ptr<FittedGp>> outputs;
+  for (int i = 0; i < n; ++i)
+    outputs.push_back(all_points_backend().condition(TrainingSet{inputs, residuals.col(i)},
+                                                     hyperparameters[static_cast<std::size_t>(i)]));
+  return ResidualModel(simulator, std::move(outputs), sharing);
+}
+
+void residual_steps(benchmark::State& state, const char* system, bool derivatives, OutputSharing sharing) {
+  using namespace gpilqg;
+  const ResidualModel model = residual_model(system, sharing);
+  const int n = model.state_dim(), m = model.control_dim();
+  const Matrix points = bench::draw_inputs(bench::system_box(system), 64, 99);
+  Vector next(n);
+  StepJacobians jacobians;
+  jacobians.resize(n, m);
+  DiffusionColumns columns;
+  Eigen::Index j = 0;
+  for (auto _ : state) {
+    const auto x = points.row(j).head(n).transpose();
+    const auto u = points.row(j).tail(m).transpose();
+    if (derivatives) {
+      model.step(x, u, next, &jacobians);
+      model.uncertainty(x, u, columns, true);
+    } else {
+      model.uncertainty(x, u, columns, false);
+      model.step(x, u, next);
+    }
+    benchmark::DoNotOptimize(next.data());
+    benchmark::DoNotOptimize(columns.columns.data());
+    j = (j + 1) % points.rows();
+  }
+}
+
+// Each with the outputs' shared prediction (the default) and per output (OutputSharing::Off, the
+// reference path and the cost before the sharing).
+void BM_ResidualDerivativeStep(benchmark::State& state, const char* system, OutputSharing sharing) {
+  residual_steps(state, system, true, sharing);
+}
+void BM_ResidualForwardStep(benchmark::State& state, const char* system, OutputSharing sharing) {
+  residual_steps(state, system, false, sharing);
+}
+#define GPILQG_RESIDUAL_BENCHMARK(function, name, system, sharing) \
+  BENCHMARK_CAPTURE(function, name, system, sharing)                \
+      ->MinTime(0.2)                                                \
+      ->Repetitions(3)                                              \
+      ->ComputeStatistics("min", minimum)                           \
+      ->Unit(benchmark::kMicrosecond)
+GPILQG_RESIDUAL_BENCHMARK(BM_ResidualDerivativeStep, cartpole_shared, "cartpole", OutputSharing::Auto);
+GPILQG_RESIDUAL_BENCHMARK(BM_ResidualDerivativeStep, cartpole_per_output, "cartpole", OutputSharing::Off);
+GPILQG_RESIDUAL_BENCHMARK(BM_ResidualDerivativeStep, quadrotor_shared, "quadrotor", OutputSharing::Auto);
+GPILQG_RESIDUAL_BENCHMARK(BM_ResidualDerivativeStep, quadrotor_per_output, "quadrotor", OutputSharing::Off);
+GPILQG_RESIDUAL_BENCHMARK(BM_ResidualForwardStep, cartpole_shared, "cartpole", OutputSharing::Auto);
+GPILQG_RESIDUAL_BENCHMARK(BM_ResidualForwardStep, cartpole_per_output, "cartpole", OutputSharing::Off);
+GPILQG_RESIDUAL_BENCHMARK(BM_ResidualForwardStep, quadrotor_shared, "quadrotor", OutputSharing::Auto);
+GPILQG_RESIDUAL_BENCHMARK(BM_ResidualForwardStep, quadrotor_per_output, "quadrotor", OutputSharing::Off);
 
 }  // namespace

@@ -71,9 +71,7 @@ MpcRun run_mpc(const StepModel& world, MpcController& controller, const Cost& ta
   run.trajectory = r.trajectory;
   run.steps_completed = r.steps_completed;
   run.finite = r.finite;
-  for (int t = 0; t < r.steps_completed; ++t)
-    run.cost += task.stage(t, run.trajectory.x.col(t), run.trajectory.u.col(t));
-  if (r.finite) run.cost += task.terminal_at(steps, run.trajectory.x.col(steps));
+  run.cost = trajectory_cost(task, run.trajectory);  // a diverged run is scored at its last finite state
   return run;
 }
 

@@ -13,4 +13,11 @@ Trajectory::Trajectory(int state_dim, int control_dim, int horizon)
                                 "): expected n >= 1, m >= 0, T >= 0");
 }
 
+double trajectory_cost(const Cost& cost, const Trajectory& trajectory) {
+  const int T = trajectory.horizon();
+  double J = cost.terminal_at(T, trajectory.x.col(T));
+  for (int t = 0; t < T; ++t) J += cost.stage(t, trajectory.x.col(t), trajectory.u.col(t));
+  return J;
+}
+
 }  // namespace gpilqg

@@ -18,16 +18,57 @@ toml::table TomlFields::parse(const std::filesystem::path& file) {
   }
 }
 
+toml::table TomlFields::parse_text(const std::string& text, const std::string& source) {
+  try {
+    return toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:line {}: {}; expected valid TOML", source, e.source().begin.line, e.description()));
+  }
+}
+
+namespace {
+
+std::string keys_of(const toml::table& table) {
+  std::string list;
+  for (const auto& [key, node] : table) list += (list.empty() ? "" : ", ") + std::string(key.str());
+  return list;
+}
+
+void merge_level(toml::table& base, const toml::table& overrides, const std::string& prefix) {
+  for (const auto& [key, node] : overrides) {
+    const std::string name(key.str());
+    const std::string path = prefix.empty() ? name : prefix + "." + name;
+    toml::node* existing = base.get(name);
+    if (existing == nullptr) {
+      const auto& source = node.source();
+      throw InputError(fmt::format("{}:line {}: unknown field '{}'; expected one of: {}",
+                                   source.path ? *source.path : std::string("<config>"), source.begin.line, path,
+                                   keys_of(base)));
+    }
+    if (existing->is_table() && node.is_table()) merge_level(*existing->as_table(), *node.as_table(), path);
+    else base.insert_or_assign(name, node);
+  }
+}
+
+}  // namespace
+
+void TomlFields::merge(toml::table& base, const toml::table& overrides) { merge_level(base, overrides, ""); }
+
 const toml::node* TomlFields::find(const std::string& path) const {
   return root_.at_path(path).node();
 }
 
 bool TomlFields::has(const std::string& path) const { return find(path) != nullptr; }
 
+std::string TomlFields::source_of(const toml::node* node) const {
+  if (node != nullptr && node->source().path && !node->source().path->empty()) return *node->source().path;
+  return file_.string();
+}
+
 void TomlFields::fail(const std::string& path, const std::string& problem) const {
   const toml::node* node = find(path);
   if (node != nullptr && node->source().begin.line > 0)
-    throw InputError(fmt::format("{}:line {}: field '{}': {}", file_.string(), node->source().begin.line, path, problem));
+    throw InputError(fmt::format("{}:line {}: field '{}': {}", source_of(node), node->source().begin.line, path, problem));
   throw InputError(fmt::format("{}: field '{}': {}", file_.string(), path, problem));
 }
 
@@ -46,7 +87,7 @@ void TomlFields::only_keys(const std::string& section, const std::vector<std::st
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
     const std::string path = section.empty() ? name : section + "." + name;
-    throw InputError(fmt::format("{}:line {}: unknown field '{}'; expected one of: {}", file_.string(),
+    throw InputError(fmt::format("{}:line {}: unknown field '{}'; expected one of: {}", source_of(&node),
                                  node.source().begin.line, path, list));
   }
 }

@@ -6,6 +6,7 @@
 
 #include "dense_cholesky.hpp"
 #include "exact_gp_internal.hpp"
+#include "exact_prediction.hpp"
 #include "parallel.hpp"
 
 namespace gpilqg::gp::detail {
@@ -27,28 +28,34 @@ class ExactFittedGp final : public FittedGp {
     const int d = data_.input_dim();
     check_exact_parameters(parameters_, d, "ExactGpBackend::condition");
     const Hyperparameters h = Hyperparameters::unpack(parameters_, d);
-    inverse_squared_lengthscales_ = (-2.0 * h.log_lengthscales.array()).exp();
-    signal_variance_ = h.signal_variance();
+    predictor_ = ExactPredictor(&data_.inputs, (-2.0 * h.log_lengthscales.array()).exp(), h.signal_variance());
+    const double sf2 = predictor_.signal_variance();
     const Eigen::Index n = data_.size();
-    auto fill = [this, threads](Matrix& k) {
-      kernel_lower(data_.inputs, inverse_squared_lengthscales_, signal_variance_, k, threads);
+    Matrix factor;
+    auto fill = [this, threads, sf2](Matrix& k) {
+      kernel_lower(data_.inputs, predictor_.inverse_squared_lengthscales(), sf2, k, threads);
     };
-    const FactorOutcome outcome =
-        cholesky_with_jitter(n, fill, signal_variance_, h.noise_variance(), jitter, factor_, threads);
+    const FactorOutcome outcome = cholesky_with_jitter(n, fill, sf2, h.noise_variance(), jitter, factor, threads);
     if (outcome.status == FactorStatus::Failed)
       throw std::runtime_error("ExactGpBackend::condition: K is not positive definite even with jitter " +
                                std::to_string(outcome.jitter) + " on " + std::to_string(n) + " points");
     report_.status = outcome.status;
     report_.jitter = outcome.jitter;
-    solve_alpha(factor_, data_.targets, alpha_);
-    report_.negative_log_marginal_likelihood = nlml_from_factor(factor_, data_.targets, alpha_);
+    Vector alpha;
+    solve_alpha(factor, data_.targets, alpha);
+    report_.negative_log_marginal_likelihood = nlml_from_factor(factor, data_.targets, alpha);
     if (n <= kMaxPointsWithCachedInverseFactor) {
-      invert_lower_triangular(factor_, threads);
-      factor_.triangularView<Eigen::StrictlyUpper>().setZero();
-      inverse_factor_ = std::move(factor_);
-      factor_ = Matrix();
+      invert_lower_triangular(factor, threads);
+      factor.triangularView<Eigen::StrictlyUpper>().setZero();
+      predictor_.set_weights(std::move(alpha), std::move(factor), Matrix());
+    } else {
+      predictor_.set_weights(std::move(alpha), Matrix(), std::move(factor));
     }
   }
+  ExactFittedGp(const ExactFittedGp&) = delete;  // predictor_ points into data_
+  ExactFittedGp& operator=(const ExactFittedGp&) = delete;
+
+  const ExactPredictor& predictor() const { return predictor_; }
 
   std::string_view backend_name() const override { return "exact"; }
   int input_dim() const override { return data_.input_dim(); }
@@ -56,56 +63,19 @@ class ExactFittedGp final : public FittedGp {
   const Vector& parameters() const override { return parameters_; }
   const ConditioningReport& conditioning() const override { return report_; }
 
-  /// mean = k' alpha, variance = sf^2 - |v|^2 with v = L^-1 k (GPML eqs. 2.25, 2.26, algorithm 2.1);
-  /// with r_i = x_i - z,
-  ///   d mean / dz_d     =  (1/l_d^2) sum_i alpha_i k_i r_id
-  ///   d variance / dz_d = -(2/l_d^2) sum_i w_i k_i r_id,  w = K^-1 k = L^-T v.
+  /// The stages of exact_prediction.hpp on this output alone.
   void predict(const VectorCRef& z, Prediction& out, const PredictionRequest& request) const override {
     const int d = input_dim();
     if (z.size() != d)
       throw std::invalid_argument("ExactGp::predict: input has " + std::to_string(z.size()) + " entries; expected " +
                                   std::to_string(d));
-    const Eigen::Index n = data_.size();
     PredictionWorkspace& ws = out.workspace;
-    ws.cross.resize(n);
-    auto k = ws.cross.array();
-    k.setZero();
-    for (int dim = 0; dim < d; ++dim)
-      k += inverse_squared_lengthscales_(dim) * (data_.inputs.col(dim).array() - z(dim)).square();
-    k = signal_variance_ * (-0.5 * k).exp();
-    out.mean = ws.cross.dot(alpha_);
-    if (request.gradients) {
-      ws.extra.resize(n);
-      ws.extra.array() = alpha_.array() * k;
-      out.mean_gradient.resize(d);
-      for (int dim = 0; dim < d; ++dim)
-        out.mean_gradient(dim) =
-            inverse_squared_lengthscales_(dim) * (data_.inputs.col(dim).dot(ws.extra) - z(dim) * out.mean);
-    }
-    if (!request.variance) return;
-    ws.weighted.resize(n);
-    double explained = 0.0;  // k' K^-1 k
-    if (inverse_factor_.size() != 0) {
-      ws.weighted.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * ws.cross;
-      explained = ws.weighted.squaredNorm();
-      if (request.gradients) {
-        ws.extra.noalias() = inverse_factor_.triangularView<Eigen::Lower>().transpose() * ws.weighted;
-        ws.weighted.swap(ws.extra);
-      }
-    } else {
-      ws.weighted = ws.cross;
-      factor_.triangularView<Eigen::Lower>().solveInPlace(ws.weighted);
-      explained = ws.weighted.squaredNorm();
-      if (request.gradients) factor_.triangularView<Eigen::Lower>().adjoint().solveInPlace(ws.weighted);
-    }
-    out.variance = std::max(signal_variance_ - explained, 0.0);
-    if (request.gradients) {
-      ws.extra.array() = ws.weighted.array() * k;
-      out.variance_gradient.resize(d);
-      for (int dim = 0; dim < d; ++dim)
-        out.variance_gradient(dim) =
-            -2.0 * inverse_squared_lengthscales_(dim) * (data_.inputs.col(dim).dot(ws.extra) - z(dim) * explained);
-    }
+    ws.cross.resize(data_.size());
+    predictor_.cross(z, nullptr, ws.cross);
+    out.mean = predictor_.mean(z, ws.cross, request.gradients ? &out.mean_gradient : nullptr, ws.extra);
+    if (request.variance)
+      out.variance = predictor_.variance(z, ws.cross, request.gradients ? &out.variance_gradient : nullptr,
+                                         ws.weighted, ws.extra);
   }
 
   /// Blocked: K(X, Z) for up to 512 points at a time, mean = Ks' alpha, variance = sf^2 - colwise
@@ -140,32 +110,94 @@ class ExactFittedGp final : public FittedGp {
     for (Eigen::Index c = 0; c < count; ++c) {
       auto k = cross.col(c).array();
       for (int dim = 0; dim < input_dim(); ++dim)
-        k += inverse_squared_lengthscales_(dim) * (data_.inputs.col(dim).array() - points(c, dim)).square();
-      k = signal_variance_ * (-0.5 * k).exp();
+        k += predictor_.inverse_squared_lengthscales()(dim) * (data_.inputs.col(dim).array() - points(c, dim)).square();
+      k = predictor_.signal_variance() * (-0.5 * k).exp();
     }
-    mean.noalias() = cross.transpose() * alpha_;
-    if (inverse_factor_.size() != 0) {
-      solved.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * cross;
+    mean.noalias() = cross.transpose() * predictor_.alpha();
+    if (predictor_.inverse_factor().size() != 0) {
+      solved.noalias() = predictor_.inverse_factor().triangularView<Eigen::Lower>() * cross;
       variance = solved.colwise().squaredNorm().transpose();
     } else {
-      factor_.triangularView<Eigen::Lower>().solveInPlace(cross);
+      predictor_.factor().triangularView<Eigen::Lower>().solveInPlace(cross);
       variance = cross.colwise().squaredNorm().transpose();
     }
-    variance = (signal_variance_ - variance.array()).max(0.0).matrix();
+    variance = (predictor_.signal_variance() - variance.array()).max(0.0).matrix();
   }
 
   TrainingSet data_;
   int threads_;
   Vector parameters_;
   ConditioningReport report_;
-  Vector inverse_squared_lengthscales_;
-  double signal_variance_ = 0.0;
-  Vector alpha_;
-  Matrix factor_;          // L = chol(K), kept only when L^-1 is not cached
-  Matrix inverse_factor_;  // L^-1 (lower, zero above) when N <= kMaxPointsWithCachedInverseFactor
+  ExactPredictor predictor_;  // L^-1 cached when N <= kMaxPointsWithCachedInverseFactor, else L
 };
 
 }  // namespace
+
+void ExactPredictor::squared_differences(const Matrix& inputs, const VectorCRef& z, Matrix& squared) {
+  squared.resize(inputs.rows(), inputs.cols());
+  for (Eigen::Index dim = 0; dim < inputs.cols(); ++dim)
+    squared.col(dim).array() = (inputs.col(dim).array() - z(dim)).square();
+}
+
+void ExactPredictor::cross(const VectorCRef& z, const Matrix* squared, Eigen::Ref<Vector> k) const {
+  const Matrix& x = *inputs_;
+  auto a = k.array();
+  a.setZero();
+  for (Eigen::Index dim = 0; dim < x.cols(); ++dim) {
+    if (squared != nullptr)
+      a += w_(dim) * squared->col(dim).array();
+    else
+      a += w_(dim) * (x.col(dim).array() - z(dim)).square();
+  }
+  a = sf2_ * (-0.5 * a).exp();
+}
+
+double ExactPredictor::mean(const VectorCRef& z, const VectorCRef& k, Vector* gradient, Vector& scratch) const {
+  const double m = k.dot(alpha_);
+  if (gradient != nullptr) {
+    const Matrix& x = *inputs_;
+    scratch.resize(x.rows());
+    scratch.array() = alpha_.array() * k.array();
+    gradient->resize(x.cols());
+    for (Eigen::Index dim = 0; dim < x.cols(); ++dim)
+      (*gradient)(dim) = w_(dim) * (x.col(dim).dot(scratch) - z(dim) * m);
+  }
+  return m;
+}
+
+double ExactPredictor::variance(const VectorCRef& z, const VectorCRef& k, Vector* gradient, Vector& weighted,
+                                Vector& scratch) const {
+  const Matrix& x = *inputs_;
+  const Eigen::Index n = x.rows();
+  weighted.resize(n);
+  scratch.resize(n);
+  double explained = 0.0;  // k' K^-1 k
+  if (inverse_factor_.size() != 0) {
+    weighted.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * k;
+    explained = weighted.squaredNorm();
+    if (gradient != nullptr) {
+      scratch.noalias() = inverse_factor_.triangularView<Eigen::Lower>().transpose() * weighted;
+      weighted.swap(scratch);
+    }
+  } else {
+    weighted = k;
+    factor_.triangularView<Eigen::Lower>().solveInPlace(weighted);
+    explained = weighted.squaredNorm();
+    if (gradient != nullptr) factor_.triangularView<Eigen::Lower>().adjoint().solveInPlace(weighted);
+  }
+  if (gradient != nullptr) {
+    scratch.array() = weighted.array() * k.array();
+    gradient->resize(x.cols());
+    for (Eigen::Index dim = 0; dim < x.cols(); ++dim)
+      (*gradient)(dim) = -2.0 * w_(dim) * (x.col(dim).dot(scratch) - z(dim) * explained);
+  }
+  return std::max(sf2_ - explained, 0.0);
+}
+
+const ExactPredictor* exact_predictor(const FittedGp& gp) {
+  const auto* exact = dynamic_cast<const ExactFittedGp*>(&gp);
+  return exact != nullptr ? &exact->predictor() : nullptr;
+}
 
 std::unique_ptr<FittedGp> make_exact_fitted_gp(TrainingSet data, const VectorCRef& parameters,
                                                const JitterSchedule& jitter, int threads) {

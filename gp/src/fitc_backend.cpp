@@ -1,12 +1,15 @@
 /// The FITC backend behind the GpBackend interface: options, the NLML objective (bounds and initial
 /// values) and the fitted model.
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <stdexcept>
 #include <string>
 
 #include "gpilqg/gp/fitc.hpp"
 #include "gpilqg/gp/hyperparameters.hpp"
+#include "sparse_backend.hpp"
 
 namespace gpilqg::gp {
 
@@ -25,98 +28,51 @@ void FitcOptions::validate() const {
 
 namespace {
 
-class FitcObjective final : public MarginalLikelihoodObjective {
- public:
-  FitcObjective(const TrainingSet& data, const FitcOptions& fitc, const FitOptions& fit)
-      : likelihood_(data.inputs, data.targets, std::min(fitc.inducing, data.size()), fitc.jitter, fit.jitter,
-                    fitc.threads) {
-    const FitcLayout& layout = likelihood_.layout();
-    const int D = layout.input_dim;
-    const Hyperparameters h = initial_hyperparameters(data);
-    const Matrix Xu = initial_pseudo_inputs(data.inputs, layout.inducing, h.lengthscales(),
-                                            fitc.initialisation, fit.seed, fitc.kmeans_iterations);
-    initial_ = layout.pack(h.pack(), Xu);
-
-    const ParameterBounds hb = hyperparameter_bounds(data, fit.min_noise_std);
-    bounds_.lower.resize(layout.size());
-    bounds_.upper.resize(layout.size());
-    bounds_.lower.head(D + 2) = hb.lower;
-    bounds_.upper.head(D + 2) = hb.upper;
-    if (fitc.optimise_pseudo_inputs) {
-      // Each coordinate within the data's range widened by that range on both sides.
-      const Vector lo = data.inputs.colwise().minCoeff().transpose();
-      const Vector hi = data.inputs.colwise().maxCoeff().transpose();
-      for (int d = 0; d < D; ++d) {
-        const double range = hi(d) > lo(d) ? hi(d) - lo(d) : 1.0;
-        bounds_.lower.segment(layout.inducing_offset() + d * layout.inducing, layout.inducing)
-            .setConstant(lo(d) - range);
-        bounds_.upper.segment(layout.inducing_offset() + d * layout.inducing, layout.inducing)
-            .setConstant(hi(d) + range);
-      }
-    } else {
-      bounds_.lower.tail(layout.size() - D - 2) = initial_.tail(layout.size() - D - 2);
-      bounds_.upper.tail(layout.size() - D - 2) = initial_.tail(layout.size() - D - 2);
-    }
+struct FitcTraits {
+  using Likelihood = FitcLikelihood;
+  using Predictor = FitcPredictor;
+  using Layout = FitcLayout;
+  static constexpr std::string_view name = "fitc";
+  static constexpr const char* label = "FITC";
+  static constexpr const char* condition_who = "FitcBackend::condition";
+  static int cross_size(const FitcPredictor& p) { return p.inducing(); }
+  static void predict(const FitcPredictor& p, const VectorCRef& z, PredictionWorkspace& w, double& mean,
+                      double* variance, double* dmean, double* dvariance) {
+    if (w.extra.size() != p.input_dim()) w.extra.resize(p.input_dim());
+    p.predict(z, w.cross.data(), w.weighted.data(), w.extra.data(), mean, variance, dmean, dvariance);
   }
-
-  int parameter_count() const override { return likelihood_.parameter_count(); }
-  int input_dim() const override { return likelihood_.layout().input_dim; }
-  NlmlEvaluation evaluate(const VectorCRef& parameters, Vector* gradient) override {
-    return likelihood_.evaluate(parameters, gradient);
-  }
-  ParameterBounds bounds() const override { return bounds_; }
-  Vector initial_parameters() const override { return initial_; }
-
- private:
-  FitcLikelihood likelihood_;
-  Vector initial_;
-  ParameterBounds bounds_;
 };
 
-class FittedFitc final : public FittedGp {
- public:
-  FittedFitc(TrainingSet data, Vector parameters, FitcPredictor predictor, ConditioningReport report)
-      : data_(std::move(data)),
-        parameters_(std::move(parameters)),
-        predictor_(std::move(predictor)),
-        report_(report) {}
-
-  std::string_view backend_name() const override { return "fitc"; }
-  int input_dim() const override { return predictor_.input_dim(); }
-  const TrainingSet& training_set() const override { return data_; }
-  const Vector& parameters() const override { return parameters_; }
-  const ConditioningReport& conditioning() const override { return report_; }
-
-  void predict(const VectorCRef& z, Prediction& out, const PredictionRequest& request) const override {
-    const int D = predictor_.input_dim();
-    const int M = predictor_.inducing();
-    if (z.size() != D)
-      throw std::invalid_argument("FITC prediction: the input has " + std::to_string(z.size()) +
-                                  " entries; expected " + std::to_string(D));
-    PredictionWorkspace& w = out.workspace;
-    if (w.cross.size() != M) w.cross.resize(M);
-    if (w.weighted.size() != M) w.weighted.resize(M);
-    if (w.extra.size() != D) w.extra.resize(D);
-    double* dmean = nullptr;
-    double* dvariance = nullptr;
-    if (request.gradients) {
-      if (out.mean_gradient.size() != D) out.mean_gradient.resize(D);
-      dmean = out.mean_gradient.data();
-      if (request.variance) {
-        if (out.variance_gradient.size() != D) out.variance_gradient.resize(D);
-        dvariance = out.variance_gradient.data();
-      }
+/// The start (data-driven hyperparameters, pseudo-inputs by fitc.initialisation) and the bounds of a
+/// FITC fit: the hyperparameter box, and each pseudo-input coordinate within the data's range widened by
+/// that range on both sides (or pinned at its start when the pseudo-inputs are not optimised).
+std::pair<Vector, ParameterBounds> fitc_start(const FitcLayout& layout, const TrainingSet& data,
+                                              const FitcOptions& fitc, const FitOptions& fit) {
+  const int D = layout.input_dim;
+  const Hyperparameters h = initial_hyperparameters(data);
+  const Matrix Xu = initial_pseudo_inputs(data.inputs, layout.inducing, h.lengthscales(), fitc.initialisation,
+                                          fit.seed, fitc.kmeans_iterations);
+  Vector initial = layout.pack(h.pack(), Xu);
+  ParameterBounds bounds;
+  const ParameterBounds hb = hyperparameter_bounds(data, fit.min_noise_std);
+  bounds.lower.resize(layout.size());
+  bounds.upper.resize(layout.size());
+  bounds.lower.head(D + 2) = hb.lower;
+  bounds.upper.head(D + 2) = hb.upper;
+  if (fitc.optimise_pseudo_inputs) {
+    const Vector lo = data.inputs.colwise().minCoeff().transpose();
+    const Vector hi = data.inputs.colwise().maxCoeff().transpose();
+    for (int d = 0; d < D; ++d) {
+      const double range = hi(d) > lo(d) ? hi(d) - lo(d) : 1.0;
+      bounds.lower.segment(layout.inducing_offset() + d * layout.inducing, layout.inducing).setConstant(lo(d) - range);
+      bounds.upper.segment(layout.inducing_offset() + d * layout.inducing, layout.inducing).setConstant(hi(d) + range);
     }
-    predictor_.predict(z, w.cross.data(), w.weighted.data(), w.extra.data(), out.mean,
-                       request.variance ? &out.variance : nullptr, dmean, dvariance);
+  } else {
+    bounds.lower.tail(layout.size() - D - 2) = initial.tail(layout.size() - D - 2);
+    bounds.upper.tail(layout.size() - D - 2) = initial.tail(layout.size() - D - 2);
   }
-
- private:
-  TrainingSet data_;
-  Vector parameters_;
-  FitcPredictor predictor_;
-  ConditioningReport report_;
-};
+  return {std::move(initial), std::move(bounds)};
+}
 
 }  // namespace
 
@@ -126,21 +82,19 @@ std::unique_ptr<MarginalLikelihoodObjective> FitcBackend::objective(const Traini
                                                                     const FitOptions& options) const {
   validate_training_set(data, "FitcBackend::objective");
   options.validate();
-  return std::make_unique<FitcObjective>(data, options_, options);
+  FitcLikelihood likelihood(data.inputs, data.targets, std::min(options_.inducing, data.size()), options_.jitter,
+                            options.jitter, options_.threads);
+  auto [initial, bounds] = fitc_start(likelihood.layout(), data, options_, options);
+  return std::make_unique<sparse_detail::LikelihoodObjective<FitcLikelihood>>(std::move(likelihood),
+                                                                              std::move(initial), std::move(bounds));
 }
 
 std::unique_ptr<FittedGp> FitcBackend::condition(TrainingSet data, const VectorCRef& parameters,
                                                  const JitterSchedule& jitter) const {
-  validate_training_set(data, "FitcBackend::condition");
-  jitter.validate();
-  const FitcLayout layout = FitcLayout::from_size(static_cast<int>(parameters.size()), data.input_dim());
-  if (!parameters.allFinite())
-    throw std::invalid_argument("FitcBackend::condition: the parameter vector has non-finite entries");
-  const FitcLikelihood likelihood(data.inputs, data.targets, layout.inducing, options_.jitter, jitter,
-                                  options_.threads);
-  ConditioningReport report;
-  FitcPredictor predictor = likelihood.predictor(parameters, &report);
-  return std::make_unique<FittedFitc>(std::move(data), Vector(parameters), std::move(predictor), report);
+  return sparse_detail::condition<FitcTraits>(
+      std::move(data), parameters, jitter, [&](const FitcLayout& layout, const TrainingSet& d) {
+        return FitcLikelihood(d.inputs, d.targets, layout.inducing, options_.jitter, jitter, options_.threads);
+      });
 }
 
 }  // namespace gpilqg::gp

@@ -85,18 +85,7 @@ struct FitcLikelihood::Workspace {
 
 namespace {
 
-void require(bool condition, const std::string& message) {
-  if (!condition) throw std::invalid_argument("FitcLikelihood: " + message);
-}
-
-/// The contract of a failed evaluation: +infinity, status Failed (never NaN).
-NlmlEvaluation failed(double jitter = 0.0) {
-  NlmlEvaluation e;
-  e.value = std::numeric_limits<double>::infinity();
-  e.status = FactorStatus::Failed;
-  e.jitter = jitter;
-  return e;
-}
+NlmlEvaluation failed(double jitter = 0.0) { return sparse_detail::failed_evaluation(jitter); }
 
 }  // namespace
 
@@ -108,13 +97,7 @@ FitcLikelihood::FitcLikelihood(const MatrixCRef& X, const VectorCRef& r, int ind
       schedule_(schedule),
       threads_(threads),
       ws_(std::make_unique<Workspace>()) {
-  require(X.rows() > 0 && X.cols() > 0,
-          "no training inputs (X is " + std::to_string(X.rows()) + " x " + std::to_string(X.cols()) + ")");
-  require(r.size() == X.rows(), "X has " + std::to_string(X.rows()) + " rows but there are " +
-                                    std::to_string(r.size()) + " targets");
-  require(X.allFinite() && r.allFinite(), "training data contain non-finite values");
-  require(inducing >= 1, "the number of pseudo-inputs must be >= 1, got " + std::to_string(inducing));
-  require(threads >= 1, "threads must be >= 1, got " + std::to_string(threads));
+  sparse_detail::validate_likelihood_inputs("FitcLikelihood", X, r, inducing, "pseudo-inputs", threads);
   jitter.validate();
   schedule.validate();
   layout_ = FitcLayout{static_cast<int>(X.cols()), inducing};

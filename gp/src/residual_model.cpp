@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "shared_prediction.hpp"
+
 namespace gpilqg::gp {
 
 namespace {
@@ -16,6 +18,8 @@ namespace {
 struct StepScratch {
   Vector z;
   std::vector<Prediction> predictions;
+  Vector values;     // shared path: the n means or variances
+  Matrix gradients;  // shared path: their gradients as rows (n x (n + m))
 };
 
 StepScratch& step_scratch(int input_dim, int outputs) {
@@ -58,7 +62,8 @@ void ResidualModelOptions::validate() const {
     throw std::invalid_argument("ResidualModelOptions::threads = " + std::to_string(threads) + "; expected >= 1");
 }
 
-ResidualModel::ResidualModel(SimulatorPtr simulator, std::vector<std::unique_ptr<FittedGp>> outputs)
+ResidualModel::ResidualModel(SimulatorPtr simulator, std::vector<std::unique_ptr<FittedGp>> outputs,
+                             OutputSharing sharing)
     : simulator_(std::move(simulator)) {
   if (!simulator_) throw std::invalid_argument("ResidualModel: null simulator");
   const int n = simulator_->state_dim(), m = simulator_->control_dim();
@@ -73,6 +78,7 @@ ResidualModel::ResidualModel(SimulatorPtr simulator, std::vector<std::unique_ptr
                                   std::to_string(n + m) + " (z = [x; u])");
     outputs_.push_back(std::move(outputs[i]));
   }
+  if (sharing == OutputSharing::Auto) shared_ = detail::SharedExactPrediction::make(outputs_);
 }
 
 ResidualModel ResidualModel::fit(SimulatorPtr simulator, const ResidualData& data, const GpBackend& backend,
@@ -135,6 +141,15 @@ void ResidualModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_n
   StepScratch& s = step_scratch(n + m, n);
   s.z.head(n) = x;
   s.z.tail(m) = u;
+  if (shared_) {
+    shared_->means(s.z, s.values, jacobians != nullptr ? &s.gradients : nullptr);
+    x_next += s.values;
+    if (jacobians != nullptr) {
+      jacobians->A += s.gradients.leftCols(n);
+      jacobians->B += s.gradients.rightCols(m);
+    }
+    return;
+  }
   const PredictionRequest request{false, jacobians != nullptr};
   for (int i = 0; i < n; ++i) {
     Prediction& p = s.predictions[static_cast<std::size_t>(i)];
@@ -159,17 +174,27 @@ void ResidualModel::uncertainty(const VectorCRef& x, const VectorCRef& u, Diffus
   StepScratch& s = step_scratch(n + m, n);
   s.z.head(n) = x;
   s.z.tail(m) = u;
-  const PredictionRequest request{true, derivatives};
+  if (shared_) {
+    shared_->variances(s.z, s.values, derivatives ? &s.gradients : nullptr);
+  } else {
+    const PredictionRequest request{true, derivatives};
+    s.values.resize(n);
+    if (derivatives) s.gradients.resize(n, n + m);
+    for (int i = 0; i < n; ++i) {
+      Prediction& p = s.predictions[static_cast<std::size_t>(i)];
+      outputs_[static_cast<std::size_t>(i)]->predict(s.z, p, request);
+      s.values(i) = p.variance;
+      if (derivatives) s.gradients.row(i) = p.variance_gradient.transpose();
+    }
+  }
   for (int i = 0; i < n; ++i) {
-    Prediction& p = s.predictions[static_cast<std::size_t>(i)];
-    outputs_[static_cast<std::size_t>(i)]->predict(s.z, p, request);
     // The GP's variance is the per-step error variance (Sigma dt)_ii; G_ii^2 dt = var_i.
-    const double sigma = std::sqrt(p.variance / step);
+    const double sigma = std::sqrt(s.values(i) / step);
     out.columns(i, i) = sigma;
     if (derivatives && sigma > 0.0) {
       const double scale = 1.0 / (2.0 * sigma * step);
-      out.d_dx[static_cast<std::size_t>(i)].row(i) = scale * p.variance_gradient.head(n).transpose();
-      out.d_du[static_cast<std::size_t>(i)].row(i) = scale * p.variance_gradient.tail(m).transpose();
+      out.d_dx[static_cast<std::size_t>(i)].row(i) = scale * s.gradients.row(i).head(n);
+      out.d_du[static_cast<std::size_t>(i)].row(i) = scale * s.gradients.row(i).tail(m);
     }
   }
 }

@@ -3,6 +3,8 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace gpilqg::gp::sparse_detail {
 
@@ -71,6 +73,28 @@ void se_covariance(const MatrixCRef& A, double sf2, Matrix& K) {
       K(i, j) = K(j, i) = sf2 * std::exp(-0.5 * d2);
     }
   }
+}
+
+NlmlEvaluation failed_evaluation(double jitter) {
+  NlmlEvaluation e;
+  e.value = std::numeric_limits<double>::infinity();
+  e.status = FactorStatus::Failed;
+  e.jitter = jitter;
+  return e;
+}
+
+void validate_likelihood_inputs(const char* who, const MatrixCRef& X, const VectorCRef& r, int count,
+                                const char* what, int threads) {
+  auto require = [who](bool condition, const std::string& message) {
+    if (!condition) throw std::invalid_argument(std::string(who) + ": " + message);
+  };
+  require(X.rows() > 0 && X.cols() > 0,
+          "no training inputs (X is " + std::to_string(X.rows()) + " x " + std::to_string(X.cols()) + ")");
+  require(r.size() == X.rows(), "X has " + std::to_string(X.rows()) + " rows but there are " +
+                                    std::to_string(r.size()) + " targets");
+  require(X.allFinite() && r.allFinite(), "training data contain non-finite values");
+  require(count >= 1, std::string("the number of ") + what + " must be >= 1, got " + std::to_string(count));
+  require(threads >= 1, "threads must be >= 1, got " + std::to_string(threads));
 }
 
 }  // namespace gpilqg::gp::sparse_detail

@@ -56,4 +56,13 @@ inline void merge(const CholeskyOutcome& outcome, FactorStatus& status, double& 
 /// log(2 pi).
 inline constexpr double kLog2Pi = 1.8378770664093454836;
 
+/// The contract of a failed NLML evaluation: +infinity, status Failed (never NaN).
+NlmlEvaluation failed_evaluation(double jitter = 0.0);
+
+/// The checks both sparse likelihoods make on construction; throws std::invalid_argument with the
+/// message prefixed by `who` ("FitcLikelihood"): empty X, |r| != rows of X, non-finite data,
+/// `count` < 1 (the number of `what`: pseudo-inputs, spectral points), threads < 1.
+void validate_likelihood_inputs(const char* who, const MatrixCRef& X, const VectorCRef& r, int count,
+                                const char* what, int threads);
+
 }  // namespace gpilqg::gp::sparse_detail

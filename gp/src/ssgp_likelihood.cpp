@@ -38,30 +38,14 @@ struct SsgpLikelihood::Workspace {
 
 namespace {
 
-NlmlEvaluation failed(double jitter = 0.0) {
-  NlmlEvaluation e;
-  e.value = std::numeric_limits<double>::infinity();
-  e.status = FactorStatus::Failed;
-  e.jitter = jitter;
-  return e;
-}
-
-void require(bool condition, const std::string& message) {
-  if (!condition) throw std::invalid_argument("SsgpLikelihood: " + message);
-}
+NlmlEvaluation failed(double jitter = 0.0) { return sparse_detail::failed_evaluation(jitter); }
 
 }  // namespace
 
 SsgpLikelihood::SsgpLikelihood(const MatrixCRef& X, const VectorCRef& r, int frequencies,
                                JitterSchedule schedule, int threads)
     : X_(X), r_(r), schedule_(schedule), threads_(threads), ws_(std::make_unique<Workspace>()) {
-  require(X.rows() > 0 && X.cols() > 0,
-          "no training inputs (X is " + std::to_string(X.rows()) + " x " + std::to_string(X.cols()) + ")");
-  require(r.size() == X.rows(), "X has " + std::to_string(X.rows()) + " rows but there are " +
-                                    std::to_string(r.size()) + " targets");
-  require(X.allFinite() && r.allFinite(), "training data contain non-finite values");
-  require(frequencies >= 1, "the number of spectral points must be >= 1, got " + std::to_string(frequencies));
-  require(threads >= 1, "threads must be >= 1, got " + std::to_string(threads));
+  sparse_detail::validate_likelihood_inputs("SsgpLikelihood", X, r, frequencies, "spectral points", threads);
   schedule.validate();
   layout_ = SsgpLayout{static_cast<int>(X.cols()), frequencies};
 }

@@ -79,7 +79,9 @@ TEST(Allocation, ResidualModelStepAndUncertaintyDoNotAllocateAfterWarmUp) {
   ResidualModelOptions options;
   options.fit.optimise = false;
   const ResidualModel model = ResidualModel::fit(simulator, data, ExactGpBackend{}, options);
-  const Vector x = Vector::Constant(4, 0.1), u = Vector::Constant(1, 0.2);
+  ASSERT_TRUE(model.shares_outputs());
+  const Vector u = Vector::Constant(1, 0.2);
+  Vector x = Vector::Constant(4, 0.1);
   Vector next(4);
   StepJacobians jac;
   jac.resize(4, 1);
@@ -88,6 +90,7 @@ TEST(Allocation, ResidualModelStepAndUncertaintyDoNotAllocateAfterWarmUp) {
   model.uncertainty(x, u, g, true);
   const long before = g_malloc_calls.load();
   for (int i = 0; i < 10; ++i) {
+    x(0) = 0.01 * i;  // a new query each time (the shared prediction keeps the last one)
     model.step(x, u, next, &jac);
     model.step(x, u, next);
     model.uncertainty(x, u, g, true);

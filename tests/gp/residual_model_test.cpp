@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <random>
+#include <thread>
 
 #include "gp_test_support.hpp"
 #include "gpilqg/core/integrator.hpp"
@@ -174,6 +175,123 @@ TEST_F(CartPoleResidual, JacobiansAndUncertaintyDerivativesMatchCentralDifferenc
       EXPECT_TRUE(matrices_near(g.d_du[static_cast<std::size_t>(i)], dg.rightCols(1), scale, 1e-5)) << "column " << i;
     }
   }
+}
+
+/// The model's GPs conditioned again from their fitted parameters and training sets, with or without
+/// shared prediction; `subset_first` conditions output 0 on its first 100 points only (other inputs).
+ResidualModel rebuilt(const ResidualModel& model, OutputSharing sharing, bool subset_first = false) {
+  std::vector<std::unique_ptr<FittedGp>> outputs;
+  for (int i = 0; i < model.state_dim(); ++i) {
+    TrainingSet data = model.output(i).training_set();
+    if (subset_first && i == 0) data = TrainingSet{data.inputs.topRows(100), data.targets.head(100)};
+    outputs.push_back(ExactGpBackend{}.condition(data, model.output(i).parameters()));
+  }
+  return ResidualModel(model.simulator_ptr(), std::move(outputs), sharing);
+}
+
+/// Everything step and uncertainty return at (x, u), in the order given (true: step first).
+struct StepOutputs {
+  Vector next, plain_next, sigma, plain_sigma;
+  Matrix A, B;
+  std::vector<Matrix> d_dx, d_du;
+};
+StepOutputs query(const ResidualModel& model, const Vector& x, const Vector& u, bool step_first) {
+  StepOutputs o;
+  StepJacobians jac;
+  jac.resize(4, 1);
+  DiffusionColumns g, plain;
+  o.next.resize(4);
+  o.plain_next.resize(4);
+  if (step_first) {  // the derivative pass's order, then the forward pass's at the same point
+    model.step(x, u, o.next, &jac);
+    model.uncertainty(x, u, g, true);
+    model.uncertainty(x, u, plain, false);
+    model.step(x, u, o.plain_next);
+  } else {
+    model.uncertainty(x, u, plain, false);
+    model.step(x, u, o.plain_next);
+    model.step(x, u, o.next, &jac);
+    model.uncertainty(x, u, g, true);
+  }
+  o.A = jac.A;
+  o.B = jac.B;
+  o.sigma = g.columns.diagonal();
+  o.plain_sigma = plain.columns.diagonal();
+  o.d_dx = g.d_dx;
+  o.d_du = g.d_du;
+  return o;
+}
+
+::testing::AssertionResult same_outputs(const StepOutputs& a, const StepOutputs& b) {
+  constexpr double kTol = 1e-12;
+  for (const auto& [x, y] : {std::pair{&a.next, &b.next}, {&a.plain_next, &b.plain_next}, {&a.sigma, &b.sigma},
+                             {&a.plain_sigma, &b.plain_sigma}})
+    if (auto r = matrices_near(*x, *y, kTol, kTol); !r) return r;
+  if (auto r = matrices_near(a.A, b.A, kTol, kTol); !r) return r << " (A)";
+  if (auto r = matrices_near(a.B, b.B, kTol, kTol); !r) return r << " (B)";
+  for (std::size_t i = 0; i < a.d_dx.size(); ++i) {
+    if (auto r = matrices_near(a.d_dx[i], b.d_dx[i], kTol, kTol); !r) return r << " (dG/dx " << i << ")";
+    if (auto r = matrices_near(a.d_du[i], b.d_du[i], kTol, kTol); !r) return r << " (dG/du " << i << ")";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+TEST_F(CartPoleResidual, SharedPredictionEqualsPerOutputPrediction) {
+  EXPECT_TRUE(model_->shares_outputs());  // fit conditions every output on one subsample
+  const ResidualModel shared = rebuilt(*model_, OutputSharing::Auto);
+  const ResidualModel reference = rebuilt(*model_, OutputSharing::Off);
+  ASSERT_TRUE(shared.shares_outputs());
+  ASSERT_FALSE(reference.shares_outputs());
+  // Points near the data, one far from it, and repeats; both call orders; the two models interleaved,
+  // so every query of `shared` follows one at another point or of another model (the per-thread cache
+  // must never serve a stale entry).
+  std::vector<Vector> points;
+  for (int k = 0; k < 6; ++k)
+    points.push_back(data_->inputs.row(17 * k).transpose() + ::gpilqg::test::random_vector(5, -0.05, 0.05, 60 + k));
+  points.push_back(Vector::Constant(5, 40.0));
+  points.push_back(points[1]);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Vector x = points[k].head(4), u = points[k].tail(1);
+    for (const bool step_first : {true, false}) {
+      const StepOutputs expected = query(reference, x, u, step_first);
+      EXPECT_TRUE(same_outputs(query(shared, x, u, step_first), expected)) << "point " << k;
+      const Vector other = points[(k + 1) % points.size()];
+      query(shared, other.head(4), other.tail(1), !step_first);
+      EXPECT_TRUE(same_outputs(query(shared, x, u, step_first), expected)) << "point " << k << " again";
+    }
+  }
+}
+
+TEST_F(CartPoleResidual, SharedPredictionIsPerThread) {
+  const ResidualModel shared = rebuilt(*model_, OutputSharing::Auto);
+  const ResidualModel reference = rebuilt(*model_, OutputSharing::Off);
+  std::vector<Vector> points;
+  for (int k = 0; k < 8; ++k) points.push_back(data_->inputs.row(11 * k).transpose());
+  std::vector<StepOutputs> expected;
+  for (const auto& z : points) expected.push_back(query(reference, z.head(4), z.tail(1), true));
+  // Two threads walk the points in opposite directions, many times, on the one shared model.
+  std::vector<int> mismatches(2, 0);
+  auto walk = [&](int t) {
+    for (int rep = 0; rep < 20; ++rep)
+      for (std::size_t j = 0; j < points.size(); ++j) {
+        const std::size_t k = t == 0 ? j : points.size() - 1 - j;
+        if (!same_outputs(query(shared, points[k].head(4), points[k].tail(1), rep % 2 == 0), expected[k]))
+          ++mismatches[static_cast<std::size_t>(t)];
+      }
+  };
+  std::thread other(walk, 1);
+  walk(0);
+  other.join();
+  EXPECT_EQ(mismatches[0], 0);
+  EXPECT_EQ(mismatches[1], 0);
+}
+
+TEST_F(CartPoleResidual, OutputsOnDifferentInputsPredictEachOnItsOwn) {
+  const ResidualModel mixed = rebuilt(*model_, OutputSharing::Auto, true);
+  const ResidualModel reference = rebuilt(*model_, OutputSharing::Off, true);
+  EXPECT_FALSE(mixed.shares_outputs());
+  const Vector z = data_->inputs.row(3).transpose();
+  EXPECT_TRUE(same_outputs(query(mixed, z.head(4), z.tail(1), true), query(reference, z.head(4), z.tail(1), true)));
 }
 
 TEST_F(CartPoleResidual, NoiseIsTheSimulators) {

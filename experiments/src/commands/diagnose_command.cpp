@@ -2,6 +2,9 @@
 /// [--out F.h5] [--plots DIR]`: compare a model with measurements, see where it fails, learn which
 /// physical effect is missing, add it and watch the error fall (DESIGN.md sections 5, 6 and 8).
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -20,11 +23,15 @@
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 #include "gpilqg/experiments/diagnosis/report_hdf5.hpp"
+#include "gpilqg/experiments/plot_script.hpp"
 #include "gpilqg/gp/backend_registry.hpp"
 
 namespace gpilqg::cli {
 
 namespace {
+
+/// The plotting script under experiments/plots/ (plot_script.hpp).
+constexpr const char* kPlotScript = "diagnose_plots.py";
 
 struct DiagnoseOptions {
   std::string system;
@@ -44,39 +51,13 @@ struct DiagnoseOptions {
   std::uint64_t seed = 1;
 };
 
-/// The interpreter that plots: $GPILQG_PYTHON, else Debian's /usr/bin/python3 (DESIGN.md section 10).
-std::string python() {
-  const char* env = std::getenv("GPILQG_PYTHON");
-  return env != nullptr && *env != '\0' ? env : "/usr/bin/python3";
-}
-
-/// experiments/scripts/diagnose_plots.py: next to the installed program (../share/gpilqg), else in the
-/// source tree this program was built from.
-std::filesystem::path plot_script() {
-  std::error_code error;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
-  if (!error) {
-    const auto installed = self.parent_path().parent_path() / "share" / "gpilqg" / "diagnose_plots.py";
-    if (std::filesystem::exists(installed)) return installed;
-  }
-  return std::filesystem::path(GPILQG_SOURCE_SCRIPTS) / "diagnose_plots.py";
-}
-
-std::string quoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-/// Checks, before any work, that the plotting interpreter has matplotlib and h5py.
+/// Checks, before any work, that plots can be drawn (exit 2 with the missing packages otherwise).
 void check_plotting() {
-  const std::string probe = quoted(python()) + " -c 'import matplotlib, h5py' >/dev/null 2>&1";
-  if (std::system(probe.c_str()) != 0)
-    throw InputError(fmt::format("--plots: {} cannot import matplotlib and h5py; expected a Python with both "
-                                 "(Debian: apt-get install python3-matplotlib python3-h5py, or set GPILQG_PYTHON)",
-                                 python()));
-  if (!std::filesystem::exists(plot_script()))
-    throw std::runtime_error("the plotting script " + plot_script().string() + " is missing");
+  try {
+    require_plotting(kPlotScript);
+  } catch (const std::runtime_error& e) {
+    throw InputError(std::string("--plots: ") + e.what());
+  }
 }
 
 diagnosis::DiagnosisOptions make_options(const DiagnoseOptions& o) {
@@ -131,10 +112,21 @@ int run_diagnose(const DiagnoseOptions& o) {
                                 {fmt::format("written by gpilqg diagnose from {} (verdict: {})", o.data, report.verdict.status),
                                  fmt::format("next: gpilqg diagnose --system {} --data {} --model {}", o.system, o.data, o.write_model)});
   if (!o.plots.empty()) {
-    const std::string command = fmt::format("{} {} {} {}{}", quoted(python()), quoted(plot_script().string()),
-                                            quoted(h5.string()), quoted(o.plots), o.json ? " >/dev/null" : "");
-    if (std::system(command.c_str()) != 0)
-      throw std::runtime_error("the plotting script failed: " + command);
+    // The script's own line goes to stdout; with --json, stdout holds the JSON document only.
+    std::cout.flush();
+    const int saved = o.json ? ::dup(STDOUT_FILENO) : -1;
+    if (saved >= 0 && !std::freopen("/dev/null", "w", stdout)) throw std::runtime_error("cannot silence stdout");
+    try {
+      run_plot_script(kPlotScript, h5, o.plots);
+    } catch (...) {
+      if (saved >= 0) ::dup2(saved, STDOUT_FILENO);
+      throw;
+    }
+    if (saved >= 0) {
+      std::fflush(stdout);
+      ::dup2(saved, STDOUT_FILENO);
+      ::close(saved);
+    }
   }
 
   if (o.json) {

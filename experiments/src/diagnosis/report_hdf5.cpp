@@ -1,13 +1,12 @@
 #include "gpilqg/experiments/diagnosis/report_hdf5.hpp"
 
-#include <H5Cpp.h>
-
 #include <chrono>
 #include <ctime>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
 #include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/hdf5_writer.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 
@@ -15,164 +14,106 @@ namespace gpilqg::diagnosis {
 
 namespace {
 
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-
-void write_string_attribute(H5::H5Object& object, const std::string& name, const std::string& value) {
-  const H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-  const char* data = value.c_str();
-  object.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, &data);
+std::vector<double> row_major(const std::vector<std::vector<Vector>>& values) {
+  std::vector<double> out;
+  for (const auto& row : values)
+    for (const Vector& v : row) out.insert(out.end(), v.data(), v.data() + v.size());
+  return out;
 }
 
-void write_int_attribute(H5::H5Object& object, const std::string& name, long value) {
-  object.createAttribute(name, H5::PredType::NATIVE_LONG, H5::DataSpace(H5S_SCALAR)).write(H5::PredType::NATIVE_LONG, &value);
-}
+void write_data(Hdf5Writer& h5, const DiagnosisReport& r) {
+  h5.write_matrix("/data/x", r.data.x);
+  h5.write_matrix("/data/u", r.data.u);
+  h5.write_matrix("/data/x_next", r.data.x_next);
+  h5.write_vector("/data/t", r.data.t);
+  h5.write_vector("/data/episode", r.data.episode);
+  h5.write_vector("/data/heldout", std::vector<int>(r.data.heldout.begin(), r.data.heldout.end()));
 
-void write_strings(H5::Group& group, const std::string& name, const std::vector<std::string>& values, bool attribute) {
-  const H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-  std::vector<const char*> data;
-  for (const auto& v : values) data.push_back(v.c_str());
-  const hsize_t dims[1] = {values.size()};
-  const H5::DataSpace space(1, dims);
-  if (values.empty()) return;
-  if (attribute)
-    group.createAttribute(name, type, space).write(type, data.data());
-  else
-    group.createDataSet(name, type, space).write(data.data(), type);
-}
-
-/// Any shape as float64 in row-major order; `dims` gives the shape.
-void write_array(H5::Group& group, const std::string& name, const double* data, std::vector<hsize_t> dims) {
-  const H5::DataSpace space(static_cast<int>(dims.size()), dims.data());
-  group.createDataSet(name, H5::PredType::IEEE_F64LE, space).write(data, H5::PredType::NATIVE_DOUBLE);
-}
-
-void write_matrix(H5::Group& group, const std::string& name, const MatrixCRef& m) {
-  const RowMajor rows = m;
-  write_array(group, name, rows.data(), {static_cast<hsize_t>(m.rows()), static_cast<hsize_t>(m.cols())});
-}
-
-void write_vector(H5::Group& group, const std::string& name, const VectorCRef& v) {
-  const Vector copy = v;
-  write_array(group, name, copy.data(), {static_cast<hsize_t>(v.size())});
-}
-
-template <class Int>
-void write_ints(H5::Group& group, const std::string& name, const std::vector<Int>& values) {
-  std::vector<long> data(values.begin(), values.end());
-  const hsize_t dims[1] = {data.size()};
-  group.createDataSet(name, H5::PredType::STD_I64LE, H5::DataSpace(1, dims)).write(data.data(), H5::PredType::NATIVE_LONG);
-}
-
-void write_data(H5::Group root, const DiagnosisReport& r) {
-  H5::Group data = root.createGroup("data");
-  write_matrix(data, "x", r.data.x);
-  write_matrix(data, "u", r.data.u);
-  write_matrix(data, "x_next", r.data.x_next);
-  write_vector(data, "t", r.data.t);
-  write_ints(data, "episode", r.data.episode);
-  write_ints(data, "heldout", std::vector<int>(r.data.heldout.begin(), r.data.heldout.end()));
-
-  H5::Group compare = root.createGroup("compare");
-  write_matrix(compare, "predicted", r.predicted);
-  write_matrix(compare, "residual", r.residual);
-  write_matrix(compare, "gp_mean", r.gp.mean);
-  write_matrix(compare, "gp_std", r.gp.variance.cwiseSqrt());
-  H5::Group states = compare.createGroup("states");
-  const auto n = static_cast<Eigen::Index>(r.states.size());
-  Vector rmse(n), floor(n), heldout(n), fit(n), structure(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const StateScore& s = r.states[static_cast<std::size_t>(i)];
-    rmse(i) = s.rmse;
-    floor(i) = s.noise_floor;
-    heldout(i) = s.heldout_rmse;
-    fit(i) = s.fit_percent;
-    structure(i) = s.gp_explained;
+  h5.write_matrix("/compare/predicted", r.predicted);
+  h5.write_matrix("/compare/residual", r.residual);
+  h5.write_matrix("/compare/gp_mean", r.gp.mean);
+  h5.write_matrix("/compare/gp_std", r.gp.variance.cwiseSqrt());
+  std::vector<double> rmse, floor, heldout, fit, structure;
+  for (const StateScore& s : r.states) {
+    rmse.push_back(s.rmse);
+    floor.push_back(s.noise_floor);
+    heldout.push_back(s.heldout_rmse);
+    fit.push_back(s.fit_percent);
+    structure.push_back(s.gp_explained);
   }
-  write_vector(states, "rmse", rmse);
-  write_vector(states, "noise_floor", floor);
-  write_vector(states, "heldout_rmse", heldout);
-  write_vector(states, "fit_percent", fit);
-  write_vector(states, "gp_explained", structure);
+  h5.write_vector("/compare/states/rmse", rmse);
+  h5.write_vector("/compare/states/noise_floor", floor);
+  h5.write_vector("/compare/states/heldout_rmse", heldout);
+  h5.write_vector("/compare/states/fit_percent", fit);
+  h5.write_vector("/compare/states/gp_explained", structure);
   for (const KStepScore& k : r.k_step) {
-    H5::Group g = compare.createGroup("k_" + std::to_string(k.k));
-    write_int_attribute(g, "k", k.k);
-    write_int_attribute(g, "stride", k.stride);
-    write_matrix(g, "measured", k.predictions.measured);
-    write_matrix(g, "predicted", k.predictions.predicted);
-    write_ints(g, "episode", k.predictions.episode);
-    write_ints(g, "start", k.predictions.start);
+    const std::string g = "/compare/k_" + std::to_string(k.k);
+    h5.write_matrix(g + "/measured", k.predictions.measured);
+    h5.write_matrix(g + "/predicted", k.predictions.predicted);
+    h5.write_vector(g + "/episode", k.predictions.episode);
+    h5.write_vector(g + "/start", k.predictions.start);
+    h5.attribute(g, "k", static_cast<std::int64_t>(k.k));
+    h5.attribute(g, "stride", static_cast<std::int64_t>(k.stride));
   }
 }
 
-void write_where(H5::Group root, const DiagnosisReport& r) {
-  H5::Group where = root.createGroup("where");
-  write_matrix(where, "relevance", r.relevance);
-  write_matrix(where, "sensitivity", r.sensitivity);
-  write_matrix(where, "episode_rmse", r.episode_rms);
-  H5::Group bins = where.createGroup("bins");
+void write_where(Hdf5Writer& h5, const DiagnosisReport& r) {
+  h5.write_matrix("/where/relevance", r.relevance);
+  h5.write_matrix("/where/sensitivity", r.sensitivity);
+  h5.write_matrix("/where/episode_rmse", r.episode_rms);
   for (const BinnedResidual& b : r.bins) {
-    H5::Group g = bins.createGroup(b.input);
-    write_vector(g, "edges", b.edges);
-    write_matrix(g, "rmse", b.rms);
-    write_ints(g, "count", b.count);
+    const std::string g = "/where/bins/" + b.input;
+    h5.write_vector(g + "/edges", b.edges);
+    h5.write_matrix(g + "/rmse", b.rms);
+    h5.write_vector(g + "/count", b.count);
   }
-  H5::Group xc = where.createGroup("cross_correlation");
   const int L = r.xcorr.max_lag;
   Vector lags(2 * L + 1);
   for (int k = -L; k <= L; ++k) lags(k + L) = k;
-  write_vector(xc, "lags", lags);
-  const auto n = r.xcorr.values.size();
-  const auto m = n > 0 ? r.xcorr.values[0].size() : 0;
-  std::vector<double> values;
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < m; ++j) values.insert(values.end(), r.xcorr.values[i][j].data(), r.xcorr.values[i][j].data() + 2 * L + 1);
-  write_array(xc, "values", values.data(), {n, m, static_cast<hsize_t>(2 * L + 1)});
-  write_matrix(xc, "band", r.xcorr.band);
+  h5.write_vector("/where/cross_correlation/lags", lags);
+  const std::uint64_t n = r.xcorr.values.size(), m = n > 0 ? r.xcorr.values[0].size() : 0;
+  h5.write_array("/where/cross_correlation/values", {n, m, static_cast<std::uint64_t>(2 * L + 1)}, row_major(r.xcorr.values));
+  h5.write_matrix("/where/cross_correlation/band", r.xcorr.band);
 }
 
-void write_ranking(H5::Group root, const DiagnosisReport& r) {
-  H5::Group g = root.createGroup("ranking");
+void write_ranking(Hdf5Writer& h5, const DiagnosisReport& r) {
   const int state = worst_state(r);
-  write_string_attribute(g, "heldout_state", r.state_names[static_cast<std::size_t>(state)]);
+  h5.attribute("/ranking", "heldout_state", r.state_names[static_cast<std::size_t>(state)]);
   if (r.ranking.empty()) return;
   std::vector<std::string> effect, parameter, unit, aliases;
-  const auto G = static_cast<Eigen::Index>(r.ranking.size());
-  Vector estimate(G), low(G), high(G), explained(G), explained_ci(G), z(G), before(G), after(G);
-  for (Eigen::Index k = 0; k < G; ++k) {
-    const RankedEffect& e = r.ranking[static_cast<std::size_t>(k)];
+  std::vector<double> estimate, low, high, explained, explained_ci, z, before, after;
+  for (const RankedEffect& e : r.ranking) {
     effect.push_back(e.fit.effect);
     parameter.push_back(e.fit.parameters[0].name);
     unit.push_back(e.fit.parameters[0].unit);
     std::string list;
     for (const EffectFit& a : e.aliases) list += (list.empty() ? "" : ",") + a.effect;
     aliases.push_back(list);
-    estimate(k) = e.fit.estimate(0);
-    low(k) = e.fit.ci_low(0);
-    high(k) = e.fit.ci_high(0);
-    explained(k) = e.fit.explained;
-    explained_ci(k) = e.fit.explained_ci;
-    z(k) = e.fit.z_score;
-    before(k) = e.fit.heldout_rmse_before(state);
-    after(k) = e.fit.heldout_rmse_after(state);
+    estimate.push_back(e.fit.estimate(0));
+    low.push_back(e.fit.ci_low(0));
+    high.push_back(e.fit.ci_high(0));
+    explained.push_back(e.fit.explained);
+    explained_ci.push_back(e.fit.explained_ci);
+    z.push_back(e.fit.z_score);
+    before.push_back(e.fit.heldout_rmse_before(state));
+    after.push_back(e.fit.heldout_rmse_after(state));
   }
-  write_strings(g, "effect", effect, false);
-  write_strings(g, "parameter_name", parameter, false);
-  write_strings(g, "unit", unit, false);
-  write_strings(g, "aliases", aliases, false);
-  write_vector(g, "estimate", estimate);
-  write_vector(g, "ci_low", low);
-  write_vector(g, "ci_high", high);
-  write_vector(g, "explained", explained);
-  write_vector(g, "explained_ci", explained_ci);
-  write_vector(g, "z_score", z);
-  write_vector(g, "heldout_rmse_before", before);
-  write_vector(g, "heldout_rmse_after", after);
+  h5.attribute("/ranking", "effect", effect);
+  h5.attribute("/ranking", "parameter_name", parameter);
+  h5.attribute("/ranking", "unit", unit);
+  h5.attribute("/ranking", "aliases", aliases);
+  h5.write_vector("/ranking/estimate", estimate);
+  h5.write_vector("/ranking/ci_low", low);
+  h5.write_vector("/ranking/ci_high", high);
+  h5.write_vector("/ranking/explained", explained);
+  h5.write_vector("/ranking/explained_ci", explained_ci);
+  h5.write_vector("/ranking/z_score", z);
+  h5.write_vector("/ranking/heldout_rmse_before", before);
+  h5.write_vector("/ranking/heldout_rmse_after", after);
 }
 
-void write_add(H5::Group root, const DiagnosisReport& r) {
+void write_add(Hdf5Writer& h5, const DiagnosisReport& r) {
   if (r.comparison.empty()) return;
-  H5::Group g = root.createGroup("add");
-  write_string_attribute(g, "effect", r.comparison_effect);
   std::vector<std::string> names;
   Matrix rmse(static_cast<Eigen::Index>(r.comparison.size()), static_cast<Eigen::Index>(r.states.size()));
   Matrix variance(2, static_cast<Eigen::Index>(r.states.size()));
@@ -182,12 +123,13 @@ void write_add(H5::Group root, const DiagnosisReport& r) {
     rmse.row(static_cast<Eigen::Index>(k)) = r.comparison[k].heldout_rmse.transpose();
     if (r.comparison[k].signal_variance.size() > 0 && with_gp < 2) variance.row(with_gp++) = r.comparison[k].signal_variance.transpose();
   }
-  write_strings(g, "model", names, false);
-  write_matrix(g, "heldout_rmse", rmse);
-  write_matrix(g, "signal_variance", variance);
-  write_matrix(g, "residual_before", r.residual_base);
-  write_matrix(g, "residual_after", r.residual_after);
-  write_matrix(g, "relevance_before", r.relevance_base);
+  h5.write_matrix("/add/heldout_rmse", rmse);
+  h5.write_matrix("/add/signal_variance", variance);
+  h5.write_matrix("/add/residual_before", r.residual_base);
+  h5.write_matrix("/add/residual_after", r.residual_after);
+  h5.write_matrix("/add/relevance_before", r.relevance_base);
+  h5.attribute("/add", "effect", r.comparison_effect);
+  h5.attribute("/add", "model", names);
 }
 
 std::string now_utc() {
@@ -203,30 +145,25 @@ std::string now_utc() {
 
 void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport& r) {
   write_atomically(file, [&](const std::filesystem::path& temporary) {
-    try {
-      H5::Exception::dontPrint();
-      H5::H5File h5(temporary.string(), H5F_ACC_TRUNC);
-      H5::Group root = h5.openGroup("/");
-      write_int_attribute(root, "schema_version", 1);
-      write_string_attribute(root, "gpilqg_version", GPILQG_VERSION_STRING);
-      write_string_attribute(root, "system", r.system);
-      write_string_attribute(root, "created", now_utc());
-      write_string_attribute(root, "status", r.verdict.status);
-      write_string_attribute(root, "verdict_effect", r.verdict.effect ? r.verdict.effect->effect : std::string());
-      write_int_attribute(root, "consistent", r.consistent ? 1 : 0);
-      write_string_attribute(root, "model", model_file_text(r.model));
-      write_string_attribute(root, "model_next", model_file_text(r.model_next));
-      write_string_attribute(root, "report", report_json(r).dump());
-      write_strings(root, "state_names", r.state_names, true);
-      write_strings(root, "control_names", r.control_names, true);
-      write_strings(root, "input_names", r.input_names, true);
-      write_data(root, r);
-      write_where(root, r);
-      write_ranking(root, r);
-      write_add(root, r);
-    } catch (const H5::Exception& e) {
-      throw std::runtime_error(file.string() + ": writing the HDF5 report failed (" + e.getDetailMsg() + ")");
-    }
+    Hdf5Writer h5(temporary);
+    h5.attribute("/", "schema_version", std::int64_t{1});
+    h5.attribute("/", "gpilqg_version", std::string(GPILQG_VERSION));
+    h5.attribute("/", "system", r.system);
+    h5.attribute("/", "created", now_utc());
+    h5.attribute("/", "status", r.verdict.status);
+    h5.attribute("/", "verdict_effect", r.verdict.effect ? r.verdict.effect->effect : std::string());
+    h5.attribute("/", "consistent", std::int64_t{r.consistent ? 1 : 0});
+    h5.attribute("/", "model", model_file_text(r.model));
+    h5.attribute("/", "model_next", model_file_text(r.model_next));
+    h5.attribute("/", "report", report_json(r).dump());
+    h5.attribute("/", "state_names", r.state_names);
+    h5.attribute("/", "control_names", r.control_names);
+    h5.attribute("/", "input_names", r.input_names);
+    write_data(h5, r);
+    write_where(h5, r);
+    write_ranking(h5, r);
+    write_add(h5, r);
+    h5.close();
   });
 }
 

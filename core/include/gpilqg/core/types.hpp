@@ -9,6 +9,8 @@ namespace gpilqg {
 
 using Vector = Eigen::VectorXd;
 using Matrix = Eigen::MatrixXd;
+/// Row-major storage: the order of HDF5 datasets and of C arrays handed to other libraries.
+using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 /// Read-only view of a vector or matrix block, so callers may pass columns, rows or segments
 /// without copying.
 using VectorCRef = Eigen::Ref<const Vector>;

@@ -19,6 +19,12 @@ class TomlFields {
  public:
   /// Parses `file`; a syntax error becomes an InputError "<file>:line N: <what>".
   static toml::table parse(const std::filesystem::path& file);
+  /// Parses TOML text; `source` names it in errors (and in the nodes' source regions).
+  static toml::table parse_text(const std::string& text, const std::string& source);
+  /// Overrides `base` with `overrides`: tables merge key by key, every other value (arrays included)
+  /// replaces the base's. A key `base` does not have is an InputError naming the overriding source,
+  /// its line and the keys that exist there.
+  static void merge(toml::table& base, const toml::table& overrides);
 
   TomlFields(const toml::table& root, std::filesystem::path file) : root_(root), file_(std::move(file)) {}
 
@@ -39,6 +45,8 @@ class TomlFields {
 
  private:
   const toml::node* find(const std::string& path) const;
+  /// The file a node was read from (its source region), else the file this reader was made for.
+  std::string source_of(const toml::node* node) const;
   const toml::table& root_;
   std::filesystem::path file_;
 };

@@ -31,6 +31,10 @@
 
 namespace gpilqg::gp {
 
+namespace detail {
+class SharedExactPrediction;
+}
+
 /// Inputs and residual targets of all outputs: rows are samples.
 struct ResidualData {
   Matrix inputs;     ///< N x (n + m), z = [x; u]
@@ -52,6 +56,12 @@ ResidualData make_residual_data(const StepModel& simulator, const MatrixCRef& x,
 /// more than 1e-6 relative (naming the episode and both values).
 ResidualData make_residual_data(const StepModel& simulator, const MeasurementSet& measurements);
 
+/// Whether the outputs share per-query work at prediction time (see ResidualModel).
+enum class OutputSharing {
+  Auto,  ///< share when every output is an exact GP on the same training inputs (the default)
+  Off,   ///< every output predicts on its own through FittedGp::predict (the reference path)
+};
+
 struct ResidualModelOptions {
   FitOptions fit;            ///< per output (the seed is offset by the output index for restarts)
   ResampleOptions resample;  ///< used when a validation set is given
@@ -72,7 +82,15 @@ class ResidualModel final : public StepModel {
 
   /// Wraps already-fitted GPs, one per state: outputs[i] has input_dim n + m. Throws
   /// std::invalid_argument for a null simulator, a wrong number of outputs or a wrong input dimension.
-  ResidualModel(SimulatorPtr simulator, std::vector<std::unique_ptr<FittedGp>> outputs);
+  ///
+  /// Shared prediction (issue #3 point 4): when every output is an exact GP on the same training
+  /// inputs X (what fit produces: one subsample for all outputs), the outputs share what depends only
+  /// on X and the query z: the squared differences (x_id - z_d)^2 are formed once per query for all
+  /// outputs, and the cross-covariances k_a(X, z) once per (x, u) for both step and uncertainty (the DDP
+  /// engine calls the two at the same point), so uncertainty does not recompute the means. The
+  /// results equal the per-output path's (OutputSharing::Off) to the bit; only the time differs.
+  ResidualModel(SimulatorPtr simulator, std::vector<std::unique_ptr<FittedGp>> outputs,
+                OutputSharing sharing = OutputSharing::Auto);
 
   /// Fits one GP per state on `data`, outputs in parallel. All outputs train on the same subsample
   /// (one draw of backend.select_training_points), so they share their inputs. With `validation`
@@ -101,6 +119,9 @@ class ResidualModel final : public StepModel {
   void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
                    bool derivatives) const override;
 
+  /// Whether the outputs share per-query work (see the constructor).
+  bool shares_outputs() const { return shared_ != nullptr; }
+
   /// The GP of state i.
   const FittedGp& output(int i) const { return *outputs_.at(static_cast<std::size_t>(i)); }
   const StepModel& simulator() const { return *simulator_; }
@@ -109,6 +130,7 @@ class ResidualModel final : public StepModel {
  private:
   SimulatorPtr simulator_;
   std::vector<std::shared_ptr<const FittedGp>> outputs_;
+  std::shared_ptr<const detail::SharedExactPrediction> shared_;  // null: per-output prediction
 };
 
 }  // namespace gpilqg::gp

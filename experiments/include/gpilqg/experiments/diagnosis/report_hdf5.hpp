@@ -13,12 +13,12 @@
 ///   /where/relevance, /where/sensitivity (n x (n + m)); /where/episode_rmse (E x n)
 ///   /where/bins/<input>/{edges (B + 1), rmse (n x B), count (B)}
 ///   /where/cross_correlation/{lags (2L + 1), values (n x m x (2L + 1)), band (n x m)}
-///   /ranking/{effect, parameter_name, unit (G strings), estimate, ci_low, ci_high, explained, explained_ci,
-///             z_score, heldout_rmse_before, heldout_rmse_after (G), aliases (G strings, comma-separated)}
-///             attrs: heldout_state
-///   /add/{model (4 strings), heldout_rmse (4 x n), signal_variance (2 x n: sim+GP, sim+effect+GP),
+///   /ranking/{estimate, ci_low, ci_high, explained, explained_ci, z_score, heldout_rmse_before,
+///             heldout_rmse_after (G)}  attrs: heldout_state, effect, parameter_name, unit, aliases (G strings,
+///             aliases comma-separated)
+///   /add/{heldout_rmse (4 x n, rows as attribute model), signal_variance (2 x n: sim+GP, sim+effect+GP),
 ///         residual_before, residual_after (N x n: "sim" and "sim+effect"), relevance_before (n x (n + m))}
-///         attrs: effect       (present when the report has the four models)
+///         attrs: effect, model (4 strings)       (present when the report has the four models)
 
 #include <filesystem>
 
@@ -26,7 +26,8 @@
 
 namespace gpilqg::diagnosis {
 
-/// Writes the report. Throws std::runtime_error naming the file when HDF5 fails.
+/// Writes the report with core's Hdf5Writer, through a temporary file. Throws std::runtime_error
+/// naming the file when HDF5 fails.
 void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport& report);
 
 }  // namespace gpilqg::diagnosis

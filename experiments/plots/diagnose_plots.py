@@ -88,16 +88,17 @@ def residual_band(f, out, states, shown):
 
 
 def ranking(f, out):
-    if "ranking" not in f or "effect" not in f["ranking"]:
+    if "ranking" not in f or "effect" not in f["ranking"].attrs:
         return
     g = f["ranking"]
-    effects = names(g["effect"][()])
+    effects = names(g.attrs["effect"])
+    parameter, unit, alias_lists = names(g.attrs["parameter_name"]), names(g.attrs["unit"]), names(g.attrs["aliases"])
     explained = g["explained"][()]
     ci = g["explained_ci"][()]
     labels = []
     for k, e in enumerate(effects):
-        label = f"{e}\n{text(g['parameter_name'][k])} = {g['estimate'][k]:.3g} [{g['ci_low'][k]:.3g}, {g['ci_high'][k]:.3g}] {text(g['unit'][k])}"
-        aliases = text(g["aliases"][k])
+        label = f"{e}\n{parameter[k]} = {g['estimate'][k]:.3g} [{g['ci_low'][k]:.3g}, {g['ci_high'][k]:.3g}] {unit[k]}"
+        aliases = alias_lists[k]
         if aliases:
             label += f"\naliases: {aliases}"
         labels.append(label)

@@ -1,0 +1,71 @@
+#pragma once
+/// @file algorithm_runs.hpp
+/// The algorithms of `gpilqg run` on one task and one seed (DESIGN.md section 7 names):
+///
+///   ilqg_real   iLQG on the true (real-world) model: the reference optimum
+///   ilqg_sim    iLQG on the simulator only
+///   gp_ilqg     the paper's Algorithm 1: Robust-iLQG on simulator + GP residual, refitted on the
+///               real-world rollouts of each iteration's policy (gp_ilqg_<backend> per GP backend)
+///   pddp        PDDP trained at every iteration on exactly the data gp_ilqg had (the paper's protocol)
+///   pddp_own    PDDP as published: random-control episodes first, then its own policy's rollouts
+///
+/// Every run has config.iterations + 1 iterations: iteration 0 is the policy before any data of this
+/// task (for a transfer task, with the previous task's data), iteration k the policy after k rounds
+/// of rollouts. A loop that converged (policy change below loop.policy_tolerance) stops collecting
+/// and repeats its last iteration, marked `repeated`; so does a fixed-model algorithm.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gpilqg/experiments/task_actions.hpp"
+#include "gpilqg/gp/backend.hpp"
+
+namespace gpilqg {
+
+/// Measured transitions (rows): x_t, u_t, x_{t+1} as the real world's sensors saw them.
+struct TransitionData {
+  Matrix x, u, x_next;
+  std::vector<int> iteration;  ///< the iteration whose rollouts produced each row (-1: an earlier task)
+  int size() const { return static_cast<int>(x.rows()); }
+  /// Appends the completed transitions of a rollout.
+  void append(const RealRollout& rollout, int iteration);
+  /// The first `rows` rows.
+  TransitionData head(int rows) const;
+};
+
+struct IterationRecord {
+  Plan plan;
+  Evaluation evaluation;
+  int data_rows = 0;            ///< transitions the plan's model was fitted on
+  double fit_seconds = 0.0;
+  double rollout_seconds = 0.0;  ///< data-collection rollouts after this iteration's plan
+  double policy_change = -1.0;   ///< AffinePolicy::distance to the previous iteration (-1: none)
+  std::vector<Vector> hyperparameters;  ///< per state output: [log l (n+m); log sf; log sn] (empty: no GP)
+  bool repeated = false;        ///< a copy of the previous iteration (converged or fixed model)
+};
+
+struct AlgorithmRun {
+  std::string name;
+  std::vector<IterationRecord> iterations;
+  int converged_at = -1;  ///< first iteration whose policy change fell below the tolerance (-1: never)
+  TransitionData data;    ///< everything it collected, including data carried over from an earlier task
+  std::shared_ptr<const StepModel> final_model;  ///< the last plan's model (GP-ILQG: the residual model)
+};
+
+/// ilqg_real (world) or ilqg_sim (simulator): one iLQG plan, evaluated once, repeated.
+AlgorithmRun run_fixed_model(const TaskContext& context, const std::string& name,
+                             std::shared_ptr<const StepModel> model, std::uint64_t seed);
+
+/// Algorithm 1 with `backend`, starting from `initial` data (an earlier task's, or empty).
+AlgorithmRun run_gp_ilqg(const TaskContext& context, const std::string& name, const gp::GpBackend& backend,
+                         TransitionData initial, std::uint64_t seed);
+
+/// PDDP on the data `source` had at each of its iterations (no rollouts of its own).
+AlgorithmRun run_pddp_on_data_of(const TaskContext& context, const AlgorithmRun& source, std::uint64_t seed);
+
+/// PDDP collecting its own data: when `initial` is empty, config.pddp_own_initial_rollouts random
+/// episodes first.
+AlgorithmRun run_pddp_own(const TaskContext& context, TransitionData initial, std::uint64_t seed);
+
+}  // namespace gpilqg

@@ -1,0 +1,40 @@
+#pragma once
+/// @file run_results_io.hpp
+/// The result file of `gpilqg run` (DESIGN.md section 7; README "Results file" documents it with an
+/// h5py example). S seeds, K + 1 iterations, E evaluation rollouts, T steps, n states, m controls,
+/// D = n + m GP inputs; every dataset is float64:
+///
+///   /                       attrs: schema_version (1), gpilqg_version, config (full TOML), seed (first),
+///                           created (UTC, ISO 8601), system
+///   /seeds                  (S)
+///   /<task>                 attrs: algorithms (names in run order), transfer (0/1), horizon, dt
+///   /<task>/data/{x, u, dx} (N x n, N x m, N x n): the real-world transitions gp_ilqg collected, all
+///                           seeds and iterations, measured (dx = x' - x); plus seed (N), iteration (N)
+///   /<task>/<algorithm>/cost             (K+1 x S) mean real-world cost of each iteration's policy
+///   /<task>/<algorithm>/normalised_cost  (K+1 x S) cost / ilqg_real's cost of the same seed
+///   /<task>/<algorithm>/evaluation_costs (K+1 x S x E) the single rollouts behind `cost`
+///   /<task>/<algorithm>/{time_fit, time_solve, time_rollouts, time_evaluation} (K+1 x S) [s]
+///   /<task>/<algorithm>/{data_rows, repeated, diverged} (K+1 x S); converged_at (S), -1: never
+///   /<task>/<algorithm>/iter_<k>/x (S x n x T+1), u (S x m x T): the plan's nominal trajectory
+///   /<task>/<algorithm>/iter_<k>/K (S x T x m x n), k (S x m x T): its feedback and feed-forward
+///   /<task>/<algorithm>/iter_<k>/{predicted_cost, solve_time} (S)
+///   /<task>/<algorithm>/iter_<k>/{eval_x, eval_u} (S x n x T+1, S x m x T): the first evaluation rollout
+///   /<task>/<algorithm>/gp/<state>/hyper (K+1 x S x D+2): [log l; log sf; log sn], zeros where
+///                           gp/<state>/fitted (K+1 x S) is 0 (no GP yet); gp_ilqg algorithms only
+///   /<task>/figure1/{grid, simulator, mean, std, truth, data_z, data_y, base}: the 1-D model slice,
+///                           attrs output, input (names)
+///   /<task>/gp_ilqg         a soft link to gp_ilqg_<first backend> when GP backends are compared
+///
+/// The file is written to a temporary name in the same folder and renamed into place, so a reader
+/// never sees a half-written result and an interrupted write leaves any previous file intact.
+
+#include <filesystem>
+
+#include "gpilqg/experiments/run_experiment.hpp"
+
+namespace gpilqg {
+
+/// Writes `results` atomically. Throws std::runtime_error naming the file when writing fails.
+void write_run_results(const std::filesystem::path& file, const RunResults& results);
+
+}  // namespace gpilqg

@@ -1,0 +1,86 @@
+#pragma once
+/// @file task_actions.hpp
+/// The three things every algorithm of `gpilqg run` does on a task, written once:
+///
+///  - plan: a finite-horizon DDP solve on some model (iLQG on the world or the simulator, Robust-iLQG
+///    on the GP-corrected simulator, DDP over the belief for PDDP) gives a Plan: nominal trajectory,
+///    affine feedback policy, the predicted cost and the solve time;
+///  - act: a Plan becomes a closed-loop controller: its affine policy, or, when [mpc] is enabled, a
+///    receding-horizon DDP on the same model warm-started from the plan (the paper's quadrotor);
+///  - roll out on the real world: the controller sees noisy measurements, the world samples its
+///    process noise; data rollouts also perturb the control (exploration) and record what was
+///    measured; evaluation rollouts use the shared evaluation streams.
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <random>
+#include <vector>
+
+#include "gpilqg/control/ddp_solver.hpp"
+#include "gpilqg/control/mpc.hpp"
+#include "gpilqg/experiments/run_setup.hpp"
+
+namespace gpilqg {
+
+struct Plan {
+  AffinePolicy policy;          ///< x_bar, u_bar, K (k = 0); what the result stores as iter_<k>/{x,u,K,k}
+  double predicted_cost = 0.0;  ///< the solver's expected cost on its own model
+  double solve_seconds = 0.0;
+  DdpSummary summary;
+  std::shared_ptr<const StepModel> model;  ///< what MPC re-plans on (null: the policy only, e.g. PDDP's)
+  DdpVariant variant = DdpVariant::ILQG;
+};
+
+/// The context of one task: config, task, models and cost (all outlive the actions), and where
+/// progress lines go (may be empty).
+struct TaskContext {
+  const RunConfig& config;
+  const RunTask& task;
+  int task_index;
+  const RunModels& models;
+  const Cost& cost;
+  std::function<void(const std::string&)> progress;
+};
+
+/// DDP on `model` (kept alive by the plan, for MPC) from the controls `u_start` (m x T; empty: config.u_init repeated), limited by
+/// [control]; `variant` ILQG (process noise F) or RobustILQG (F and the GP's G).
+Plan plan_with_ddp(const TaskContext& context, std::shared_ptr<const StepModel> model, DdpVariant variant,
+                   const Matrix& u_start);
+
+/// The plan of an algorithm that has no model yet: the open-loop controls config.u_init (PDDP before
+/// it has data).
+Plan open_loop_plan(const TaskContext& context);
+
+/// A controller that acts on measured states (see the file comment). `holder` keeps the MPC state
+/// alive for as long as the controller is used.
+Controller make_controller(const TaskContext& context, const Plan& plan, std::unique_ptr<MpcController>& holder);
+
+/// One rollout on the real world.
+struct RealRollout {
+  Trajectory truth;    ///< true states and applied controls
+  int steps_completed = 0;  ///< transitions before a divergence (the horizon when finite)
+  Matrix measured;     ///< n x (T+1): the measured states (what the controller saw, and x_T measured)
+  bool finite = true;  ///< false: the world diverged (the trajectory holds the last finite state)
+  double cost = 0.0;   ///< the task cost of the true trajectory
+};
+
+/// Runs `plan` on the world from the task's x0 for its horizon, with Gaussian exploration of std
+/// `exploration` (empty: none) added to every control.
+RealRollout roll_out(const TaskContext& context, const Plan& plan, const Vector& exploration, std::mt19937_64& rng);
+
+/// Open-loop random excitation: each control drawn uniformly in u_init +- amplitude, held for 5 steps.
+RealRollout random_rollout(const TaskContext& context, const Vector& amplitude, std::mt19937_64& rng);
+
+/// The reported cost of a plan: the mean task cost of config.evaluation_rollouts rollouts on the
+/// world, with the shared evaluation streams of `seed`.
+struct Evaluation {
+  double mean_cost = 0.0;
+  std::vector<double> costs;
+  Trajectory example;  ///< the first evaluation rollout (for the figures)
+  int diverged = 0;
+  double seconds = 0.0;
+};
+Evaluation evaluate(const TaskContext& context, const Plan& plan, std::uint64_t seed);
+
+}  // namespace gpilqg

@@ -1,0 +1,235 @@
+#include "gpilqg/experiments/algorithm_runs.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+
+#include <fmt/format.h>
+
+#include "gpilqg/control/belief_space.hpp"
+#include "gpilqg/gp/exact_gp.hpp"
+#include "gpilqg/gp/gp_belief_dynamics.hpp"
+#include "gpilqg/gp/residual_model.hpp"
+
+namespace gpilqg {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// A stable number for an algorithm's name (FNV-1a), so its random streams do not depend on the
+/// order in which algorithms run.
+std::uint64_t stream_id(const std::string& name) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const char ch : name) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
+  return h;
+}
+
+void report(const TaskContext& c, const std::string& name, int k, const IterationRecord& r) {
+  if (!c.progress) return;
+  c.progress(fmt::format("{} {} iteration {}/{}: cost {:.4g}{} (data {}, fit {:.1f} s, solve {:.1f} s, rollouts {:.1f} s, "
+                         "evaluation {:.1f} s{})",
+                         c.task.name, name, k, c.config.iterations, r.evaluation.mean_cost,
+                         r.evaluation.diverged ? fmt::format(", {} diverged", r.evaluation.diverged) : "", r.data_rows,
+                         r.fit_seconds, r.plan.solve_seconds, r.rollout_seconds, r.evaluation.seconds,
+                         r.policy_change >= 0.0 ? fmt::format(", policy change {:.3g}", r.policy_change) : ""));
+}
+
+/// Plans from data; fills the record's fit time and hyperparameters and may keep the plan's model.
+using DataPlanner = std::function<Plan(const TransitionData& data, const Plan* previous, IterationRecord& record)>;
+
+/// The loop every data-driven algorithm shares (Algorithm 1's structure): plan from the data,
+/// evaluate, stop when the policy no longer changes, else roll the policy out config.rollouts times
+/// with exploration and add what was measured. With `borrowed`, the data of iteration k is what that
+/// run had at its iteration k, and nothing is collected.
+AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, TransitionData initial, std::uint64_t seed,
+                           const DataPlanner& planner, const AlgorithmRun* borrowed = nullptr) {
+  AlgorithmRun run;
+  run.name = name;
+  run.data = std::move(initial);
+  const std::uint64_t id = stream_id(name);
+  const int K = c.config.iterations;
+  bool stopped = false;
+  for (int k = 0; k <= K; ++k) {
+    const IterationRecord* previous = k > 0 ? &run.iterations.back() : nullptr;
+    const TransitionData data =
+        borrowed != nullptr ? borrowed->data.head(borrowed->iterations.at(static_cast<std::size_t>(k)).data_rows)
+                            : run.data;
+    if (stopped || (borrowed != nullptr && previous != nullptr && data.size() == previous->data_rows)) {
+      IterationRecord copy = *previous;
+      copy.repeated = true;
+      copy.rollout_seconds = copy.fit_seconds = 0.0;
+      copy.plan.solve_seconds = copy.evaluation.seconds = 0.0;
+      run.iterations.push_back(std::move(copy));
+      continue;
+    }
+    IterationRecord record;
+    record.data_rows = data.size();
+    record.plan = planner(data, previous != nullptr ? &previous->plan : nullptr, record);
+    record.evaluation = evaluate(c, record.plan, seed);
+    if (previous != nullptr) {
+      record.policy_change = record.plan.policy.distance(previous->plan.policy);
+      if (record.policy_change <= c.config.policy_tolerance && run.converged_at < 0) {
+        run.converged_at = k;
+        stopped = borrowed == nullptr;  // a borrowing run follows its source's data to the end
+      }
+    }
+    if (borrowed == nullptr && !stopped && k < K) {
+      const auto start = std::chrono::steady_clock::now();
+      for (int r = 0; r < c.config.rollouts; ++r) {
+        auto rng = make_rng(seed, c.task_index, RandomStream::DataRollout,
+                            {id, static_cast<std::uint64_t>(k), static_cast<std::uint64_t>(r)});
+        run.data.append(roll_out(c, record.plan, c.config.exploration_std, rng), k);
+      }
+      record.rollout_seconds = seconds_since(start);
+    }
+    report(c, name, k, record);
+    run.final_model = record.plan.model;
+    run.iterations.push_back(std::move(record));
+  }
+  return run;
+}
+
+Matrix warm_start(const Plan* previous) { return previous != nullptr ? previous->policy.u_bar : Matrix(); }
+
+gp::FitOptions fit_options(const TaskContext& c, std::uint64_t seed, const std::string& name, int data_rows) {
+  gp::FitOptions options;
+  options.restarts = c.config.restarts;
+  options.max_evaluations = c.config.max_evaluations;
+  options.seed = derive_seed(seed, c.task_index, RandomStream::GpFit,
+                             {stream_id(name), static_cast<std::uint64_t>(data_rows)});
+  return options;
+}
+
+}  // namespace
+
+void TransitionData::append(const RealRollout& rollout, int iteration_index) {
+  const int T = rollout.steps_completed;
+  const int n = static_cast<int>(rollout.measured.rows());
+  const int m = static_cast<int>(rollout.truth.u.rows());
+  const int old = size();
+  x.conservativeResize(old + T, n);
+  u.conservativeResize(old + T, m);
+  x_next.conservativeResize(old + T, n);
+  for (int t = 0; t < T; ++t) {
+    x.row(old + t) = rollout.measured.col(t).transpose();
+    u.row(old + t) = rollout.truth.u.col(t).transpose();
+    x_next.row(old + t) = rollout.measured.col(t + 1).transpose();
+    iteration.push_back(iteration_index);
+  }
+}
+
+TransitionData TransitionData::head(int rows) const {
+  TransitionData out;
+  out.x = x.topRows(rows);
+  out.u = u.topRows(rows);
+  out.x_next = x_next.topRows(rows);
+  out.iteration.assign(iteration.begin(), iteration.begin() + rows);
+  return out;
+}
+
+AlgorithmRun run_fixed_model(const TaskContext& c, const std::string& name, std::shared_ptr<const StepModel> model,
+                             std::uint64_t seed) {
+  AlgorithmRun run;
+  run.name = name;
+  IterationRecord record;
+  record.plan = plan_with_ddp(c, std::move(model), DdpVariant::ILQG, Matrix());
+  record.evaluation = evaluate(c, record.plan, seed);
+  report(c, name, 0, record);
+  run.final_model = record.plan.model;
+  run.iterations.push_back(record);
+  record.repeated = true;
+  record.plan.solve_seconds = record.evaluation.seconds = 0.0;
+  for (int k = 1; k <= c.config.iterations; ++k) run.iterations.push_back(record);
+  return run;
+}
+
+AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp::GpBackend& backend,
+                         TransitionData initial, std::uint64_t seed) {
+  std::shared_ptr<const gp::ResidualModel> last;
+  const DataPlanner planner = [&](const TransitionData& data, const Plan* previous, IterationRecord& record) {
+    // Algorithm 1: without data, iLQG on the simulator (Robust-iLQG without G is iLQG).
+    if (data.size() == 0) return plan_with_ddp(c, c.models.simulator, DdpVariant::ILQG, warm_start(previous));
+    const auto start = std::chrono::steady_clock::now();
+    const gp::ResidualData all = gp::make_residual_data(*c.models.simulator, data.x, data.u, data.x_next);
+    // The paper's re-sample rule, judged on the newest rollouts.
+    const int newest = *std::max_element(data.iteration.begin(), data.iteration.end());
+    std::vector<int> recent;
+    for (int i = 0; i < data.size(); ++i)
+      if (data.iteration[static_cast<std::size_t>(i)] == newest) recent.push_back(i);
+    const gp::ResidualData validation = all.subset(recent);
+    gp::ResidualModelOptions options;
+    options.fit = fit_options(c, seed, name, data.size());
+    options.threads = 2;
+    auto model = std::make_shared<const gp::ResidualModel>(gp::ResidualModel::fit(
+        c.models.simulator, all, backend, options, nullptr, last ? &validation : nullptr, last.get()));
+    record.fit_seconds = seconds_since(start);
+    const int D = static_cast<int>(all.inputs.cols());
+    for (int i = 0; i < model->state_dim(); ++i) record.hyperparameters.push_back(model->output(i).parameters().head(D + 2));
+    last = model;
+    return plan_with_ddp(c, model, DdpVariant::RobustILQG, warm_start(previous));
+  };
+  return learning_loop(c, name, std::move(initial), seed, planner);
+}
+
+namespace {
+
+/// PDDP's plan from data: n GPs on z = [x; u] -> x' - x (no simulator), moment matching, DDP over the
+/// belief from N(x0, diag(observation_std^2)); the policy acts on measured states (belief_space.hpp).
+DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uint64_t seed) {
+  return [&c, name, seed](const TransitionData& data, const Plan* previous, IterationRecord& record) {
+    if (data.size() == 0) return open_loop_plan(c);  // no data, no model: PDDP's initial controls
+    const auto start = std::chrono::steady_clock::now();
+    const int n = static_cast<int>(data.x.cols()), m = static_cast<int>(data.u.cols());
+    Matrix inputs(data.size(), n + m);
+    inputs << data.x, data.u;
+    const Matrix increments = data.x_next - data.x;
+    gp::ExactGpOptions exact;
+    exact.max_training_points = c.config.backend_settings.exact_points;
+    const gp::ExactGpBackend backend(exact);
+    const auto dynamics = gp::GpBeliefDynamics::fit(n, m, c.config.dt, inputs, increments, backend,
+                                                    fit_options(c, seed, name, data.size()));
+    record.fit_seconds = seconds_since(start);
+
+    PddpProblem problem;
+    problem.model = &dynamics;
+    problem.cost = &c.cost;
+    problem.x0 = c.task.x0;
+    problem.Sigma0 = c.config.observation_std.array().square().matrix().asDiagonal();
+    problem.horizon = c.task.horizon;
+    problem.u_min = c.config.u_min;
+    problem.u_max = c.config.u_max;
+    DdpOptions options = c.config.solver;
+    options.max_iterations = c.config.pddp_max_iterations;
+    const Matrix u_start = previous != nullptr ? previous->policy.u_bar : Matrix(c.config.u_init.replicate(1, c.task.horizon));
+    const auto solve_start = std::chrono::steady_clock::now();
+    PddpResult result = solve_pddp(problem, u_start, options);
+    Plan plan;
+    plan.solve_seconds = seconds_since(solve_start);
+    plan.policy = std::move(result.state_policy);
+    plan.predicted_cost = result.belief.expected_cost;
+    plan.summary = std::move(result.belief.summary);
+    plan.variant = DdpVariant::ILQR;
+    return plan;  // no StepModel: PDDP's policy acts without MPC
+  };
+}
+
+}  // namespace
+
+AlgorithmRun run_pddp_on_data_of(const TaskContext& c, const AlgorithmRun& source, std::uint64_t seed) {
+  return learning_loop(c, "pddp", TransitionData{}, seed, pddp_planner(c, "pddp", seed), &source);
+}
+
+AlgorithmRun run_pddp_own(const TaskContext& c, TransitionData initial, std::uint64_t seed) {
+  const std::string name = "pddp_own";
+  if (initial.size() == 0) {
+    for (int r = 0; r < c.config.pddp_own_initial_rollouts; ++r) {
+      auto rng = make_rng(seed, c.task_index, RandomStream::RandomData, {stream_id(name), static_cast<std::uint64_t>(r)});
+      initial.append(random_rollout(c, c.config.pddp_own_amplitude, rng), -1);
+    }
+  }
+  return learning_loop(c, name, std::move(initial), seed, pddp_planner(c, name, seed));
+}
+
+}  // namespace gpilqg

@@ -1,0 +1,188 @@
+#include "gpilqg/experiments/run_config.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "embedded_run_configs.hpp"
+#include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/toml_fields.hpp"
+
+namespace gpilqg {
+namespace {
+
+/// Reads the [[tasks]] array: at least one task, every field present (a replaced array has no
+/// defaults to fall back on), names unique.
+std::vector<RunTask> read_tasks(const TomlFields& f, const toml::table& root, int n, int m) {
+  const toml::array* tasks = root["tasks"].as_array();
+  if (tasks == nullptr || tasks->empty()) f.fail("tasks", "expected a non-empty array of [[tasks]] tables");
+  std::vector<RunTask> out;
+  for (std::size_t i = 0; i < tasks->size(); ++i) {
+    const std::string p = fmt::format("tasks[{}]", i);
+    if (!(*tasks)[i].is_table()) f.fail(p, "is not a table; expected [[tasks]]");
+    f.only_keys(p, {"name", "x0", "goal", "horizon", "Q", "R", "Qf", "track_line", "transfer"});
+    RunTask t;
+    t.name = f.string(p + ".name");
+    if (t.name.empty() || t.name.find_first_of("/ ") != std::string::npos)
+      f.fail(p + ".name", "must be non-empty without '/' or spaces (it names an HDF5 group)");
+    for (const auto& earlier : out)
+      if (earlier.name == t.name) f.fail(p + ".name", fmt::format("'{}' is used by two tasks", t.name));
+    t.x0 = f.vector(p + ".x0", n);
+    t.goal = f.vector(p + ".goal", n);
+    t.horizon = static_cast<int>(f.integer(p + ".horizon"));
+    if (t.horizon < 2) f.fail(p + ".horizon", "must be >= 2");
+    t.Q = f.vector(p + ".Q", n);
+    t.R = f.vector(p + ".R", m);
+    t.Qf = f.vector(p + ".Qf", n);
+    for (const char* w : {".Q", ".R", ".Qf"})
+      if ((f.vector(p + w, -1).array() < 0.0).any()) f.fail(p + w, "has negative entries; expected weights >= 0");
+    if ((t.R.array() <= 0.0).any()) f.fail(p + ".R", "must be > 0 (the control weight makes each step well posed)");
+    const auto flag = [&](const std::string& key) {
+      const toml::node* node = root.at_path(p + "." + key).node();
+      if (node == nullptr) f.fail(p + "." + key, "missing; expected true or false");
+      if (!node->is_boolean()) f.fail(p + "." + key, "is not a boolean; expected true or false");
+      return node->as_boolean()->get();
+    };
+    t.track_line = flag("track_line");
+    t.transfer = flag("transfer");
+    if (i == 0 && t.transfer) f.fail(p + ".transfer", "the first task has no previous task to transfer from");
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+bool boolean(const TomlFields& f, const toml::table& root, const std::string& path) {
+  const toml::node* node = root.at_path(path).node();
+  if (node == nullptr) f.fail(path, "missing; expected true or false");
+  if (!node->is_boolean()) f.fail(path, "is not a boolean; expected true or false");
+  return node->as_boolean()->get();
+}
+
+int positive_integer(const TomlFields& f, const std::string& path, int minimum) {
+  const long value = f.integer(path);
+  if (value < minimum) f.fail(path, fmt::format("is {}; expected >= {}", value, minimum));
+  return static_cast<int>(value);
+}
+
+Vector non_negative(const TomlFields& f, const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) {
+  Vector v = f.vector(path, size, std::move(fallback));
+  if ((v.array() < 0.0).any()) f.fail(path, "has negative entries; expected standard deviations >= 0");
+  return v;
+}
+
+RunConfig read_run_config(const toml::table& root, const std::string& source) {
+  const TomlFields f(root, source);
+  f.only_keys("", {"system", "noise", "control", "tasks", "loop", "gp", "solver", "mpc", "pddp"});
+  RunConfig c;
+  c.system = f.string("system.name");
+  SystemSignature signature;
+  try {
+    signature = system_signature(c.system);
+  } catch (const std::invalid_argument& e) {
+    f.fail("system.name", e.what());
+  }
+  const int n = static_cast<int>(signature.states.size());
+  const int m = static_cast<int>(signature.controls.size());
+
+  c.dt = f.number("system.dt");
+  if (c.dt <= 0.0) f.fail("system.dt", "must be > 0");
+  const std::string integrator = f.string("system.integrator");
+  if (auto i = parse_integrator(integrator)) c.integrator = *i;
+  else f.fail("system.integrator", fmt::format("'{}'; expected \"euler\" or \"rk4\"", integrator));
+  c.substeps = positive_integer(f, "system.substeps", 1);
+
+  c.noise.multiplicative_std = non_negative(f, "noise.actuator_multiplicative", m, Vector());
+  c.noise.additive_std = non_negative(f, "noise.actuator_additive", m, Vector());
+  c.observation_std = non_negative(f, "noise.observation", n, Vector::Zero(n));
+
+  c.u_init = f.vector("control.u_init", m);
+  c.u_min = f.vector("control.u_min", m, Vector());
+  c.u_max = f.vector("control.u_max", m, Vector());
+  if (c.u_min.size() && c.u_max.size() && (c.u_min.array() > c.u_max.array()).any())
+    f.fail("control.u_min", "exceeds control.u_max");
+
+  c.tasks = read_tasks(f, root, n, m);
+
+  c.iterations = positive_integer(f, "loop.iterations", 1);
+  c.rollouts = positive_integer(f, "loop.rollouts", 1);
+  c.exploration_std = non_negative(f, "loop.exploration", m);
+  c.policy_tolerance = f.number("loop.policy_tolerance");
+  if (c.policy_tolerance < 0.0) f.fail("loop.policy_tolerance", "must be >= 0");
+  c.evaluation_rollouts = positive_integer(f, "loop.evaluation_rollouts", 1);
+
+  c.backend = f.string("gp.backend");
+  c.backend_settings.exact_points = positive_integer(f, "gp.exact_points", 2);
+  c.backend_settings.inducing = positive_integer(f, "gp.inducing", 1);
+  c.backend_settings.frequencies = positive_integer(f, "gp.frequencies", 1);
+  try {
+    (void)gp::make_backend(c.backend, c.backend_settings);
+  } catch (const std::invalid_argument& e) {
+    f.fail("gp.backend", e.what());
+  }
+  c.restarts = positive_integer(f, "gp.restarts", 0);
+  c.max_evaluations = positive_integer(f, "gp.max_evaluations", 1);
+
+  c.solver.max_iterations = positive_integer(f, "solver.max_iterations", 1);
+  c.solver.cost_tolerance = f.number("solver.tolerance");
+  c.solver.gradient_tolerance = f.number("solver.gradient_tolerance");
+  try {
+    c.solver.validate();
+  } catch (const std::invalid_argument& e) {
+    f.fail("solver", e.what());
+  }
+
+  c.mpc = boolean(f, root, "mpc.enabled");
+  if (c.mpc) {
+    c.mpc_options.horizon = positive_integer(f, "mpc.horizon", 1);
+    c.mpc_options.first_solve_iterations = positive_integer(f, "mpc.first_solve_iterations", 1);
+    c.mpc_options.iterations_per_step = positive_integer(f, "mpc.iterations_per_step", 1);
+  }
+
+  c.pddp = boolean(f, root, "pddp.enabled");
+  c.pddp_max_iterations = positive_integer(f, "pddp.max_iterations", 1);
+  c.pddp_own = boolean(f, root, "pddp.own");
+  c.pddp_own_initial_rollouts = positive_integer(f, "pddp.own_initial_rollouts", 1);
+  c.pddp_own_amplitude = non_negative(f, "pddp.own_amplitude", m);
+
+  std::ostringstream text;
+  text << toml::toml_formatter{root};
+  c.text = text.str();
+  return c;
+}
+
+}  // namespace
+
+const std::string& default_run_config_text(const std::string& system) {
+  static const std::string cartpole = embedded::kRunCartpoleToml;
+  static const std::string quadrotor = embedded::kRunQuadrotorToml;
+  if (system == "cartpole") return cartpole;
+  if (system == "quadrotor") return quadrotor;
+  throw InputError(fmt::format("run: unknown system '{}'; expected \"cartpole\" or \"quadrotor\"", system));
+}
+
+RunConfig parse_run_config(const std::string& system, const std::string& override_text, const std::string& source) {
+  const std::string defaults_source = fmt::format("<embedded defaults of run {}>", system);
+  toml::table root = TomlFields::parse_text(default_run_config_text(system), defaults_source);
+  if (!override_text.empty()) {
+    const toml::table overrides = TomlFields::parse_text(override_text, source);
+    TomlFields::merge(root, overrides);
+  }
+  const RunConfig config = read_run_config(root, source.empty() ? defaults_source : source);
+  if (config.system != system)
+    throw InputError(fmt::format("{}: field 'system.name' is '{}' but the command runs '{}'", source, config.system, system));
+  return config;
+}
+
+RunConfig load_run_config(const std::string& system, const std::optional<std::filesystem::path>& override_file) {
+  if (!override_file) return parse_run_config(system, "", "");
+  if (!std::filesystem::exists(*override_file))
+    throw InputError(fmt::format("{}: no such file; expected a TOML config", override_file->string()));
+  std::ifstream in(*override_file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_run_config(system, text.str(), override_file->string());
+}
+
+}  // namespace gpilqg

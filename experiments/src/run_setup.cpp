@@ -1,0 +1,41 @@
+#include "gpilqg/experiments/run_setup.hpp"
+
+#include <vector>
+
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/systems.hpp"
+
+namespace gpilqg {
+
+RunModels make_run_models(const RunConfig& c) {
+  const auto make = [&](Preset preset) -> std::shared_ptr<const StepModel> {
+    return std::make_shared<IntegratedStepModel>(make_system(c.system, preset, {}, c.noise), c.integrator, c.dt,
+                                                 c.substeps);
+  };
+  return {make(Preset::RealWorld), make(Preset::Simulator)};
+}
+
+QuadraticCost make_task_cost(const RunConfig& c, const RunTask& task) {
+  const Matrix Q = task.Q.asDiagonal();
+  const Matrix R = task.R.asDiagonal();
+  const Matrix Qf = task.Qf.asDiagonal();
+  if (!task.track_line) return QuadraticCost(c.dt, Q, R, Qf, task.goal);
+  const Matrix x_ref = straight_line_reference(task.x0, task.goal, task.horizon);
+  const Matrix u_ref = c.u_init.replicate(1, task.horizon);  // track around the configured nominal control
+  return QuadraticCost::tracking(c.dt, Q, R, Qf, x_ref, u_ref);
+}
+
+std::mt19937_64 make_rng(std::uint64_t seed, int task, RandomStream stream, std::initializer_list<std::uint64_t> index) {
+  std::vector<std::uint32_t> words = {static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                                      static_cast<std::uint32_t>(task), static_cast<std::uint32_t>(stream)};
+  for (const std::uint64_t i : index) words.push_back(static_cast<std::uint32_t>(i));
+  std::seed_seq sequence(words.begin(), words.end());
+  return std::mt19937_64(sequence);
+}
+
+std::uint64_t derive_seed(std::uint64_t seed, int task, RandomStream stream, std::initializer_list<std::uint64_t> index) {
+  auto rng = make_rng(seed, task, stream, index);
+  return rng();
+}
+
+}  // namespace gpilqg

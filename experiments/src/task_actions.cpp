@@ -1,0 +1,137 @@
+#include "gpilqg/experiments/task_actions.hpp"
+
+#include <chrono>
+
+#include "gpilqg/control/rollout.hpp"
+
+namespace gpilqg {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Matrix repeated_u_init(const TaskContext& c) { return c.config.u_init.replicate(1, c.task.horizon); }
+
+/// Clamps u to [control] limits (empty: none).
+void clamp_to_limits(const RunConfig& config, VectorRef u) {
+  if (config.u_min.size()) u = u.cwiseMax(config.u_min);
+  if (config.u_max.size()) u = u.cwiseMin(config.u_max);
+}
+
+}  // namespace
+
+Plan plan_with_ddp(const TaskContext& c, std::shared_ptr<const StepModel> model, DdpVariant variant,
+                   const Matrix& u_start) {
+  DdpProblem problem;
+  problem.model = model.get();
+  problem.cost = &c.cost;
+  problem.x0 = c.task.x0;
+  problem.horizon = c.task.horizon;
+  problem.u_min = c.config.u_min;
+  problem.u_max = c.config.u_max;
+  DdpOptions options = c.config.solver;
+  options.variant = variant;
+  DdpSolver solver(options);
+  const auto start = std::chrono::steady_clock::now();
+  DdpResult result = solver.solve(problem, u_start.size() ? u_start : repeated_u_init(c));
+  Plan plan;
+  plan.solve_seconds = seconds_since(start);
+  plan.policy = std::move(result.policy);
+  plan.predicted_cost = result.expected_cost;
+  plan.summary = std::move(result.summary);
+  plan.model = std::move(model);
+  plan.variant = variant;
+  return plan;
+}
+
+Plan open_loop_plan(const TaskContext& c) {
+  const int n = static_cast<int>(c.task.x0.size());
+  const int m = static_cast<int>(c.config.u_init.size());
+  const int T = c.task.horizon;
+  Plan plan;
+  plan.policy.x_bar = c.task.x0.replicate(1, T + 1);
+  plan.policy.u_bar = repeated_u_init(c);
+  plan.policy.k = Matrix::Zero(m, T);
+  plan.policy.K.assign(static_cast<std::size_t>(T), Matrix::Zero(m, n));
+  plan.policy.u_min = c.config.u_min;
+  plan.policy.u_max = c.config.u_max;
+  return plan;
+}
+
+Controller make_controller(const TaskContext& c, const Plan& plan, std::unique_ptr<MpcController>& holder) {
+  if (!c.config.mpc || plan.model == nullptr) {
+    holder.reset();
+    const AffinePolicy* policy = &plan.policy;
+    return [policy](int t, const VectorCRef& x, VectorRef u) { policy->control(t, x, u); };
+  }
+  MpcOptions options = c.config.mpc_options;
+  options.solver = c.config.solver;
+  options.solver.variant = plan.variant;
+  const int H = std::min(options.horizon, plan.policy.horizon());
+  Matrix warm = plan.policy.u_bar.leftCols(H);
+  holder = std::make_unique<MpcController>(*plan.model, c.cost, options, c.config.u_min, c.config.u_max, warm);
+  MpcController* mpc = holder.get();
+  return [mpc](int t, const VectorCRef& x, VectorRef u) { u = mpc->control(t, x); };
+}
+
+RealRollout roll_out(const TaskContext& c, const Plan& plan, const Vector& exploration, std::mt19937_64& rng) {
+  std::unique_ptr<MpcController> holder;
+  const Controller act = make_controller(c, plan, holder);
+  const int T = c.task.horizon;
+  RealRollout out;
+  out.measured.resize(c.task.x0.size(), T + 1);
+  std::normal_distribution<double> standard_normal;
+  const Controller explore = [&](int t, const VectorCRef& observed, VectorRef u) {
+    out.measured.col(t) = observed;
+    act(t, observed, u);
+    for (Eigen::Index j = 0; j < exploration.size(); ++j) u(j) += exploration(j) * standard_normal(rng);
+    clamp_to_limits(c.config, u);
+  };
+  RolloutResult r = closed_loop_rollout(*c.models.world, c.task.x0, T, explore, RolloutNoise::Process,
+                                        c.config.observation_std, &rng);
+  Vector last = r.trajectory.x.col(T);
+  add_observation_noise(c.config.observation_std, rng, last);
+  out.measured.col(T) = last;
+  // A diverged rollout stops calling the controller: its remaining measurements repeat the last state.
+  for (int t = r.steps_completed + 1; t <= T; ++t) out.measured.col(t) = r.trajectory.x.col(t);
+  out.finite = r.finite;
+  out.steps_completed = r.steps_completed;
+  out.truth = std::move(r.trajectory);
+  out.cost = trajectory_cost(c.cost, out.truth);
+  return out;
+}
+
+RealRollout random_rollout(const TaskContext& c, const Vector& amplitude, std::mt19937_64& rng) {
+  const int m = static_cast<int>(c.config.u_init.size());
+  const int T = c.task.horizon;
+  constexpr int kHoldSteps = 5;
+  Plan plan = open_loop_plan(c);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int t = 0; t < T; t += kHoldSteps) {
+    Vector level(m);
+    for (int j = 0; j < m; ++j) level(j) = c.config.u_init(j) + amplitude(j) * unit(rng);
+    clamp_to_limits(c.config, level);
+    for (int s = t; s < std::min(T, t + kHoldSteps); ++s) plan.policy.u_bar.col(s) = level;
+  }
+  return roll_out(c, plan, Vector(), rng);
+}
+
+Evaluation evaluate(const TaskContext& c, const Plan& plan, std::uint64_t seed) {
+  const auto start = std::chrono::steady_clock::now();
+  Evaluation e;
+  for (int i = 0; i < c.config.evaluation_rollouts; ++i) {
+    auto rng = make_rng(seed, c.task_index, RandomStream::Evaluation, {static_cast<std::uint64_t>(i)});
+    RealRollout r = roll_out(c, plan, Vector(), rng);
+    e.costs.push_back(r.cost);
+    e.diverged += r.finite ? 0 : 1;
+    if (i == 0) e.example = std::move(r.truth);
+  }
+  double sum = 0.0;
+  for (const double cost : e.costs) sum += cost;
+  e.mean_cost = sum / static_cast<double>(e.costs.size());
+  e.seconds = seconds_since(start);
+  return e;
+}
+
+}  // namespace gpilqg
