@@ -122,6 +122,25 @@ void CartPole::input_matrix(const VectorCRef& x, const VectorCRef&, InputMatrix&
   out.d_du[0].setZero();
 }
 
+const std::vector<Quantity>& CartPole::generalised_forces() const {
+  static const std::vector<Quantity> kForces = {{"Q_x", "N"}, {"Q_theta", "N m"}};
+  return kForces;
+}
+
+void CartPole::generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const {
+  const double s = std::sin(x(2)), c = std::cos(x(2));
+  const MassMatrix mm = mass_matrix(p_, s, c);
+  W.setZero(4, 2);
+  W.row(1) = mm.M_inv.row(0);
+  W.row(3) = mm.M_inv.row(1);
+  if (d_dx == nullptr) return;
+  d_dx->resize(4);
+  for (auto& d : *d_dx) d.setZero(4, 2);
+  const Mat2 dM_inv = -mm.M_inv * mm.dM_dtheta * mm.M_inv;
+  (*d_dx)[2].row(1) = dM_inv.row(0);
+  (*d_dx)[2].row(3) = dM_inv.row(1);
+}
+
 double CartPole::energy(const VectorCRef& x) const {
   const double mc = p_.cart_mass, mp = p_.pole_mass, l = p_.pole_length, g = p_.gravity;
   const double x_dot = x(1), theta_dot = x(3), c = std::cos(x(2));

@@ -284,6 +284,23 @@ void Quadrotor::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdo
   write_input_matrix(p_, thrust, jacobians->fu);
 }
 
+const std::vector<Quantity>& Quadrotor::generalised_forces() const {
+  static const std::vector<Quantity> kForces = {{"F_x", "N"},   {"F_y", "N"},   {"F_z", "N"},
+                                                {"tau_x", "N m"}, {"tau_y", "N m"}, {"tau_z", "N m"}};
+  return kForces;
+}
+
+void Quadrotor::generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const {
+  assert(x.size() == kStateDim);
+  static_cast<void>(x);
+  W.setZero(kStateDim, 6);
+  W.block<3, 3>(kV, 0).diagonal().setConstant(1.0 / p_.mass);
+  W.block<3, 3>(kW, 3).diagonal().setConstant(1.0 / p_.inertia);
+  if (d_dx == nullptr) return;
+  d_dx->resize(kStateDim);
+  for (auto& d : *d_dx) d.setZero(kStateDim, 6);
+}
+
 void Quadrotor::input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const {
   // b = f_u: column j is (0, R(r) e3 / m, 0, torque_j / J), independent of u. Only the thrust part
   // depends on x, through r: d b_j / dr = d(R e3)/dr / m, the same for all four columns; d b_j / du = 0.

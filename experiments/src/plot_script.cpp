@@ -47,17 +47,29 @@ std::filesystem::path plot_script_dir() {
 #endif
 }
 
-void run_plot_script(const std::string& script, const std::filesystem::path& input, const std::filesystem::path& out_dir) {
-  const std::string python = interpreter();
-  const std::filesystem::path path = plot_script_dir() / script;
+namespace {
+
+void check_plotting(const std::string& python, const std::filesystem::path& path, const std::string& consequence) {
   if (!std::filesystem::exists(path))
     throw std::runtime_error(fmt::format("plotting: no script {} (set GPILQG_PLOTS_DIR to the folder of the plot scripts)",
                                          path.string()));
   if (run_process({python, "-c", "import matplotlib, h5py"}) != 0)
     throw std::runtime_error(fmt::format(
         "plotting: {} cannot import matplotlib and h5py; install python3-matplotlib python3-h5py (Debian) or set "
-        "GPILQG_PYTHON; the result file {} is complete",
-        python, input.string()));
+        "GPILQG_PYTHON{}",
+        python, consequence));
+}
+
+}  // namespace
+
+void require_plotting(const std::string& script) {
+  check_plotting(interpreter(), plot_script_dir() / script, "");
+}
+
+void run_plot_script(const std::string& script, const std::filesystem::path& input, const std::filesystem::path& out_dir) {
+  const std::string python = interpreter();
+  const std::filesystem::path path = plot_script_dir() / script;
+  check_plotting(python, path, fmt::format("; the result file {} is complete", input.string()));
   std::filesystem::create_directories(out_dir);
   const int status = run_process({python, path.string(), input.string(), out_dir.string()});
   if (status != 0)

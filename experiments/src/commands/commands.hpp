@@ -21,6 +21,9 @@ void add_solve_command(CLI::App& app, CommandAction& action);
 /// `gpilqg simulate --system NAME --out FILE [...]`
 void add_simulate_command(CLI::App& app, CommandAction& action);
 
+/// `gpilqg diagnose --system NAME --data FILE [--model F.toml] [--add EFFECT[=VALUE]]... [...]`
+void add_diagnose_command(CLI::App& app, CommandAction& action);
+
 /// `gpilqg run cartpole|quadrotor [--config F] [--seeds N] [--iterations K] [--backends LIST] [--out F.h5] [--plots DIR]`
 void add_run_command(CLI::App& app, CommandAction& action);
 

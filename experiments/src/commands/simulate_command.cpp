@@ -9,7 +9,9 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/synthetic_data.hpp"
 
@@ -22,6 +24,7 @@ struct SimulateOptions {
   std::string preset = "real";
   std::string out;
   std::vector<std::string> parameters;
+  std::vector<std::string> effects;
   int episodes = -1;
   int steps = -1;
   double dt = -1.0;
@@ -60,7 +63,17 @@ int run_simulate(const SimulateOptions& o) {
   ActuatorNoise noise;
   if (o.actuator_noise > 0.0) noise.additive_std = Vector::Constant(m, o.actuator_noise);
   if (o.multiplicative_noise > 0.0) noise.multiplicative_std = Vector::Constant(m, o.multiplicative_noise);
-  const auto system = make_system(o.system, *preset, parse_parameters(o.parameters), noise);
+  // The world: the preset with overridden parameters and hidden effects of the library.
+  ModelSpec world;
+  world.system = o.system;
+  world.preset = *preset;
+  world.parameters = parse_parameters(o.parameters);
+  for (const std::string& text : o.effects) {
+    const diagnosis::EffectRequest request = diagnosis::parse_add_option(text, o.system, "--effect");
+    if (!request.values) throw InputError("--effect '" + text + "': expected EFFECT=VALUE, e.g. cart_coulomb_friction=1");
+    world = world.with(find_effect(o.system, request.effect), *request.values);
+  }
+  const auto system = world.build(noise);
 
   ExcitationSettings settings = default_excitation(*system);
   if (o.episodes > 0) settings.episodes = o.episodes;
@@ -89,6 +102,8 @@ void add_simulate_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--system", options->system, "System name (cartpole, quadrotor)")->required();
   cmd->add_option("--preset", options->preset, "Parameter set: sim or real")->capture_default_str();
   cmd->add_option("--param", options->parameters, "Override a physical parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--effect", options->effects,
+                  "Add a physical effect of the library to the world, EFFECT=VALUE (repeatable)");
   cmd->add_option("--episodes", options->episodes, "Number of episodes (default per system)");
   cmd->add_option("--steps", options->steps, "Samples per episode (default per system)");
   cmd->add_option("--dt", options->dt, "Sampling step in seconds (default 0.02)");

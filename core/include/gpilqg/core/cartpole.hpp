@@ -16,6 +16,7 @@
 /// Jacobians: d q_ddot / d z = M^-1 (dh/dz - dM/dz q_ddot) for z in (q, q_dot, u).
 
 #include "gpilqg/core/dynamics.hpp"
+#include "gpilqg/core/generalised_forces.hpp"
 
 namespace gpilqg {
 
@@ -31,7 +32,7 @@ struct CartPoleParameters {
   static CartPoleParameters real_world() { return {1.0, 1.0, 1.3, 9.81}; }
 };
 
-class CartPole final : public Dynamics {
+class CartPole final : public Dynamics, public GeneralisedForceInput {
  public:
   /// Throws std::invalid_argument naming the parameter when a mass or the length is not positive.
   explicit CartPole(CartPoleParameters parameters = CartPoleParameters::simulator());
@@ -49,6 +50,12 @@ class CartPole final : public Dynamics {
   /// Total mechanical energy (kinetic + potential, zero at the hanging rest state) [J]; conserved
   /// with no input and no friction.
   double energy(const VectorCRef& x) const;
+
+  /// Generalised forces Q = (Q_x [N] along the rail, Q_theta [N m] about the pivot) added to h:
+  /// q_ddot gains M^-1 Q, so W(x) has rows 1 and 3 equal to the rows of M^-1(theta) and zeros
+  /// elsewhere; dW/dtheta = -M^-1 (dM/dtheta) M^-1 on the same rows, every other dW/dx_j is zero.
+  const std::vector<Quantity>& generalised_forces() const override;
+  void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const override;
 
  private:
   CartPoleParameters p_;

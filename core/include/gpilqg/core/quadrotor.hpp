@@ -28,6 +28,7 @@
 ///   series (no trigonometric calls); above, from their closed forms (see quadrotor.cpp).
 
 #include "gpilqg/core/dynamics.hpp"
+#include "gpilqg/core/generalised_forces.hpp"
 
 namespace gpilqg {
 
@@ -45,7 +46,7 @@ struct QuadrotorParameters {
   static QuadrotorParameters real_world() { return {0.7, 0.15, 0.025, 0.05, 0.17, 9.81}; }
 };
 
-class Quadrotor final : public Dynamics {
+class Quadrotor final : public Dynamics, public GeneralisedForceInput {
  public:
   /// Throws std::invalid_argument naming the parameter and its value when mass, inertia, rho or
   /// gravity is not a finite value > 0, or kv or km is not a finite value >= 0.
@@ -63,6 +64,12 @@ class Quadrotor final : public Dynamics {
 
   /// The rotor force that holds the quadrotor in hover, m g / 4 [N] per rotor.
   double hover_force() const { return p_.mass * p_.gravity / 4.0; }
+
+  /// Generalised forces Q = (F_x, F_y, F_z [N], a force on the centre of mass in the world frame;
+  /// tau_x, tau_y, tau_z [N m], a torque in the body frame): v_dot gains F / m and w_dot gains
+  /// tau / inertia, so W = [0; I/m; 0; I/inertia] (12 x 6) is constant and every dW/dx_j is zero.
+  const std::vector<Quantity>& generalised_forces() const override;
+  void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const override;
 
  private:
   QuadrotorParameters p_;

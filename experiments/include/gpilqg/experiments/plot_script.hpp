@@ -14,6 +14,10 @@ namespace gpilqg {
 /// else the installed share/gpilqg/plots.
 std::filesystem::path plot_script_dir();
 
+/// Checks that `script` exists and the interpreter imports matplotlib and h5py, throwing like
+/// run_plot_script; commands call it before long work so that a missing package fails fast.
+void require_plotting(const std::string& script);
+
 /// Runs `<interpreter> <dir>/<script> <input> <out_dir>` (out_dir created), without a shell.
 /// Throws std::runtime_error naming the interpreter and the missing packages when matplotlib or h5py
 /// cannot be imported, and naming the script and its exit status when it fails.

@@ -1,0 +1,91 @@
+#pragma once
+/// @file effect_library.hpp
+/// The physical-effects library (DESIGN.md section 5, fixed names) and the model description the
+/// diagnosis works on: a system preset, recalibrated parameters, an actuator gain and force effects.
+///
+/// | name                     | parameter      | enters as                                           |
+/// |--------------------------|----------------|-----------------------------------------------------|
+/// | cart_viscous_friction    | b [N s/m]      | Q_x = -b x_dot                                      |
+/// | cart_coulomb_friction    | mu [N]         | Q_x = -mu tanh(x_dot / 0.05)                        |
+/// | pole_viscous_damping     | c [N m s/rad]  | Q_theta = -c theta_dot                              |
+/// | pole_coulomb_friction    | tau [N m]      | Q_theta = -tau tanh(theta_dot / 0.05)               |
+/// | actuator_gain            | k [-]          | the applied input is k u                            |
+/// | external_force_x, _y, _z | F [N]          | constant force on the body (cart: x only)           |
+/// | quadratic_drag           | c_d [N s^2/m^2]| -c_d abs(v) v on the translational velocity         |
+/// | param:<name>             | the value      | recalibrates one physical parameter                 |
+///
+/// `quadratic_drag` is elementwise, F_i = -c_d |v_i| v_i (the cart: Q_x = -c_d |x_dot| x_dot; the
+/// quadrotor: per world axis, drag of a body with the same area in every direction along the axes).
+/// The cart-pole friction and damping effects apply to the cart-pole only; the quadrotor's external
+/// forces act at the centre of mass in the world frame. `param:<name>` exists for every physical
+/// parameter of the system except gravity.
+
+#include <map>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "gpilqg/core/effects.hpp"
+#include "gpilqg/core/systems.hpp"
+
+namespace gpilqg {
+
+enum class EffectKind {
+  Force,          ///< a generalised force (ForceEffect)
+  ActuatorGain,   ///< the applied input is k u
+  Recalibration,  ///< one physical parameter takes another value
+};
+
+/// One candidate of the library for one system.
+struct LibraryEffect {
+  std::string name;                        ///< the fixed name, e.g. "cart_coulomb_friction", "param:pole_length"
+  EffectKind kind = EffectKind::Force;
+  std::vector<EffectParameter> parameters;  ///< one entry for every built-in effect
+  std::string formula;                     ///< e.g. "Q_x = -mu tanh(x_dot / 0.05)"
+  bool linear = false;                     ///< xdot is linear in the parameters
+  ForceEffectPtr force;                    ///< kind == Force only
+  std::string recalibrated;                ///< kind == Recalibration: the parameter's name, e.g. "pole_length"
+};
+
+/// Every effect of the library that applies to the built-in system `system` ("cartpole",
+/// "quadrotor"), in a fixed order: forces, actuator_gain, then param:<name> in the system's parameter
+/// order. Throws std::invalid_argument listing the systems for an unknown name.
+const std::vector<LibraryEffect>& effect_library(std::string_view system);
+
+/// The library entry called `name`. Throws std::invalid_argument naming `name` and listing every
+/// valid name for the system.
+const LibraryEffect& find_effect(std::string_view system, std::string_view name);
+
+/// The names of effect_library(system), comma-separated, for error messages.
+std::string effect_names(std::string_view system);
+
+/// A model to compare with measurements: the preset's system with recalibrated parameters, an
+/// actuator gain, and force effects of the library with their parameter values.
+struct ModelSpec {
+  std::string system = "cartpole";
+  Preset preset = Preset::Simulator;
+  std::map<std::string, double> parameters;        ///< recalibrations: name -> value (overrides the preset)
+  double actuator_gain = 1.0;                      ///< k
+  std::vector<std::pair<std::string, Vector>> forces;  ///< library force effects -> parameter values, in order
+
+  /// The model's Dynamics (an EffectDynamics when it has a gain other than 1 or forces), with `noise`.
+  /// Throws std::invalid_argument for an unknown system, parameter or effect, or invalid values.
+  DynamicsPtr build(const ActuatorNoise& noise = {}) const;
+
+  /// The values the model gives `effect`'s parameters now: a force's values (0 when absent), the
+  /// gain, or the (possibly recalibrated) physical parameter. Adding the effect at these values
+  /// leaves the model unchanged.
+  Vector current_values(const LibraryEffect& effect) const;
+
+  /// This model with `effect` at `values` (a force replaces its previous values, the gain and a
+  /// parameter are set). Throws std::invalid_argument for a wrong number of values, a non-finite
+  /// value or one outside the parameter's physical bounds.
+  ModelSpec with(const LibraryEffect& effect, const VectorCRef& values) const;
+
+  /// One line per difference from the preset, e.g. "cart_coulomb_friction: mu = 1.98 N"; empty for
+  /// the bare preset.
+  std::vector<std::string> describe() const;
+};
+
+}  // namespace gpilqg

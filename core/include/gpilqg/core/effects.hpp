@@ -1,0 +1,131 @@
+#pragma once
+/// @file effects.hpp
+/// Physical effects (DESIGN.md sections 2 and 5): named, parameterised generalised forces added to a
+/// mechanical system's equations of motion, and the Dynamics decorator "system + effects".
+///
+/// With the system's generalised-force map W(x) (generalised_forces.hpp), an actuator gain k and
+/// effects e = 1..E with parameters theta_e,
+///
+///   M(q) q_ddot = h(q, q_dot, k u) + sum_e Q_e(x, u; theta_e)
+///   xdot        = f(x, k u) + W(x) Q(x, u),           Q = sum_e Q_e  (k_Q entries)
+///
+/// and the Jacobians, exact by the chain rule (tests/core/effects_test.cpp checks them against central
+/// differences):
+///
+///   f_x = f_x^base(x, k u) + W dQ/dx + [ (dW/dx_1) Q, ..., (dW/dx_n) Q ]
+///   f_u = k f_u^base(x, k u) + W dQ/du
+///
+/// Parameter recalibrations ("param:<name>") are not forces: they rebuild the base system with another
+/// parameter value (effect_library.hpp, ModelSpec).
+
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gpilqg/core/dynamics.hpp"
+#include "gpilqg/core/generalised_forces.hpp"
+
+namespace gpilqg {
+
+/// One parameter of an effect, e.g. {"b", "N s/m", 1.0}.
+struct EffectParameter {
+  std::string name;
+  std::string unit;
+  /// Typical magnitude: sets the finite-difference step and the search box when the parameter is fitted.
+  double scale = 1.0;
+  /// Physical bounds (a mass stays positive); infinite when the sign is free.
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+};
+
+/// A generalised force Q(x, u; theta) with k_Q entries, in the components of the system's
+/// GeneralisedForceInput. Immutable and shareable between threads.
+class ForceEffect {
+ public:
+  virtual ~ForceEffect() = default;
+  /// The effect's name, e.g. "cart_viscous_friction".
+  virtual const std::string& name() const = 0;
+  virtual const std::vector<EffectParameter>& parameters() const = 0;
+  /// How it enters, e.g. "Q_x = -b x_dot".
+  virtual const std::string& formula() const = 0;
+  /// True when Q depends on u (then dQ/du may be nonzero).
+  virtual bool depends_on_input() const { return false; }
+  /// True when Q is linear in theta (least squares then estimates theta directly).
+  virtual bool linear_in_parameters() const { return false; }
+  /// Adds Q(x, u; theta) to `Q` (k_Q entries) and, when not null, dQ/dx to `dQ_dx` (k_Q x n) and
+  /// dQ/du to `dQ_du` (k_Q x m). `u` is the commanded input. `theta` has parameters().size() entries.
+  virtual void add_force(const VectorCRef& x, const VectorCRef& u, const VectorCRef& theta, VectorRef Q,
+                         Matrix* dQ_dx, Matrix* dQ_du) const = 0;
+};
+
+using ForceEffectPtr = std::shared_ptr<const ForceEffect>;
+
+/// Q = theta g(x): a force linear in its one parameter, with a basis g(x) (k_Q entries) that does not
+/// depend on u. Every force of the built-in library has this form.
+class LinearForceEffect final : public ForceEffect {
+ public:
+  /// Writes g(x) into `g` (k_Q entries, zeroed by the caller) and, when not null, dg/dx into `dg_dx`
+  /// (k_Q x n, zeroed by the caller).
+  using Basis = std::function<void(const VectorCRef& x, VectorRef g, Matrix* dg_dx)>;
+
+  /// `force_dim` is k_Q of the systems this effect applies to. Throws std::invalid_argument for an
+  /// empty name, a null basis or force_dim < 1.
+  LinearForceEffect(std::string name, EffectParameter parameter, std::string formula, int force_dim, Basis basis);
+
+  const std::string& name() const override { return name_; }
+  const std::vector<EffectParameter>& parameters() const override { return parameters_; }
+  const std::string& formula() const override { return formula_; }
+  bool linear_in_parameters() const override { return true; }
+  void add_force(const VectorCRef& x, const VectorCRef& u, const VectorCRef& theta, VectorRef Q, Matrix* dQ_dx,
+                 Matrix* dQ_du) const override;
+
+ private:
+  std::string name_;
+  std::vector<EffectParameter> parameters_;
+  std::string formula_;
+  int force_dim_;
+  Basis basis_;
+};
+
+/// An effect with its parameter values.
+struct AppliedEffect {
+  ForceEffectPtr effect;
+  Vector theta;
+};
+
+/// "System + effects": the base system driven by k u, plus the generalised forces of the effects.
+/// Name, states and controls are the base system's, so its data files are the base system's.
+/// The noise model is the decorator's own (set_noise_model), with b = df/du of the decorated system.
+class EffectDynamics final : public Dynamics {
+ public:
+  /// Throws std::invalid_argument for a null base, a non-finite gain, a null effect, a theta of the
+  /// wrong size or with non-finite entries, or effects on a base that is not a GeneralisedForceInput.
+  EffectDynamics(DynamicsPtr base, double actuator_gain, std::vector<AppliedEffect> effects);
+
+  const std::string& name() const override { return base_->name(); }
+  const std::vector<Quantity>& states() const override { return base_->states(); }
+  const std::vector<Quantity>& controls() const override { return base_->controls(); }
+  /// The base system's parameters, then "actuator_gain.k", then "<effect>.<parameter>" per effect.
+  std::vector<Parameter> parameters() const override;
+
+  void evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot,
+                DynamicsJacobians* jacobians = nullptr) const override;
+  /// Analytic when no effect depends on u: b = k b^base(x, k u) + W dQ/du with dQ/du = 0, so
+  /// db_j/dx = k db_j^base/dx and db_j/du = k^2 db_j^base/du_a; otherwise central differences.
+  void input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const override;
+
+  const Dynamics& base() const { return *base_; }
+  double actuator_gain() const { return gain_; }
+  const std::vector<AppliedEffect>& effects() const { return effects_; }
+
+ private:
+  DynamicsPtr base_;
+  const GeneralisedForceInput* forces_ = nullptr;  ///< base_ viewed as a GeneralisedForceInput (or null)
+  double gain_;
+  std::vector<AppliedEffect> effects_;
+  bool input_dependent_ = false;
+};
+
+}  // namespace gpilqg

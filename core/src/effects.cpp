@@ -1,0 +1,121 @@
+#include "gpilqg/core/effects.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace gpilqg {
+
+namespace {
+
+/// Per-thread scratch space for EffectDynamics::evaluate, so that a shared const model does not
+/// allocate per call once warmed up.
+struct EffectScratch {
+  Vector u_applied;
+  Vector Q;
+  Matrix dQ_dx, dQ_du, W;
+  std::vector<Matrix> dW;
+  Vector g;
+  Matrix dg_dx;
+};
+
+EffectScratch& effect_scratch() {
+  thread_local EffectScratch scratch;
+  return scratch;
+}
+
+}  // namespace
+
+LinearForceEffect::LinearForceEffect(std::string name, EffectParameter parameter, std::string formula,
+                                     int force_dim, Basis basis)
+    : name_(std::move(name)), parameters_{std::move(parameter)}, formula_(std::move(formula)),
+      force_dim_(force_dim), basis_(std::move(basis)) {
+  if (name_.empty()) throw std::invalid_argument("LinearForceEffect: empty name");
+  if (!basis_) throw std::invalid_argument("LinearForceEffect '" + name_ + "': null basis");
+  if (force_dim_ < 1)
+    throw std::invalid_argument("LinearForceEffect '" + name_ + "': force_dim = " + std::to_string(force_dim_) +
+                                "; expected >= 1");
+}
+
+void LinearForceEffect::add_force(const VectorCRef& x, const VectorCRef&, const VectorCRef& theta, VectorRef Q,
+                                  Matrix* dQ_dx, Matrix*) const {
+  // Q += theta g(x);  dQ/dx += theta dg/dx;  dQ/du = 0.
+  EffectScratch& s = effect_scratch();
+  s.g.setZero(force_dim_);
+  if (dQ_dx != nullptr) s.dg_dx.setZero(force_dim_, x.size());
+  basis_(x, s.g, dQ_dx != nullptr ? &s.dg_dx : nullptr);
+  Q.noalias() += theta(0) * s.g;
+  if (dQ_dx != nullptr) dQ_dx->noalias() += theta(0) * s.dg_dx;
+}
+
+EffectDynamics::EffectDynamics(DynamicsPtr base, double actuator_gain, std::vector<AppliedEffect> effects)
+    : base_(std::move(base)), gain_(actuator_gain), effects_(std::move(effects)) {
+  if (!base_) throw std::invalid_argument("EffectDynamics: null base system");
+  if (!std::isfinite(gain_))
+    throw std::invalid_argument("EffectDynamics: actuator gain " + std::to_string(gain_) + "; expected a finite value");
+  forces_ = dynamic_cast<const GeneralisedForceInput*>(base_.get());
+  for (const AppliedEffect& e : effects_) {
+    if (!e.effect) throw std::invalid_argument("EffectDynamics: null effect");
+    const auto expected = static_cast<Eigen::Index>(e.effect->parameters().size());
+    if (e.theta.size() != expected || !e.theta.allFinite())
+      throw std::invalid_argument("EffectDynamics: effect '" + e.effect->name() + "' has " +
+                                  std::to_string(e.theta.size()) + " parameter values (finite: " +
+                                  (e.theta.allFinite() ? "yes" : "no") + "); expected " + std::to_string(expected) +
+                                  " finite values");
+    if (forces_ == nullptr)
+      throw std::invalid_argument("EffectDynamics: system '" + base_->name() +
+                                  "' does not accept generalised forces, so effect '" + e.effect->name() +
+                                  "' cannot be added");
+    input_dependent_ = input_dependent_ || e.effect->depends_on_input();
+  }
+}
+
+std::vector<Parameter> EffectDynamics::parameters() const {
+  std::vector<Parameter> out = base_->parameters();
+  out.push_back({"actuator_gain.k", "-", gain_});
+  for (const AppliedEffect& e : effects_) {
+    const auto& specs = e.effect->parameters();
+    for (std::size_t i = 0; i < specs.size(); ++i)
+      out.push_back({e.effect->name() + "." + specs[i].name, specs[i].unit, e.theta(static_cast<Eigen::Index>(i))});
+  }
+  return out;
+}
+
+void EffectDynamics::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot,
+                              DynamicsJacobians* jacobians) const {
+  EffectScratch& s = effect_scratch();
+  s.u_applied = gain_ * u;
+  base_->evaluate(x, s.u_applied, xdot, jacobians);
+  if (jacobians != nullptr) jacobians->fu *= gain_;
+  if (effects_.empty()) return;
+
+  const int n = state_dim(), m = control_dim();
+  const auto k = static_cast<int>(forces_->generalised_forces().size());
+  s.Q.setZero(k);
+  if (jacobians != nullptr) {
+    s.dQ_dx.setZero(k, n);
+    s.dQ_du.setZero(k, m);
+  }
+  for (const AppliedEffect& e : effects_)
+    e.effect->add_force(x, u, e.theta, s.Q, jacobians != nullptr ? &s.dQ_dx : nullptr,
+                        jacobians != nullptr ? &s.dQ_du : nullptr);
+  forces_->generalised_force_map(x, s.W, jacobians != nullptr ? &s.dW : nullptr);
+  xdot.noalias() += s.W * s.Q;
+  if (jacobians == nullptr) return;
+  jacobians->fx.noalias() += s.W * s.dQ_dx;
+  for (int j = 0; j < n; ++j) jacobians->fx.col(j).noalias() += s.dW[static_cast<std::size_t>(j)] * s.Q;
+  jacobians->fu.noalias() += s.W * s.dQ_du;
+}
+
+void EffectDynamics::input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const {
+  if (input_dependent_) {
+    Dynamics::input_matrix(x, u, out);
+    return;
+  }
+  const Vector u_applied = gain_ * u;
+  base_->input_matrix(x, u_applied, out);
+  out.b *= gain_;
+  for (auto& d : out.d_dx) d *= gain_;
+  for (auto& d : out.d_du) d *= gain_ * gain_;
+}
+
+}  // namespace gpilqg

@@ -1,0 +1,146 @@
+#pragma once
+/// @file diagnosis.hpp
+/// Model diagnosis (`gpilqg diagnose`): compare a model with measurements, see where it fails, learn
+/// which physical effect is missing, add it and watch the error fall.
+///
+/// The steps, each in its own file:
+///  1. compare (transitions.hpp, residual_analysis.hpp): one-step and k-step predictions (RK4 by
+///     default), RMSE, fit percent and the noise floor per state;
+///  2. where (residual_analysis.hpp): residual per episode and in bins of every input, its
+///     cross-correlation with the controls, and the GP's relevance of every input;
+///  3. which (effect_fit.hpp): every effect of the library fitted on the training episodes and scored
+///     on the held-out episodes, grouped into aliases, and a verdict;
+///  4. add: before and after on the held-out episodes for sim, sim + effect, sim + GP and
+///     sim + effect + GP, with the GP's learned signal variance.
+///
+/// Verdict.
+/// Noise floor of state i: min(held-out RMSE of the model, held-out RMSE of the model corrected by a
+/// GP fitted on the training episodes), the error nothing learnable from (x, u) removes.
+///
+///  - "consistent" when no state's residual is structured. State i is structured when the GP removes
+///    more than `structure_threshold` of its held-out squared residual, i.e. its held-out RMSE exceeds
+///    the noise floor by more than `floor_tolerance`. Nothing is proposed then.
+///  - otherwise "explained" when the best alias group removes a significant share of the held-out
+///    residual: explained >= min_explained, z score >= min_z, and explained >= relative_to_gp times what
+///    the GP (a flexible model of everything learnable) removes on the same rows. A wrong effect can
+///    still soak up some of the residual; it cannot match the GP.
+///  - "unexplained" otherwise: the residual has structure no effect of the library accounts for.
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/measurements.hpp"
+#include "gpilqg/experiments/diagnosis/effect_fit.hpp"
+#include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
+#include "gpilqg/experiments/diagnosis/transitions.hpp"
+
+namespace gpilqg::diagnosis {
+
+/// An effect to add: its library name and, optionally, its values (fitted when absent).
+struct EffectRequest {
+  std::string effect;
+  std::optional<Vector> values;
+};
+
+struct DiagnosisOptions {
+  ModelSpec model;                        ///< the model as given (preset or model file)
+  std::vector<EffectRequest> add;         ///< --add, applied in order
+  Integrator integrator = Integrator::RK4;
+  int substeps = 1;
+  double heldout_fraction = 0.3;          ///< share of the episodes held out
+  std::vector<int> horizons = {1, 10, 50};
+  GpSettings gp;
+  int bins = 5;                           ///< quantile bins per input
+  int max_lag = 20;                       ///< cross-correlation lags
+  double alias_threshold = 0.95;          ///< |regressor correlation| that makes two effects aliases
+  double structure_threshold = 0.1;       ///< GP held-out explained fraction above which a state is structured
+  double floor_tolerance = 1.05;          ///< held-out RMSE / noise floor above which a state is structured
+  double min_explained = 0.1;             ///< "explained" needs at least this held-out fraction ...
+  double min_z = 3.0;                     ///< ... this significance ...
+  double relative_to_gp = 0.5;            ///< ... and this share of what the GP explains
+  bool rank = true;                       ///< false: skip the ranking (faster; verdict from the GP only)
+  /// Throws std::invalid_argument naming the field.
+  void validate() const;
+};
+
+/// Fit scores of one state.
+struct StateScore {
+  std::string name;
+  double rmse = 0.0;           ///< one-step, all rows
+  double fit_percent = 0.0;    ///< one-step, on the increments x_{t+1} - x_t
+  double noise_floor = 0.0;    ///< min(held-out RMSE of the model, of the model + GP) (diagnosis.cpp)
+  double gp_noise_std = 0.0;   ///< the GP's fitted noise std sn_i (for reference)
+  double heldout_rmse = 0.0;   ///< one-step, held-out rows
+  double gp_explained = 0.0;   ///< held-out structure the GP finds
+  bool structured = false;
+};
+
+struct KStepScore {
+  int k = 1;
+  int stride = 1;
+  int windows = 0;
+  int diverged = 0;
+  Vector rmse;         ///< n
+  Vector fit_percent;  ///< n, on the states x_{s+k}
+  KStepPredictions predictions;
+};
+
+/// One of the four models of the "add" step.
+struct ModelScore {
+  std::string name;          ///< "sim", "sim+effect", "sim+GP", "sim+effect+GP"
+  Vector heldout_rmse;       ///< n
+  Vector signal_variance;    ///< n, the GP's sf^2 (empty for the models without GP)
+};
+
+struct Verdict {
+  std::string status;                    ///< "explained", "unexplained", "consistent"
+  std::optional<EffectFit> effect;       ///< the proposed effect (status "explained")
+  std::vector<std::string> aliases;
+  std::string reason;                    ///< one sentence: why this verdict
+};
+
+struct DiagnosisReport {
+  std::string system;
+  ModelSpec model_before;                ///< as given
+  ModelSpec model;                       ///< as diagnosed: model_before plus the added effects
+  std::vector<EffectFit> added;          ///< fits of the --add effects (values given: estimate = value)
+  ModelSpec model_next;                  ///< what the next diagnosis should start from
+  std::vector<std::string> state_names, control_names, input_names;
+  double dt = 0.0;
+  long samples = 0;                      ///< transitions
+  std::vector<long> heldout_episode_ids;
+  std::vector<int> heldout_episode_index;
+  Transitions data;
+  Matrix predicted;                      ///< N x n, one-step
+  Matrix residual;                       ///< N x n
+  int non_finite_predictions = 0;
+  std::vector<StateScore> states;
+  std::vector<KStepScore> k_step;
+  ResidualGp gp;
+  Matrix sensitivity;                    ///< n x (n + m), raw
+  Matrix relevance;                      ///< n x (n + m), rows normalised to sum 1
+  std::vector<BinnedResidual> bins;
+  CrossCorrelation xcorr;
+  Matrix episode_rms;                    ///< episodes x n
+  bool consistent = false;
+  double gp_explained_total = 0.0;       ///< weighted, held-out
+  Vector weights;                        ///< n, 1 / noise floor^2
+  std::vector<RankedEffect> ranking;
+  Verdict verdict;
+  /// The "add" step (present when effects were added, or when a proposal exists): the four models.
+  std::vector<ModelScore> comparison;
+  std::string comparison_effect;         ///< what "effect" means in the four rows
+  Matrix residual_base;                  ///< N x n, one-step residual of "sim" in the comparison
+  Matrix residual_after;                 ///< N x n, one-step residual of sim + effect (when comparison exists)
+  Matrix relevance_base;                 ///< n x (n + m), relevance of the "sim" model's GP
+};
+
+/// Runs the diagnosis. Throws std::invalid_argument for bad options or data that do not fit the model
+/// (too few episodes, dt varying between episodes).
+DiagnosisReport diagnose(const MeasurementSet& data, const DiagnosisOptions& options);
+
+}  // namespace gpilqg::diagnosis

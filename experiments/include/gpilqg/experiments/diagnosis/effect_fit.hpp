@@ -1,0 +1,96 @@
+#pragma once
+/// @file effect_fit.hpp
+/// Which physical effect is missing: fit every effect of the library to the one-step residuals of the
+/// training episodes and score it on the held-out episodes.
+///
+/// For an effect with parameters theta (current value theta_0 in the model) the predicted next state
+/// is phi(x_t, u_t; theta) (the model with the effect, integrated like the model). With per-state
+/// weights w_i = 1 / sigma_i^2 (sigma_i the noise floor) the fit minimises
+///
+///   S(theta) = sum_{t in training} sum_i w_i (x_{t+1,i} - phi_i(x_t, u_t; theta))^2.
+///
+/// 1. Linear least squares on the regressor J = d phi / d theta at theta_0 (central differences of the
+///    step, step 1e-4 of the parameter's scale): theta_LS = theta_0 + argmin |W^1/2 (r - J d)|^2, r the
+///    model's residual. For an effect linear in theta (friction, drag, external forces, the gain, kv,
+///    km, rho) this is the estimate up to the RK4 discretisation; for the others it is a Gauss-Newton
+///    step.
+/// 2. A nonlinear refit of S with NLopt (BOBYQA, derivative-free, bounded to the parameter's physical
+///    range and a box around theta_LS) gives the final estimate theta_hat.
+/// 3. A 95% interval from the Gauss-Newton covariance at theta_hat, s^2 (J'WJ)^-1 with
+///    s^2 = S / (N n - p), widened to the delete-one-episode jackknife when that is larger: one-step
+///    residuals of one episode are correlated, so the iid interval alone is too narrow.
+/// 4. On the held-out episodes: RMSE per state before and after, and the weighted fraction of
+///    squared residual explained, 1 - S_after / S_before, with a 95% interval and a z score from batch
+///    means of the per-sample reduction (batches of consecutive samples within an episode, so the
+///    serial correlation of the residual does not inflate the significance).
+///
+/// Aliases: two effects whose weighted regressors are nearly collinear (|cos angle| >= 0.95, the
+/// uncentred correlation that governs least-squares identifiability) cannot be told apart on these
+/// data; they are reported as one group under the best of them.
+
+#include <string>
+#include <vector>
+
+#include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/experiments/diagnosis/transitions.hpp"
+
+namespace gpilqg::diagnosis {
+
+/// The data and model a fit works on.
+struct FitContext {
+  const Transitions* data = nullptr;
+  ModelSpec model;                      ///< the model the effect is added to
+  Integrator integrator = Integrator::RK4;
+  double dt = 0.02;
+  int substeps = 1;
+  Vector weights;                       ///< n, w_i = 1 / sigma_i^2
+  Matrix residual;                      ///< N x n, the model's one-step residual at every row
+  int batch = 25;                       ///< batch length of the held-out significance test
+};
+
+/// The model integrated as configured.
+std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integrator integrator, double dt, int substeps);
+
+struct EffectFit {
+  std::string effect;
+  std::vector<EffectParameter> parameters;
+  Vector initial;            ///< theta_0
+  Vector linear_estimate;    ///< theta_LS
+  Vector estimate;           ///< theta_hat (NLopt)
+  Vector ci_low, ci_high;    ///< 95% interval of theta_hat
+  int evaluations = 0;       ///< NLopt objective evaluations
+  double training_objective_before = 0.0;  ///< S(theta_0)
+  double training_objective_after = 0.0;   ///< S(theta_hat)
+  Vector heldout_rmse_before;  ///< n
+  Vector heldout_rmse_after;   ///< n
+  double explained = 0.0;      ///< 1 - S_after / S_before on the held-out rows
+  double explained_ci = 0.0;   ///< half-width of its 95% interval
+  double z_score = 0.0;        ///< mean reduction / its batch-means standard error
+  Vector regressor;            ///< weighted J at theta_0 over the training rows (first parameter), for aliasing
+  bool identifiable = true;    ///< false when the effect does not change the predictions at all
+};
+
+/// Fits one effect (steps 1-4 above). Never returns NaN: an effect without influence on the data
+/// (J = 0) keeps theta_0, identifiable = false and explained = 0.
+EffectFit fit_effect(const LibraryEffect& effect, const FitContext& context);
+
+/// Scores the effect at given values without fitting (step 4 only): estimate = linear_estimate =
+/// ci_low = ci_high = values. Throws std::invalid_argument for values the effect does not accept.
+EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, const FitContext& context);
+
+/// |cos angle| between two regressors (0 when either is zero).
+double regressor_correlation(const Vector& a, const Vector& b);
+
+/// One entry of the ranking: the best effect of an alias group and the others of the group.
+struct RankedEffect {
+  EffectFit fit;
+  std::vector<EffectFit> aliases;
+};
+
+/// Fits every effect of the library and ranks the alias groups by held-out explained fraction
+/// (greedy grouping: the best remaining effect takes every remaining effect whose regressor correlation
+/// with it is >= alias_threshold).
+std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold = 0.95);
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,33 @@
+#pragma once
+/// @file report_hdf5.hpp
+/// The diagnosis as an HDF5 file, written to a temporary file and renamed into place. The plotting
+/// script (experiments/scripts/diagnose_plots.py) reads only this file. Layout (schema_version 1):
+///
+///   / attrs: schema_version, gpilqg_version, system, created, status (the verdict), verdict_effect,
+///            consistent (int), model (TOML), model_next (TOML), report (the JSON document),
+///            state_names, control_names, input_names (string arrays)
+///   /data/{x (N x n), u (N x m), x_next (N x n), t (N), episode (N, int), heldout (N, int)}
+///   /compare/{predicted, residual, gp_mean, gp_std (N x n)}
+///   /compare/states/{rmse, noise_floor, heldout_rmse, fit_percent, gp_explained} (n)
+///   /compare/k_<k>/{measured, predicted (W x n), episode, start (W, int)}  attrs: k, stride
+///   /where/relevance, /where/sensitivity (n x (n + m)); /where/episode_rmse (E x n)
+///   /where/bins/<input>/{edges (B + 1), rmse (n x B), count (B)}
+///   /where/cross_correlation/{lags (2L + 1), values (n x m x (2L + 1)), band (n x m)}
+///   /ranking/{estimate, ci_low, ci_high, explained, explained_ci, z_score, heldout_rmse_before,
+///             heldout_rmse_after (G)}  attrs: heldout_state, effect, parameter_name, unit, aliases (G strings,
+///             aliases comma-separated)
+///   /add/{heldout_rmse (4 x n, rows as attribute model), signal_variance (2 x n: sim+GP, sim+effect+GP),
+///         residual_before, residual_after (N x n: "sim" and "sim+effect"), relevance_before (n x (n + m))}
+///         attrs: effect, model (4 strings)       (present when the report has the four models)
+
+#include <filesystem>
+
+#include "gpilqg/experiments/diagnosis/diagnosis.hpp"
+
+namespace gpilqg::diagnosis {
+
+/// Writes the report with core's Hdf5Writer, through a temporary file. Throws std::runtime_error
+/// naming the file when HDF5 fails.
+void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport& report);
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,58 @@
+#pragma once
+/// @file transitions.hpp
+/// The one-step transitions of a measurement set, split into training and held-out episodes, and the
+/// predictions of a model on them: one-step x'_hat = phi(x_t, u_t) and k-step open-loop predictions over
+/// windows restarted from measured states.
+///
+/// Held-out data are whole episodes, never single samples: consecutive samples of one episode are
+/// strongly correlated, so a sample split would leak the held-out data into the fit.
+
+#include <vector>
+
+#include "gpilqg/core/measurements.hpp"
+#include "gpilqg/core/step_model.hpp"
+
+namespace gpilqg::diagnosis {
+
+/// Every pair (x_t, u_t) -> x_{t+1} of consecutive rows, over all episodes, in file order.
+struct Transitions {
+  Matrix x;                   ///< N x n, measured state at t
+  Matrix u;                   ///< N x m, control applied from t
+  Matrix x_next;              ///< N x n, measured state at t + dt
+  Vector t;                   ///< N, time of x
+  std::vector<int> episode;   ///< N, index of the episode in MeasurementSet::episodes
+  std::vector<bool> heldout;  ///< N, true for rows of held-out episodes
+  int size() const { return static_cast<int>(x.rows()); }
+  /// Indices of the training rows (heldout == false) or of the held-out rows.
+  std::vector<int> rows(bool heldout_rows) const;
+};
+
+/// The held-out episodes (indices into MeasurementSet::episodes): every episode whose position i
+/// satisfies (i + 1) * fraction crossing an integer, i.e. round(E * fraction) episodes spread evenly
+/// over the file, at least one and at least one left for training. Throws std::invalid_argument when
+/// the set has fewer than 2 episodes or fraction is outside (0, 1).
+std::vector<int> heldout_episodes(const MeasurementSet& set, double fraction);
+
+/// The transitions of `set`, with held-out rows marked. Throws std::invalid_argument when an episode's
+/// dt differs from `dt` by more than 1e-6 relative (naming the episode and both values).
+Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& heldout, double dt);
+
+/// One-step predictions phi(x_t, u_t) (N x n). A non-finite prediction is replaced by x_t (and counted
+/// in `non_finite` when not null), so no NaN leaves this function.
+Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* non_finite = nullptr);
+
+/// k-step open-loop predictions: for every episode and every start s = 0, stride, 2 stride, ... with
+/// s + k < T, roll the model k steps from the measured x_s with the measured controls and compare with
+/// the measured x_{s+k}.
+struct KStepPredictions {
+  int k = 1;
+  Matrix measured;             ///< W x n, x_{s+k}
+  Matrix predicted;            ///< W x n
+  std::vector<int> episode;    ///< W
+  std::vector<int> start;      ///< W, s
+  int diverged = 0;            ///< windows whose prediction became non-finite (left out of the W rows)
+};
+KStepPredictions k_step_predictions(const StepModel& model, const MeasurementSet& set,
+                                    const std::vector<int>& episodes, int k, int stride);
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,171 @@
+/// `gpilqg diagnose --system NAME --data FILE [--model F.toml] [--add EFFECT[=VALUE]]... [--json]
+/// [--out F.h5] [--plots DIR]`: compare a model with measurements, see where it fails, learn which
+/// physical effect is missing, add it and watch the error fall (DESIGN.md sections 5, 6 and 8).
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "gpilqg/core/measurements.hpp"
+#include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/diagnosis.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
+#include "gpilqg/experiments/diagnosis/report.hpp"
+#include "gpilqg/experiments/diagnosis/report_hdf5.hpp"
+#include "gpilqg/experiments/plot_script.hpp"
+#include "gpilqg/gp/backend_registry.hpp"
+
+namespace gpilqg::cli {
+
+namespace {
+
+/// The plotting script under experiments/plots/ (plot_script.hpp).
+constexpr const char* kPlotScript = "diagnose_plots.py";
+
+struct DiagnoseOptions {
+  std::string system;
+  std::string data;
+  std::string model;
+  std::string preset = "sim";
+  std::vector<std::string> add;
+  bool json = false;
+  std::string out;
+  std::string plots;
+  std::string write_model;
+  std::string integrator = "rk4";
+  double heldout = 0.3;
+  int gp_points = 300;
+  int gp_restarts = 1;
+  std::string backend = "exact";
+  std::uint64_t seed = 1;
+};
+
+/// Checks, before any work, that plots can be drawn (exit 2 with the missing packages otherwise).
+void check_plotting() {
+  try {
+    require_plotting(kPlotScript);
+  } catch (const std::runtime_error& e) {
+    throw InputError(std::string("--plots: ") + e.what());
+  }
+}
+
+diagnosis::DiagnosisOptions make_options(const DiagnoseOptions& o) {
+  diagnosis::DiagnosisOptions d;
+  if (!o.model.empty()) {
+    d.model = diagnosis::read_model_file(o.model, o.system);
+  } else {
+    const auto preset = parse_preset(o.preset);
+    if (!preset) throw InputError("--preset '" + o.preset + "': expected 'sim' or 'real'");
+    d.model.system = o.system;
+    d.model.preset = *preset;
+  }
+  for (const std::string& text : o.add) d.add.push_back(diagnosis::parse_add_option(text, o.system));
+  const auto integrator = parse_integrator(o.integrator);
+  if (!integrator) throw InputError("--integrator '" + o.integrator + "': expected 'rk4' or 'euler'");
+  d.integrator = *integrator;
+  if (!(o.heldout > 0.0 && o.heldout < 1.0))
+    throw InputError(fmt::format("--heldout {}: expected a fraction of the episodes in (0, 1)", o.heldout));
+  if (o.gp_points < 10) throw InputError(fmt::format("--gp-points {}: expected at least 10", o.gp_points));
+  if (o.gp_restarts < 0) throw InputError(fmt::format("--gp-restarts {}: expected >= 0", o.gp_restarts));
+  try {
+    gp::make_backend(o.backend);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("--backend: ") + e.what());
+  }
+  d.heldout_fraction = o.heldout;
+  d.gp.points = o.gp_points;
+  d.gp.restarts = o.gp_restarts;
+  d.gp.backend = o.backend;
+  d.gp.seed = o.seed;
+  return d;
+}
+
+int run_diagnose(const DiagnoseOptions& o) {
+  const SystemSignature signature = system_signature(o.system);
+  const diagnosis::DiagnosisOptions options = make_options(o);
+  if (!o.plots.empty()) check_plotting();
+  const MeasurementSet data = read_measurements(o.data, signature);
+  diagnosis::DiagnosisReport report;
+  try {
+    report = diagnosis::diagnose(data, options);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: {}", o.data, e.what()));
+  }
+
+  std::filesystem::path h5 = o.out;
+  if (h5.empty() && !o.plots.empty()) h5 = std::filesystem::path(o.plots) / "diagnosis.h5";
+  if (!o.plots.empty()) std::filesystem::create_directories(o.plots);
+  if (!h5.empty()) diagnosis::write_report_hdf5(h5, report);
+  if (!o.write_model.empty())
+    diagnosis::write_model_file(o.write_model, report.model_next,
+                                {fmt::format("written by gpilqg diagnose from {} (verdict: {})", o.data, report.verdict.status),
+                                 fmt::format("next: gpilqg diagnose --system {} --data {} --model {}", o.system, o.data, o.write_model)});
+  if (!o.plots.empty()) {
+    // The script's own line goes to stdout; with --json, stdout holds the JSON document only.
+    std::cout.flush();
+    const int saved = o.json ? ::dup(STDOUT_FILENO) : -1;
+    if (saved >= 0 && !std::freopen("/dev/null", "w", stdout)) throw std::runtime_error("cannot silence stdout");
+    try {
+      run_plot_script(kPlotScript, h5, o.plots);
+    } catch (...) {
+      if (saved >= 0) ::dup2(saved, STDOUT_FILENO);
+      throw;
+    }
+    if (saved >= 0) {
+      std::fflush(stdout);
+      ::dup2(saved, STDOUT_FILENO);
+      ::close(saved);
+    }
+  }
+
+  if (o.json) {
+    std::cout << diagnosis::report_json(report).dump(2) << '\n';
+    return kExitSuccess;
+  }
+  std::cout << diagnosis::report_text(report);
+  if (!h5.empty()) std::cout << "report: " << h5.string() << '\n';
+  if (!o.plots.empty()) std::cout << "plots: " << o.plots << '\n';
+  if (!o.write_model.empty()) std::cout << "model for the next round: " << o.write_model << '\n';
+  if (report.verdict.effect && o.add.empty())
+    std::cout << fmt::format("next: gpilqg diagnose --system {} --data {}{} --add {}\n", o.system, o.data,
+                             o.model.empty() ? "" : " --model " + o.model, report.verdict.effect->effect);
+  return kExitSuccess;
+}
+
+}  // namespace
+
+void add_diagnose_command(CLI::App& app, CommandAction& action) {
+  auto o = std::make_shared<DiagnoseOptions>();
+  auto* cmd = app.add_subcommand("diagnose",
+                                 "Compare a model with measurements, see where it fails, learn which physical effect is "
+                                 "missing, add it and watch the error fall");
+  cmd->add_option("--system", o->system, "System name (cartpole, quadrotor)")->required();
+  cmd->add_option("--data", o->data, "Measurement file (.csv, .h5)")->required();
+  cmd->add_option("--model", o->model, "Model file (TOML): preset, recalibrated parameters, effects");
+  cmd->add_option("--preset", o->preset, "Preset without --model: sim or real")->capture_default_str();
+  cmd->add_option("--add", o->add, "Add a library effect, EFFECT or EFFECT=VALUE (fitted without a value; repeatable)");
+  cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the report");
+  cmd->add_option("--out", o->out, "Write the HDF5 report here");
+  cmd->add_option("--plots", o->plots, "Write PNG plots into this folder (needs matplotlib and h5py)");
+  cmd->add_option("--write-model", o->write_model, "Write the improved model (TOML) for the next diagnosis");
+  cmd->add_option("--integrator", o->integrator, "rk4 or euler")->capture_default_str();
+  cmd->add_option("--heldout", o->heldout, "Fraction of the episodes held out")->capture_default_str();
+  cmd->add_option("--gp-points", o->gp_points, "GP training points per state")->capture_default_str();
+  cmd->add_option("--gp-restarts", o->gp_restarts, "Random restarts of the GP fit")->capture_default_str();
+  cmd->add_option("--backend", o->backend, "GP backend (exact, fitc, ssgp)")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the GP subsample and restarts")->capture_default_str();
+  cmd->callback([&action, o] { action = [o] { return run_diagnose(*o); }; });
+}
+
+}  // namespace gpilqg::cli

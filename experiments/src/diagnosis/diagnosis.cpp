@@ -1,0 +1,233 @@
+#include "gpilqg/experiments/diagnosis/diagnosis.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace gpilqg::diagnosis {
+
+void DiagnosisOptions::validate() const {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument("diagnosis option " + what);
+  };
+  require(substeps >= 1, "'substeps' must be >= 1");
+  require(heldout_fraction > 0.0 && heldout_fraction < 1.0, "'heldout_fraction' must be in (0, 1)");
+  for (int k : horizons) require(k >= 1, "'horizons' must be >= 1");
+  require(gp.points >= 10, "'gp.points' must be >= 10");
+  require(gp.restarts >= 0 && gp.threads >= 1, "'gp.restarts' must be >= 0 and 'gp.threads' >= 1");
+  require(bins >= 1 && max_lag >= 0, "'bins' must be >= 1 and 'max_lag' >= 0");
+  require(alias_threshold > 0.0 && alias_threshold <= 1.0, "'alias_threshold' must be in (0, 1]");
+  require(structure_threshold >= 0.0 && floor_tolerance >= 1.0, "'structure_threshold' >= 0, 'floor_tolerance' >= 1");
+  require(min_explained >= 0.0 && min_z >= 0.0 && relative_to_gp >= 0.0, "thresholds must be >= 0");
+}
+
+namespace {
+
+Matrix residual_of(const Transitions& data, const Matrix& predicted) { return data.x_next - predicted; }
+
+Vector heldout_rmse(const Transitions& data, const Matrix& residual) {
+  const std::vector<int> rows = data.rows(true);
+  Vector out(residual.cols());
+  for (Eigen::Index i = 0; i < residual.cols(); ++i) out(i) = rms(residual.col(i), rows);
+  return out;
+}
+
+/// The noise floor per state: the held-out RMSE of the best predictor at hand, the model or the model
+/// corrected by the GP, min(RMSE(r), RMSE(r - mu)) on the held-out episodes. It is the error that neither
+/// the model nor a flexible function of (x, u) fitted on other episodes can remove. (The GP's own noise
+/// std sn is reported too, but maximum likelihood can trade it for a very short length-scale and then
+/// it says nothing; the cross-validated floor cannot be fooled that way.) Kept above 1e-12 (1 + RMSE) so
+/// that weights stay finite on noise-free data.
+Vector noise_floor(const Transitions& data, const Matrix& residual, const ResidualGp& gp) {
+  const Vector model = heldout_rmse(data, residual);
+  const Vector corrected = heldout_rmse(data, residual - gp.mean);
+  return model.cwiseMin(corrected).cwiseMax(1e-12 * (1.0 + model.array()).matrix());
+}
+
+/// w_i = 1 / floor_i^2.
+Vector floor_weights(const Transitions& data, const Matrix& residual, const ResidualGp& gp) {
+  return noise_floor(data, residual, gp).cwiseAbs2().cwiseInverse();
+}
+
+double weighted_heldout_explained(const Transitions& data, const Matrix& residual, const Matrix& correction,
+                                  const Vector& weights) {
+  double before = 0.0, after = 0.0;
+  for (int r : data.rows(true)) {
+    before += residual.row(r).cwiseAbs2().dot(weights);
+    after += (residual.row(r) - correction.row(r)).cwiseAbs2().dot(weights);
+  }
+  return before > 0.0 ? 1.0 - after / before : 0.0;
+}
+
+/// Rows normalised to sum 1 (rows of zeros stay zero).
+Matrix shares(Matrix sensitivity) {
+  for (Eigen::Index i = 0; i < sensitivity.rows(); ++i) {
+    const double total = sensitivity.row(i).sum();
+    if (total > 0.0) sensitivity.row(i) /= total;
+  }
+  return sensitivity;
+}
+
+Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
+  Verdict v;
+  if (r.consistent) {
+    v.status = "consistent";
+    v.reason = "every state's held-out residual is at its noise floor: there is nothing left to explain";
+    return v;
+  }
+  if (r.ranking.empty()) {
+    v.status = "unexplained";
+    v.reason = "the residual is structured and no effect was ranked";
+    return v;
+  }
+  const RankedEffect& best = r.ranking.front();
+  const EffectFit& f = best.fit;
+  const bool large = f.explained >= o.min_explained;
+  const bool significant = f.z_score >= o.min_z;
+  const bool enough = f.explained >= o.relative_to_gp * r.gp_explained_total;
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, "the best candidate '%s' removes %.1f%% of the held-out residual (z = %.1f); the GP removes %.1f%%",
+                f.effect.c_str(), 100.0 * f.explained, f.z_score, 100.0 * r.gp_explained_total);
+  v.reason = buffer;
+  if (large && significant && enough) {
+    v.status = "explained";
+    v.effect = f;
+    for (const auto& a : best.aliases) v.aliases.push_back(a.effect);
+  } else {
+    v.status = "unexplained";
+    v.reason += large && significant ? ", so the residual's structure is mostly something else"
+                                     : ", not a significant reduction";
+  }
+  return v;
+}
+
+}  // namespace
+
+DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
+  o.validate();
+  if (set.episodes.empty()) throw std::invalid_argument("the data has no episodes");
+  DiagnosisReport R;
+  R.system = o.model.system;
+  if (set.system.name != R.system)
+    throw std::invalid_argument("the data are of system '" + set.system.name + "'; the model is '" + R.system + "'");
+  R.model_before = o.model;
+  R.state_names = names_of(set.system.states);
+  R.control_names = names_of(set.system.controls);
+  R.input_names = R.state_names;
+  R.input_names.insert(R.input_names.end(), R.control_names.begin(), R.control_names.end());
+  R.dt = set.episodes.front().dt();
+  R.heldout_episode_index = heldout_episodes(set, o.heldout_fraction);
+  for (int i : R.heldout_episode_index) R.heldout_episode_ids.push_back(set.episodes[static_cast<std::size_t>(i)].id);
+  R.data = make_transitions(set, R.heldout_episode_index, R.dt);
+  R.samples = R.data.size();
+  const Transitions& data = R.data;
+  const int n = static_cast<int>(R.state_names.size());
+
+  // The model as given, its residual and GP.
+  const auto before_step = make_step_model(o.model, o.integrator, R.dt, o.substeps);
+  const Matrix residual_before = residual_of(data, one_step_predictions(*before_step, data));
+  ResidualGp gp_before = fit_residual_gp(before_step, data, residual_before, o.gp);
+
+  // Effects to add: given values, or fitted on the training episodes against the model so far.
+  R.model = o.model;
+  Matrix residual = residual_before;
+  for (const EffectRequest& request : o.add) {
+    const LibraryEffect& effect = find_effect(R.system, request.effect);
+    FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, floor_weights(data, residual_before, gp_before), residual};
+    EffectFit fit = request.values ? score_effect(effect, *request.values, context) : fit_effect(effect, context);
+    R.model = R.model.with(effect, fit.estimate);
+    residual = residual_of(data, one_step_predictions(*make_step_model(R.model, o.integrator, R.dt, o.substeps), data));
+    R.added.push_back(std::move(fit));
+  }
+  const auto step = make_step_model(R.model, o.integrator, R.dt, o.substeps);
+  R.predicted = one_step_predictions(*step, data, &R.non_finite_predictions);
+  R.residual = residual_of(data, R.predicted);
+  R.gp = o.add.empty() ? gp_before : fit_residual_gp(step, data, R.residual, o.gp);
+  const Vector floors = noise_floor(data, R.residual, R.gp);
+  R.weights = floors.cwiseAbs2().cwiseInverse();
+
+  // 1. Compare.
+  const Vector gp_structure = gp_explained(R.gp, data, R.residual);
+  const Vector rmse_heldout = heldout_rmse(data, R.residual);
+  for (int i = 0; i < n; ++i) {
+    StateScore s;
+    s.name = R.state_names[static_cast<std::size_t>(i)];
+    s.rmse = rms(R.residual.col(i));
+    s.fit_percent = fit_percent(data.x_next.col(i) - data.x.col(i), R.predicted.col(i) - data.x.col(i));
+    s.noise_floor = floors(i);
+    s.gp_noise_std = R.gp.noise_std(i);
+    s.heldout_rmse = rmse_heldout(i);
+    s.gp_explained = gp_structure(i);
+    s.structured = s.gp_explained > o.structure_threshold && s.heldout_rmse > o.floor_tolerance * s.noise_floor;
+    R.states.push_back(s);
+  }
+  std::vector<int> all_episodes(set.episodes.size());
+  for (std::size_t e = 0; e < all_episodes.size(); ++e) all_episodes[e] = static_cast<int>(e);
+  for (int k : o.horizons) {
+    KStepScore score;
+    score.k = k;
+    score.stride = std::max(1, k / 10);
+    score.predictions = k_step_predictions(*step, set, all_episodes, k, score.stride);
+    score.windows = static_cast<int>(score.predictions.measured.rows());
+    score.diverged = score.predictions.diverged;
+    score.rmse = Vector::Zero(n);
+    score.fit_percent = Vector::Zero(n);
+    for (int i = 0; i < n && score.windows > 0; ++i) {
+      const Vector e = score.predictions.measured.col(i) - score.predictions.predicted.col(i);
+      score.rmse(i) = rms(e);
+      score.fit_percent(i) = fit_percent(score.predictions.measured.col(i), score.predictions.predicted.col(i));
+    }
+    R.k_step.push_back(std::move(score));
+  }
+
+  // 2. Where.
+  R.sensitivity = gp_sensitivity(R.gp, data, data.rows(false));
+  R.relevance = shares(R.sensitivity);
+  R.bins = bin_residuals(data, R.residual, R.input_names, o.bins);
+  R.xcorr = cross_correlation(data, R.residual, o.max_lag);
+  R.episode_rms = episode_rms(data, R.residual, static_cast<int>(set.episodes.size()));
+  R.consistent = true;
+  for (const StateScore& s : R.states) R.consistent = R.consistent && !s.structured;
+  R.gp_explained_total = weighted_heldout_explained(data, R.residual, R.gp.mean, R.weights);
+
+  // 3. Which.
+  const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual};
+  if (o.rank) R.ranking = rank_effects(context, o.alias_threshold);
+  R.verdict = decide(R, o);
+
+  // 4. Add: the four models on the held-out episodes.
+  R.model_next = R.model;
+  const ModelSpec* with_effect = nullptr;
+  const ResidualGp* base_gp = nullptr;
+  Matrix base_residual;
+  ModelSpec proposed;
+  if (!o.add.empty()) {
+    with_effect = &R.model;
+    base_gp = &gp_before;
+    base_residual = residual_before;
+    R.residual_after = R.residual;
+    for (const EffectFit& f : R.added) R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + f.effect;
+  } else if (R.verdict.status == "explained") {
+    proposed = R.model.with(find_effect(R.system, R.verdict.effect->effect), R.verdict.effect->estimate);
+    R.model_next = proposed;
+    with_effect = &proposed;
+    base_gp = &R.gp;
+    base_residual = R.residual;
+    R.residual_after = residual_of(data, one_step_predictions(*make_step_model(proposed, o.integrator, R.dt, o.substeps), data));
+    R.comparison_effect = R.verdict.effect->effect;
+  }
+  if (with_effect != nullptr) {
+    const ResidualGp gp_after = !o.add.empty()
+                                    ? R.gp
+                                    : fit_residual_gp(make_step_model(*with_effect, o.integrator, R.dt, o.substeps), data,
+                                                      R.residual_after, o.gp);
+    R.residual_base = base_residual;
+    R.relevance_base = !o.add.empty() ? shares(gp_sensitivity(gp_before, data, data.rows(false))) : R.relevance;
+    R.comparison.push_back({"sim", heldout_rmse(data, base_residual), Vector()});
+    R.comparison.push_back({"sim+effect", heldout_rmse(data, R.residual_after), Vector()});
+    R.comparison.push_back({"sim+GP", heldout_rmse(data, base_residual - base_gp->mean), base_gp->signal_variance});
+    R.comparison.push_back({"sim+effect+GP", heldout_rmse(data, R.residual_after - gp_after.mean), gp_after.signal_variance});
+  }
+  return R;
+}
+
+}  // namespace gpilqg::diagnosis

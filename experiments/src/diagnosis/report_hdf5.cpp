@@ -1,0 +1,170 @@
+#include "gpilqg/experiments/diagnosis/report_hdf5.hpp"
+
+#include <chrono>
+#include <ctime>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/hdf5_writer.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
+#include "gpilqg/experiments/diagnosis/report.hpp"
+
+namespace gpilqg::diagnosis {
+
+namespace {
+
+std::vector<double> row_major(const std::vector<std::vector<Vector>>& values) {
+  std::vector<double> out;
+  for (const auto& row : values)
+    for (const Vector& v : row) out.insert(out.end(), v.data(), v.data() + v.size());
+  return out;
+}
+
+void write_data(Hdf5Writer& h5, const DiagnosisReport& r) {
+  h5.write_matrix("/data/x", r.data.x);
+  h5.write_matrix("/data/u", r.data.u);
+  h5.write_matrix("/data/x_next", r.data.x_next);
+  h5.write_vector("/data/t", r.data.t);
+  h5.write_vector("/data/episode", r.data.episode);
+  h5.write_vector("/data/heldout", std::vector<int>(r.data.heldout.begin(), r.data.heldout.end()));
+
+  h5.write_matrix("/compare/predicted", r.predicted);
+  h5.write_matrix("/compare/residual", r.residual);
+  h5.write_matrix("/compare/gp_mean", r.gp.mean);
+  h5.write_matrix("/compare/gp_std", r.gp.variance.cwiseSqrt());
+  std::vector<double> rmse, floor, heldout, fit, structure;
+  for (const StateScore& s : r.states) {
+    rmse.push_back(s.rmse);
+    floor.push_back(s.noise_floor);
+    heldout.push_back(s.heldout_rmse);
+    fit.push_back(s.fit_percent);
+    structure.push_back(s.gp_explained);
+  }
+  h5.write_vector("/compare/states/rmse", rmse);
+  h5.write_vector("/compare/states/noise_floor", floor);
+  h5.write_vector("/compare/states/heldout_rmse", heldout);
+  h5.write_vector("/compare/states/fit_percent", fit);
+  h5.write_vector("/compare/states/gp_explained", structure);
+  for (const KStepScore& k : r.k_step) {
+    const std::string g = "/compare/k_" + std::to_string(k.k);
+    h5.write_matrix(g + "/measured", k.predictions.measured);
+    h5.write_matrix(g + "/predicted", k.predictions.predicted);
+    h5.write_vector(g + "/episode", k.predictions.episode);
+    h5.write_vector(g + "/start", k.predictions.start);
+    h5.attribute(g, "k", static_cast<std::int64_t>(k.k));
+    h5.attribute(g, "stride", static_cast<std::int64_t>(k.stride));
+  }
+}
+
+void write_where(Hdf5Writer& h5, const DiagnosisReport& r) {
+  h5.write_matrix("/where/relevance", r.relevance);
+  h5.write_matrix("/where/sensitivity", r.sensitivity);
+  h5.write_matrix("/where/episode_rmse", r.episode_rms);
+  for (const BinnedResidual& b : r.bins) {
+    const std::string g = "/where/bins/" + b.input;
+    h5.write_vector(g + "/edges", b.edges);
+    h5.write_matrix(g + "/rmse", b.rms);
+    h5.write_vector(g + "/count", b.count);
+  }
+  const int L = r.xcorr.max_lag;
+  Vector lags(2 * L + 1);
+  for (int k = -L; k <= L; ++k) lags(k + L) = k;
+  h5.write_vector("/where/cross_correlation/lags", lags);
+  const std::uint64_t n = r.xcorr.values.size(), m = n > 0 ? r.xcorr.values[0].size() : 0;
+  h5.write_array("/where/cross_correlation/values", {n, m, static_cast<std::uint64_t>(2 * L + 1)}, row_major(r.xcorr.values));
+  h5.write_matrix("/where/cross_correlation/band", r.xcorr.band);
+}
+
+void write_ranking(Hdf5Writer& h5, const DiagnosisReport& r) {
+  const int state = worst_state(r);
+  h5.attribute("/ranking", "heldout_state", r.state_names[static_cast<std::size_t>(state)]);
+  if (r.ranking.empty()) return;
+  std::vector<std::string> effect, parameter, unit, aliases;
+  std::vector<double> estimate, low, high, explained, explained_ci, z, before, after;
+  for (const RankedEffect& e : r.ranking) {
+    effect.push_back(e.fit.effect);
+    parameter.push_back(e.fit.parameters[0].name);
+    unit.push_back(e.fit.parameters[0].unit);
+    std::string list;
+    for (const EffectFit& a : e.aliases) list += (list.empty() ? "" : ",") + a.effect;
+    aliases.push_back(list);
+    estimate.push_back(e.fit.estimate(0));
+    low.push_back(e.fit.ci_low(0));
+    high.push_back(e.fit.ci_high(0));
+    explained.push_back(e.fit.explained);
+    explained_ci.push_back(e.fit.explained_ci);
+    z.push_back(e.fit.z_score);
+    before.push_back(e.fit.heldout_rmse_before(state));
+    after.push_back(e.fit.heldout_rmse_after(state));
+  }
+  h5.attribute("/ranking", "effect", effect);
+  h5.attribute("/ranking", "parameter_name", parameter);
+  h5.attribute("/ranking", "unit", unit);
+  h5.attribute("/ranking", "aliases", aliases);
+  h5.write_vector("/ranking/estimate", estimate);
+  h5.write_vector("/ranking/ci_low", low);
+  h5.write_vector("/ranking/ci_high", high);
+  h5.write_vector("/ranking/explained", explained);
+  h5.write_vector("/ranking/explained_ci", explained_ci);
+  h5.write_vector("/ranking/z_score", z);
+  h5.write_vector("/ranking/heldout_rmse_before", before);
+  h5.write_vector("/ranking/heldout_rmse_after", after);
+}
+
+void write_add(Hdf5Writer& h5, const DiagnosisReport& r) {
+  if (r.comparison.empty()) return;
+  std::vector<std::string> names;
+  Matrix rmse(static_cast<Eigen::Index>(r.comparison.size()), static_cast<Eigen::Index>(r.states.size()));
+  Matrix variance(2, static_cast<Eigen::Index>(r.states.size()));
+  int with_gp = 0;
+  for (std::size_t k = 0; k < r.comparison.size(); ++k) {
+    names.push_back(r.comparison[k].name);
+    rmse.row(static_cast<Eigen::Index>(k)) = r.comparison[k].heldout_rmse.transpose();
+    if (r.comparison[k].signal_variance.size() > 0 && with_gp < 2) variance.row(with_gp++) = r.comparison[k].signal_variance.transpose();
+  }
+  h5.write_matrix("/add/heldout_rmse", rmse);
+  h5.write_matrix("/add/signal_variance", variance);
+  h5.write_matrix("/add/residual_before", r.residual_base);
+  h5.write_matrix("/add/residual_after", r.residual_after);
+  h5.write_matrix("/add/relevance_before", r.relevance_base);
+  h5.attribute("/add", "effect", r.comparison_effect);
+  h5.attribute("/add", "model", names);
+}
+
+std::string now_utc() {
+  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  char buffer[32];
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buffer;
+}
+
+}  // namespace
+
+void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport& r) {
+  write_atomically(file, [&](const std::filesystem::path& temporary) {
+    Hdf5Writer h5(temporary);
+    h5.attribute("/", "schema_version", std::int64_t{1});
+    h5.attribute("/", "gpilqg_version", std::string(GPILQG_VERSION));
+    h5.attribute("/", "system", r.system);
+    h5.attribute("/", "created", now_utc());
+    h5.attribute("/", "status", r.verdict.status);
+    h5.attribute("/", "verdict_effect", r.verdict.effect ? r.verdict.effect->effect : std::string());
+    h5.attribute("/", "consistent", std::int64_t{r.consistent ? 1 : 0});
+    h5.attribute("/", "model", model_file_text(r.model));
+    h5.attribute("/", "model_next", model_file_text(r.model_next));
+    h5.attribute("/", "report", report_json(r).dump());
+    h5.attribute("/", "state_names", r.state_names);
+    h5.attribute("/", "control_names", r.control_names);
+    h5.attribute("/", "input_names", r.input_names);
+    write_data(h5, r);
+    write_where(h5, r);
+    write_ranking(h5, r);
+    write_add(h5, r);
+    h5.close();
+  });
+}
+
+}  // namespace gpilqg::diagnosis

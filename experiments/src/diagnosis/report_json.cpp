@@ -1,0 +1,168 @@
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
+#include "gpilqg/experiments/diagnosis/report.hpp"
+
+namespace gpilqg::diagnosis {
+
+int worst_state(const DiagnosisReport& r) {
+  int worst = 0;
+  double ratio = -1.0;
+  for (std::size_t i = 0; i < r.states.size(); ++i) {
+    const double q = r.states[i].heldout_rmse / std::max(r.states[i].noise_floor, 1e-300);
+    if (q > ratio) {
+      ratio = q;
+      worst = static_cast<int>(i);
+    }
+  }
+  return worst;
+}
+
+namespace {
+
+using nlohmann::json;
+
+json by_name(const std::vector<std::string>& names, const VectorCRef& values) {
+  json out = json::object();
+  for (std::size_t i = 0; i < names.size() && static_cast<Eigen::Index>(i) < values.size(); ++i)
+    out[names[i]] = values(static_cast<Eigen::Index>(i));
+  return out;
+}
+
+json vector_json(const VectorCRef& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+json parameters_json(const EffectFit& f, const Vector& values) {
+  json out = json::object();
+  for (std::size_t i = 0; i < f.parameters.size(); ++i) out[f.parameters[i].name] = values(static_cast<Eigen::Index>(i));
+  return out;
+}
+
+json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
+  json ci = json::object();
+  for (std::size_t i = 0; i < f.parameters.size(); ++i)
+    ci[f.parameters[i].name] = {f.ci_low(static_cast<Eigen::Index>(i)), f.ci_high(static_cast<Eigen::Index>(i))};
+  json units = json::object();
+  for (const auto& p : f.parameters) units[p.name] = p.unit;
+  return {{"effect", f.effect},
+          {"parameters", parameters_json(f, f.estimate)},
+          {"parameter_ci95", ci},
+          {"units", units},
+          {"initial", parameters_json(f, f.initial)},
+          {"linear_estimate", parameters_json(f, f.linear_estimate)},
+          {"explained", f.explained},
+          {"explained_ci95", {f.explained - f.explained_ci, f.explained + f.explained_ci}},
+          {"z_score", f.z_score},
+          {"identifiable", f.identifiable},
+          {"nlopt_evaluations", f.evaluations},
+          {"heldout_state", r.state_names[static_cast<std::size_t>(state)]},
+          {"heldout_rmse_before", f.heldout_rmse_before(state)},
+          {"heldout_rmse_after", f.heldout_rmse_after(state)},
+          {"heldout_rmse_by_state",
+           {{"before", by_name(r.state_names, f.heldout_rmse_before)}, {"after", by_name(r.state_names, f.heldout_rmse_after)}}}};
+}
+
+json where_json(const DiagnosisReport& r) {
+  json bins = json::object();
+  for (std::size_t i = 0; i < r.state_names.size(); ++i) {
+    json per_input = json::object();
+    for (const BinnedResidual& b : r.bins)
+      per_input[b.input] = {{"edges", vector_json(b.edges)}, {"rmse", vector_json(b.rms.row(static_cast<Eigen::Index>(i)).transpose())}, {"count", b.count}};
+    bins[r.state_names[i]] = per_input;
+  }
+  json xcorr = json::object();
+  for (std::size_t i = 0; i < r.state_names.size(); ++i) {
+    json per_control = json::object();
+    for (std::size_t j = 0; j < r.control_names.size(); ++j) {
+      const auto ii = static_cast<Eigen::Index>(i), jj = static_cast<Eigen::Index>(j);
+      per_control[r.control_names[j]] = {{"max_abs", r.xcorr.max_abs(ii, jj)}, {"band95", r.xcorr.band(ii, jj)},
+                                         {"significant", r.xcorr.max_abs(ii, jj) > r.xcorr.band(ii, jj)},
+                                         {"values", vector_json(r.xcorr.values[i][j])}};
+    }
+    xcorr[r.state_names[i]] = per_control;
+  }
+  json episodes = json::object();
+  for (std::size_t i = 0; i < r.state_names.size(); ++i)
+    episodes[r.state_names[i]] = vector_json(r.episode_rms.col(static_cast<Eigen::Index>(i)));
+  return {{"bins", bins}, {"cross_correlation", {{"lags", {-r.xcorr.max_lag, r.xcorr.max_lag}}, {"states", xcorr}}},
+          {"episode_rmse", episodes}};
+}
+
+}  // namespace
+
+nlohmann::json report_json(const DiagnosisReport& r) {
+  const int state = worst_state(r);
+  json states = json::array();
+  for (const StateScore& s : r.states)
+    states.push_back({{"name", s.name}, {"rmse", s.rmse}, {"noise_floor", s.noise_floor}, {"fit_percent", s.fit_percent},
+                      {"heldout_rmse", s.heldout_rmse}, {"gp_noise_std", s.gp_noise_std},
+                      {"gp_explained", s.gp_explained}, {"structured", s.structured}});
+  json relevance = json::object(), sensitivity = json::object();
+  for (std::size_t i = 0; i < r.state_names.size(); ++i) {
+    relevance[r.state_names[i]] = by_name(r.input_names, r.relevance.row(static_cast<Eigen::Index>(i)).transpose());
+    sensitivity[r.state_names[i]] = by_name(r.input_names, r.sensitivity.row(static_cast<Eigen::Index>(i)).transpose());
+  }
+  json k_step = json::array();
+  for (const KStepScore& k : r.k_step) {
+    json per_state = json::array();
+    for (std::size_t i = 0; i < r.state_names.size(); ++i)
+      per_state.push_back({{"name", r.state_names[i]}, {"rmse", k.rmse(static_cast<Eigen::Index>(i))},
+                           {"fit_percent", k.fit_percent(static_cast<Eigen::Index>(i))}});
+    k_step.push_back({{"k", k.k}, {"stride", k.stride}, {"windows", k.windows}, {"diverged", k.diverged}, {"states", per_state}});
+  }
+  json ranking = json::array();
+  for (const RankedEffect& g : r.ranking) {
+    json entry = fit_json(g.fit, r, state);
+    json aliases = json::array(), alias_fits = json::array();
+    for (const EffectFit& a : g.aliases) {
+      aliases.push_back(a.effect);
+      alias_fits.push_back(fit_json(a, r, state));
+    }
+    entry["aliases"] = aliases;
+    entry["alias_fits"] = alias_fits;
+    ranking.push_back(entry);
+  }
+  json verdict = {{"status", r.verdict.status}, {"reason", r.verdict.reason}, {"aliases", r.verdict.aliases}};
+  if (r.verdict.effect) {
+    verdict["effect"] = r.verdict.effect->effect;
+    verdict["parameters"] = parameters_json(*r.verdict.effect, r.verdict.effect->estimate);
+    verdict["explained"] = r.verdict.effect->explained;
+  } else {
+    verdict["effect"] = nullptr;
+    verdict["parameters"] = json::object();
+    verdict["explained"] = r.ranking.empty() ? 0.0 : r.ranking.front().fit.explained;
+  }
+  json comparison = json::object();
+  if (!r.comparison.empty()) {
+    json models = json::array();
+    for (const ModelScore& m : r.comparison) {
+      json entry = {{"name", m.name}, {"heldout_rmse", by_name(r.state_names, m.heldout_rmse)}};
+      entry["gp_signal_variance"] = m.signal_variance.size() > 0 ? by_name(r.state_names, m.signal_variance) : json(nullptr);
+      models.push_back(entry);
+    }
+    comparison = {{"effect", r.comparison_effect}, {"models", models}};
+  }
+  json added = json::array();
+  for (const EffectFit& f : r.added) added.push_back(fit_json(f, r, state));
+  json heldout_ids = r.heldout_episode_ids;
+  return {{"system", r.system},
+          {"samples", r.samples},
+          {"dt", r.dt},
+          {"heldout_episodes", heldout_ids},
+          {"consistent", r.consistent},
+          {"states", states},
+          {"k_step", k_step},
+          {"relevance", relevance},
+          {"sensitivity", sensitivity},
+          {"where", where_json(r)},
+          {"gp_explained", r.gp_explained_total},
+          {"ranking", ranking},
+          {"verdict", verdict},
+          {"model", model_file_text(r.model)},
+          {"added", added},
+          {"comparison", comparison},
+          {"model_next", model_file_text(r.model_next)},
+          {"non_finite_predictions", r.non_finite_predictions}};
+}
+
+}  // namespace gpilqg::diagnosis

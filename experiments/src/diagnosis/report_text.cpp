@@ -1,0 +1,162 @@
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "gpilqg/experiments/diagnosis/report.hpp"
+
+namespace gpilqg::diagnosis {
+
+namespace {
+
+std::string percent(double fraction) { return fmt::format("{:.1f}%", 100.0 * fraction); }
+
+std::string parameter_text(const EffectFit& f, bool interval) {
+  std::string out;
+  for (std::size_t i = 0; i < f.parameters.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    out += fmt::format("{}{} = {:.4g} {}", i == 0 ? "" : ", ", f.parameters[i].name, f.estimate(k), f.parameters[i].unit);
+    if (interval) out += fmt::format(" [{:.4g}, {:.4g}]", f.ci_low(k), f.ci_high(k));
+  }
+  return out;
+}
+
+std::string model_text(const ModelSpec& model) {
+  std::string out = fmt::format("{} preset '{}'", model.system, to_string(model.preset));
+  for (const auto& line : model.describe()) out += " + " + line;
+  return out;
+}
+
+void compare_section(const DiagnosisReport& r, std::string& out) {
+  out += "\n1. Compare: one-step prediction, fit on the increments x[t+1] - x[t]\n";
+  out += fmt::format("   {:<10} {:>10} {:>11} {:>10} {:>8} {:>9}\n", "state", "rmse", "noise floor", "held-out", "fit %",
+                     "GP finds");
+  for (const StateScore& s : r.states)
+    out += fmt::format("   {:<10} {:>10.3e} {:>11.3e} {:>10.3e} {:>8.1f} {:>9}{}\n", s.name, s.rmse, s.noise_floor,
+                       s.heldout_rmse, s.fit_percent, percent(std::max(0.0, s.gp_explained)),
+                       s.structured ? "  above the floor" : "");
+  out += "   k-step open-loop prediction from measured states (rmse / fit % on the state):\n";
+  for (const KStepScore& k : r.k_step) {
+    out += fmt::format("   k = {:<3} {:>5} windows{}:", k.k, k.windows,
+                       k.diverged > 0 ? fmt::format(" ({} diverged)", k.diverged) : std::string());
+    for (std::size_t i = 0; i < r.state_names.size() && i < 6; ++i)
+      out += fmt::format("  {} {:.2e}/{:.0f}", r.state_names[i], k.rmse(static_cast<Eigen::Index>(i)),
+                         k.fit_percent(static_cast<Eigen::Index>(i)));
+    out += r.state_names.size() > 6 ? "  ...\n" : "\n";
+  }
+  if (r.consistent) {
+    out += "   => consistent with the measurements: every residual is at its noise floor\n";
+  } else {
+    std::string above;
+    for (const StateScore& s : r.states)
+      if (s.structured) above += (above.empty() ? "" : ", ") + s.name;
+    out += "   => not consistent with the measurements: " + above + " above the noise floor\n";
+  }
+}
+
+void where_section(const DiagnosisReport& r, std::string& out) {
+  out += "\n2. Where it fails\n";
+  for (std::size_t i = 0; i < r.states.size(); ++i) {
+    if (!r.states[i].structured) continue;
+    const auto ii = static_cast<Eigen::Index>(i);
+    // The input along which the binned residual varies most, and its worst bin.
+    double best_ratio = 0.0;
+    std::string region;
+    for (const BinnedResidual& b : r.bins) {
+      Eigen::Index hi = 0;
+      const double top = b.rms.row(ii).maxCoeff(&hi);
+      double low = top;
+      for (Eigen::Index k = 0; k < b.rms.cols(); ++k)
+        if (b.count[static_cast<std::size_t>(k)] > 0) low = std::min(low, b.rms(ii, k));
+      const double ratio = low > 0.0 ? top / low : 0.0;
+      if (ratio > best_ratio) {
+        best_ratio = ratio;
+        region = fmt::format("{} in [{:.3g}, {:.3g}]: rmse {:.2e} vs {:.2e} in the best bin", b.input, b.edges(hi),
+                             b.edges(hi + 1), top, low);
+      }
+    }
+    out += fmt::format("   {}: largest where {}\n", r.state_names[i], region);
+    std::string relevance;
+    std::vector<std::pair<double, std::string>> ranked;
+    for (std::size_t j = 0; j < r.input_names.size(); ++j)
+      ranked.emplace_back(r.relevance(ii, static_cast<Eigen::Index>(j)), r.input_names[j]);
+    std::sort(ranked.rbegin(), ranked.rend());
+    for (std::size_t j = 0; j < std::min<std::size_t>(3, ranked.size()); ++j)
+      relevance += fmt::format("{}{} {:.2f}", j == 0 ? "" : ", ", ranked[j].second, ranked[j].first);
+    out += fmt::format("      GP relevance (share of mean |dmu/dz| std(z)): {}\n", relevance);
+    for (std::size_t j = 0; j < r.control_names.size(); ++j) {
+      const auto jj = static_cast<Eigen::Index>(j);
+      out += fmt::format("      cross-correlation with {}: max |rho| {:.3f}, 95% band {:.3f}{}\n", r.control_names[j],
+                         r.xcorr.max_abs(ii, jj), r.xcorr.band(ii, jj),
+                         r.xcorr.max_abs(ii, jj) > r.xcorr.band(ii, jj) ? " (significant)" : "");
+    }
+  }
+  const int worst = worst_state(r);
+  out += fmt::format("   {} residual RMSE per episode:", r.state_names[static_cast<std::size_t>(worst)]);
+  for (Eigen::Index e = 0; e < r.episode_rms.rows(); ++e) out += fmt::format(" {:.2e}", r.episode_rms(e, worst));
+  out += "\n";
+}
+
+void which_section(const DiagnosisReport& r, std::string& out) {
+  if (r.ranking.empty()) return;
+  const int worst = worst_state(r);
+  out += fmt::format("\n3. Which effect is missing (fitted on training episodes, scored on held-out episodes {})\n",
+                     fmt::join(r.heldout_episode_ids, ", "));
+  out += fmt::format("   {:<3} {:<24} {:<40} {:>16} {:>24}\n", "#", "effect", "parameter [95% interval]", "explained",
+                     "held-out rmse " + r.state_names[static_cast<std::size_t>(worst)]);
+  int rank = 1;
+  for (const RankedEffect& g : r.ranking) {
+    const EffectFit& f = g.fit;
+    out += fmt::format("   {:<3} {:<24} {:<40} {:>8} +-{:>6} {:>11.3e} -> {:.3e}\n", rank++, f.effect, parameter_text(f, true),
+                       percent(f.explained), percent(f.explained_ci), f.heldout_rmse_before(worst), f.heldout_rmse_after(worst));
+    for (const EffectFit& a : g.aliases)
+      out += fmt::format("       alias {:<18} {:<40} {:>8}   (cannot be told apart on these data)\n", a.effect,
+                         parameter_text(a, true), percent(a.explained));
+  }
+}
+
+void add_section(const DiagnosisReport& r, std::string& out) {
+  if (r.comparison.empty()) return;
+  out += fmt::format("\n4. {} on the held-out episodes (effect = {})\n",
+                     r.added.empty() ? "What adding it would do" : "Add it and watch the error fall", r.comparison_effect);
+  for (const EffectFit& f : r.added) out += fmt::format("   added {}: {}\n", f.effect, parameter_text(f, true));
+  std::vector<int> shown;
+  for (std::size_t i = 0; i < r.states.size(); ++i)
+    if (r.states[i].structured || r.comparison[0].heldout_rmse(static_cast<Eigen::Index>(i)) >
+                                      1.05 * r.comparison[1].heldout_rmse(static_cast<Eigen::Index>(i)))
+      shown.push_back(static_cast<int>(i));
+  if (shown.empty()) shown.push_back(worst_state(r));
+  out += fmt::format("   {:<15}", "model");
+  for (int i : shown) out += fmt::format(" {:>12}", "rmse " + r.state_names[static_cast<std::size_t>(i)]);
+  for (int i : shown) out += fmt::format(" {:>14}", "GP sf^2 " + r.state_names[static_cast<std::size_t>(i)]);
+  out += "\n";
+  for (const ModelScore& m : r.comparison) {
+    out += fmt::format("   {:<15}", m.name);
+    for (int i : shown) out += fmt::format(" {:>12.3e}", m.heldout_rmse(i));
+    for (int i : shown) out += m.signal_variance.size() > 0 ? fmt::format(" {:>14.3e}", m.signal_variance(i)) : fmt::format(" {:>14}", "-");
+    out += "\n";
+  }
+}
+
+}  // namespace
+
+std::string report_text(const DiagnosisReport& r) {
+  std::string out = fmt::format("gpilqg diagnose: {}\n", model_text(r.model));
+  if (!r.added.empty()) out += fmt::format("  (started from {})\n", model_text(r.model_before));
+  out += fmt::format("data: {} transitions, dt = {} s, held-out episodes {}\n", r.samples, r.dt,
+                     fmt::join(r.heldout_episode_ids, ", "));
+  compare_section(r, out);
+  where_section(r, out);
+  which_section(r, out);
+  add_section(r, out);
+  out += "\nverdict: " + r.verdict.status;
+  if (r.verdict.effect) {
+    out += fmt::format(": {} ({})", r.verdict.effect->effect, parameter_text(*r.verdict.effect, true));
+    if (!r.verdict.aliases.empty()) out += fmt::format(", or its aliases {}", fmt::join(r.verdict.aliases, ", "));
+  }
+  out += "\n  " + r.verdict.reason + "\n";
+  return out;
+}
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,124 @@
+#include "gpilqg/experiments/diagnosis/transitions.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace gpilqg::diagnosis {
+
+std::vector<int> Transitions::rows(bool heldout_rows) const {
+  std::vector<int> out;
+  for (int i = 0; i < size(); ++i)
+    if (heldout[static_cast<std::size_t>(i)] == heldout_rows) out.push_back(i);
+  return out;
+}
+
+std::vector<int> heldout_episodes(const MeasurementSet& set, double fraction) {
+  const auto count = static_cast<int>(set.episodes.size());
+  if (count < 2)
+    throw std::invalid_argument("the data has " + std::to_string(count) +
+                                " episode(s); expected at least 2, since the diagnosis holds whole episodes out");
+  if (!(fraction > 0.0 && fraction < 1.0))
+    throw std::invalid_argument("held-out fraction " + std::to_string(fraction) + "; expected a value in (0, 1)");
+  const int wanted = std::clamp(static_cast<int>(std::lround(count * fraction)), 1, count - 1);
+  // Spread evenly: episode i is held out when floor((i + 1) w / E) > floor(i w / E).
+  std::vector<int> out;
+  for (int i = 0; i < count; ++i)
+    if (((i + 1) * wanted) / count > (i * wanted) / count) out.push_back(i);
+  return out;
+}
+
+Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& heldout, double dt) {
+  const auto n = static_cast<Eigen::Index>(set.system.states.size());
+  const auto m = static_cast<Eigen::Index>(set.system.controls.size());
+  Eigen::Index rows = 0;
+  for (const Episode& e : set.episodes) rows += std::max(e.length() - 1, 0);
+  Transitions out;
+  out.x.resize(rows, n);
+  out.u.resize(rows, m);
+  out.x_next.resize(rows, n);
+  out.t.resize(rows);
+  out.episode.reserve(static_cast<std::size_t>(rows));
+  out.heldout.reserve(static_cast<std::size_t>(rows));
+  Eigen::Index row = 0;
+  for (std::size_t k = 0; k < set.episodes.size(); ++k) {
+    const Episode& e = set.episodes[k];
+    if (e.length() < 2) continue;
+    if (!(std::abs(e.dt() - dt) <= 1e-6 * dt)) {
+      std::ostringstream os;
+      os.precision(17);
+      os << "episode " << e.id << " has dt = " << e.dt() << " s; expected " << dt
+         << " s like the first episode (within 1e-6 relative)";
+      throw std::invalid_argument(os.str());
+    }
+    const bool held = std::find(heldout.begin(), heldout.end(), static_cast<int>(k)) != heldout.end();
+    const Eigen::Index steps = e.length() - 1;
+    out.x.middleRows(row, steps) = e.x.topRows(steps);
+    out.u.middleRows(row, steps) = e.u.topRows(steps);
+    out.x_next.middleRows(row, steps) = e.x.bottomRows(steps);
+    out.t.segment(row, steps) = e.t.head(steps);
+    for (Eigen::Index s = 0; s < steps; ++s) {
+      out.episode.push_back(static_cast<int>(k));
+      out.heldout.push_back(held);
+    }
+    row += steps;
+  }
+  return out;
+}
+
+Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* non_finite) {
+  Matrix out(data.size(), model.state_dim());
+  Vector next(model.state_dim());
+  int bad = 0;
+  for (int i = 0; i < data.size(); ++i) {
+    model.step(data.x.row(i).transpose(), data.u.row(i).transpose(), next);
+    if (next.allFinite()) {
+      out.row(i) = next.transpose();
+    } else {
+      out.row(i) = data.x.row(i);
+      ++bad;
+    }
+  }
+  if (non_finite != nullptr) *non_finite = bad;
+  return out;
+}
+
+KStepPredictions k_step_predictions(const StepModel& model, const MeasurementSet& set,
+                                    const std::vector<int>& episodes, int k, int stride) {
+  if (k < 1 || stride < 1) throw std::invalid_argument("k_step_predictions: k and stride must be >= 1");
+  const int n = model.state_dim();
+  KStepPredictions out;
+  out.k = k;
+  std::vector<Vector> measured, predicted;
+  Vector x(n), next(n);
+  for (int index : episodes) {
+    const Episode& e = set.episodes.at(static_cast<std::size_t>(index));
+    for (int s = 0; s + k < e.length(); s += stride) {
+      x = e.x.row(s).transpose();
+      bool finite = true;
+      for (int j = 0; j < k && finite; ++j) {
+        model.step(x, e.u.row(s + j).transpose(), next);
+        finite = next.allFinite() && next.cwiseAbs().maxCoeff() < 1e12;
+        x = next;
+      }
+      if (!finite) {
+        ++out.diverged;
+        continue;
+      }
+      measured.push_back(e.x.row(s + k).transpose());
+      predicted.push_back(x);
+      out.episode.push_back(index);
+      out.start.push_back(s);
+    }
+  }
+  out.measured.resize(static_cast<Eigen::Index>(measured.size()), n);
+  out.predicted.resize(static_cast<Eigen::Index>(predicted.size()), n);
+  for (std::size_t w = 0; w < measured.size(); ++w) {
+    out.measured.row(static_cast<Eigen::Index>(w)) = measured[w].transpose();
+    out.predicted.row(static_cast<Eigen::Index>(w)) = predicted[w].transpose();
+  }
+  return out;
+}
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,231 @@
+// `gpilqg diagnose` end to end: JSON with the fixed keys of DESIGN.md section 6 on stdout and nothing
+// else, the HDF5 report, plots, the add -> write-model -> model loop, and bad input (exit 2, "error:",
+// the file and line or the option, and the valid choices). Plus the pieces of the analysis with
+// closed-form answers: fit percent, the episode split, the cross-correlation band, the model file.
+
+#include <gtest/gtest.h>
+
+#include <H5Cpp.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "diagnosis_support.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
+#include "test_support.hpp"
+
+namespace gpilqg {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+
+/// A small cart-pole set with hidden Coulomb friction, mu = 1.2 N.
+fs::path friction_csv(const fs::path& dir) {
+  ModelSpec world;
+  world = world.with(find_effect("cartpole", "cart_coulomb_friction"), Vector::Constant(1, 1.2));
+  const fs::path file = dir / "friction.csv";
+  write_measurements(file, test::hidden_effect_data(world.build(test::actuator_noise(1, 0.02)), 5));
+  return file;
+}
+
+const std::string kFast = " --gp-points 100 --gp-restarts 0";
+
+bool has_no_nan(const json& j) {
+  if (j.is_number_float()) return std::isfinite(j.get<double>());
+  if (j.is_structured())
+    for (const auto& e : j)
+      if (!has_no_nan(e)) return false;
+  return true;
+}
+
+TEST(DiagnoseCli, JsonHasTheFixedKeysAndNamesTheHiddenEffect) {
+  const fs::path dir = test::temporary_dir("diagnose_json");
+  const fs::path data = friction_csv(dir);
+  const auto result = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --json" + kFast);
+  ASSERT_EQ(result.status, 0) << result.err;
+  const json j = json::parse(result.out);  // one document and nothing else
+  for (const char* key : {"system", "samples", "heldout_episodes", "consistent", "states", "relevance", "ranking", "verdict"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["system"], "cartpole");
+  EXPECT_EQ(j["samples"], 7 * 119);
+  EXPECT_FALSE(j["consistent"].get<bool>());
+  for (const char* key : {"name", "rmse", "noise_floor", "fit_percent"}) EXPECT_TRUE(j["states"][0].contains(key)) << key;
+  for (const char* key : {"effect", "parameters", "aliases", "explained", "heldout_rmse_before", "heldout_rmse_after"})
+    EXPECT_TRUE(j["ranking"][0].contains(key)) << key;
+  EXPECT_EQ(j["verdict"]["status"], "explained");
+  EXPECT_EQ(j["verdict"]["effect"], "cart_coulomb_friction");
+  EXPECT_NEAR(j["verdict"]["parameters"]["mu"].get<double>(), 1.2, 0.18);
+  EXPECT_EQ(j["relevance"]["x_dot"].size(), 5u);
+  EXPECT_TRUE(has_no_nan(j));
+}
+
+TEST(DiagnoseCli, AddWriteModelAndStartTheNextRoundFromIt) {
+  const fs::path dir = test::temporary_dir("diagnose_loop");
+  const fs::path data = friction_csv(dir);
+  const fs::path model = dir / "model1.toml", report = dir / "report.h5";
+  const auto added = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --add cart_coulomb_friction --write-model " +
+                                   quote(model) + " --out " + quote(report) + kFast);
+  ASSERT_EQ(added.status, 0) << added.err;
+  EXPECT_NE(added.out.find("Add it and watch the error fall"), std::string::npos) << added.out;
+  EXPECT_NE(added.out.find("sim+effect+GP"), std::string::npos) << added.out;
+  // The report file is in place and no temporary file is left beside it.
+  ASSERT_TRUE(fs::exists(report));
+  for (const auto& entry : fs::directory_iterator(dir)) EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos);
+  {
+    H5::H5File h5(report.string(), H5F_ACC_RDONLY);
+    EXPECT_TRUE(h5.nameExists("/compare/residual"));
+    EXPECT_TRUE(h5.nameExists("/add/heldout_rmse"));
+    EXPECT_TRUE(h5.nameExists("/ranking/explained"));
+  }
+  // The written model holds the fitted friction; the next diagnosis from it finds nothing left.
+  const ModelSpec next = diagnosis::read_model_file(model, "cartpole");
+  ASSERT_EQ(next.forces.size(), 1u);
+  EXPECT_NEAR(next.forces[0].second(0), 1.2, 0.18);
+  const auto again = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --model " + quote(model) + " --json" + kFast);
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_EQ(json::parse(again.out)["verdict"]["status"], "consistent") << again.out.substr(0, 2000);
+}
+
+TEST(DiagnoseCli, BadInputIsExitTwoNamingWhatIsWrong) {
+  const fs::path dir = test::temporary_dir("diagnose_bad");
+  const fs::path data = friction_csv(dir);
+  const std::string base = "diagnose --system cartpole --data " + quote(data) + kFast;
+  auto unknown = test::run_cli(base + " --add cart_friction");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_EQ(unknown.err.rfind("error:", 0), 0u) << unknown.err;
+  EXPECT_NE(unknown.err.find("cart_viscous_friction, cart_coulomb_friction"), std::string::npos) << unknown.err;
+  auto value = test::run_cli(base + " --add cart_viscous_friction=fast");
+  EXPECT_EQ(value.status, 2);
+  EXPECT_NE(value.err.find("'fast' is not a number"), std::string::npos) << value.err;
+  auto negative = test::run_cli(base + " --add param:cart_mass=-1");
+  EXPECT_EQ(negative.status, 2);
+  EXPECT_NE(negative.err.find("cart_mass"), std::string::npos) << negative.err;
+
+  const fs::path model = dir / "bad.toml";
+  std::ofstream(model) << "[model]\nsystem = \"cartpole\"\n\n[effects]\ncart_viscous_friction = 0.5\nwind = 2\n";
+  auto bad_model = test::run_cli(base + " --model " + quote(model));
+  EXPECT_EQ(bad_model.status, 2);
+  EXPECT_NE(bad_model.err.find("bad.toml:line 6: field 'effects.wind'"), std::string::npos) << bad_model.err;
+  EXPECT_NE(bad_model.err.find("quadratic_drag"), std::string::npos) << bad_model.err;
+
+  auto missing = test::run_cli("diagnose --system cartpole --data " + quote(dir / "none.csv"));
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.err.find("none.csv"), std::string::npos) << missing.err;
+}
+
+TEST(DiagnoseCli, SimulateAddsHiddenEffectsOfTheLibrary) {
+  const fs::path dir = test::temporary_dir("simulate_effect");
+  const std::string base = "simulate --system cartpole --episodes 2 --steps 20 --seed 3 --out ";
+  ASSERT_EQ(test::run_cli(base + quote(dir / "plain.csv")).status, 0);
+  const auto with = test::run_cli(base + quote(dir / "friction.csv") + " --effect cart_coulomb_friction=2");
+  ASSERT_EQ(with.status, 0) << with.err;
+  const auto plain = read_measurements(dir / "plain.csv", system_signature("cartpole"));
+  const auto friction = read_measurements(dir / "friction.csv", system_signature("cartpole"));
+  // Same seed, same excitation and noise: the first state agrees, the friction changes the rest.
+  EXPECT_EQ(plain.episodes[0].x.row(0), friction.episodes[0].x.row(0));
+  EXPECT_GT((plain.episodes[0].x - friction.episodes[0].x).cwiseAbs().maxCoeff(), 1e-3);
+  const auto bad = test::run_cli(base + quote(dir / "bad.csv") + " --effect wind=2");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("cart_coulomb_friction"), std::string::npos) << bad.err;
+}
+
+TEST(DiagnoseCli, PlotsNeedMatplotlibAndSayWhenItIsMissing) {
+  const fs::path dir = test::temporary_dir("diagnose_plots");
+  const fs::path data = friction_csv(dir);
+  // An interpreter without matplotlib (/bin/false fails every import) gives a clear error before any work.
+  const std::string command = "GPILQG_PYTHON=/bin/false '" + std::string(GPILQG_CLI_PATH) + "' diagnose --system cartpole --data " +
+                              quote(data) + " --plots " + quote(dir / "p") + " 2>" + quote(dir / "err.txt");
+  const int status = std::system(command.c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  std::ifstream err_file(dir / "err.txt");
+  const std::string err((std::istreambuf_iterator<char>(err_file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(err.find("cannot import matplotlib and h5py"), std::string::npos) << err;
+  if (std::system("/usr/bin/python3 -c 'import matplotlib, h5py' >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "/usr/bin/python3 has no matplotlib/h5py: the PNG part is not checked here";
+  const auto ok = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --plots " + quote(dir / "p") + kFast);
+  ASSERT_EQ(ok.status, 0) << ok.err;
+  for (const char* png : {"measured_vs_predicted.png", "residual_gp_band.png", "ranking.png", "residual_vs_input.png"})
+    EXPECT_GT(fs::file_size(dir / "p" / png), 1000u) << png;
+}
+
+TEST(DiagnosisPieces, FitPercentHasItsClosedForm) {
+  const Vector y = (Vector(4) << 1.0, 2.0, 3.0, 4.0).finished();
+  EXPECT_DOUBLE_EQ(diagnosis::fit_percent(y, y), 100.0);
+  // yhat = mean(y): |y - yhat| = |y - mean|, fit 0.
+  EXPECT_NEAR(diagnosis::fit_percent(y, Vector::Constant(4, 2.5)), 0.0, 1e-12);
+  // |y - mean| = sqrt(5); error 1 on one sample: 100 (1 - 1 / sqrt(5)).
+  Vector off = y;
+  off(0) += 1.0;
+  EXPECT_NEAR(diagnosis::fit_percent(y, off), 100.0 * (1.0 - 1.0 / std::sqrt(5.0)), 1e-12);
+  EXPECT_DOUBLE_EQ(diagnosis::fit_percent(Vector::Ones(3), Vector::Zero(3)), 0.0);
+}
+
+TEST(DiagnosisPieces, HeldOutEpisodesAreWholeAndSpread) {
+  MeasurementSet set;
+  set.system = system_signature("cartpole");
+  for (int e = 0; e < 10; ++e) set.episodes.push_back({e, Vector::LinSpaced(3, 0.0, 0.04), Matrix::Zero(3, 4), Matrix::Zero(3, 1)});
+  EXPECT_EQ(diagnosis::heldout_episodes(set, 0.3), (std::vector<int>{3, 6, 9}));
+  const auto data = diagnosis::make_transitions(set, {3, 6, 9}, 0.02);
+  EXPECT_EQ(data.size(), 20);
+  EXPECT_EQ(data.rows(true).size(), 6u);
+  set.episodes.resize(1);
+  EXPECT_THROW(diagnosis::heldout_episodes(set, 0.3), std::invalid_argument);
+}
+
+/// Independent white residual and input: about 95% of the lags stay inside the band (binomial
+/// bounds over 8 x 41 lags), and a residual that copies the input delayed by 3 steps peaks at lag 3.
+TEST(DiagnosisPieces, CrossCorrelationBandHoldsForIndependentSeries) {
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> normal;
+  int inside = 0, total = 0;
+  for (int trial = 0; trial < 8; ++trial) {
+    diagnosis::Transitions data;
+    const int N = 2000;
+    data.u.resize(N, 1);
+    data.episode.assign(N, 0);
+    Matrix r(N, 1), delayed(N, 1);
+    for (int t = 0; t < N; ++t) {
+      data.u(t, 0) = normal(rng);
+      r(t, 0) = normal(rng);
+    }
+    for (int t = 0; t < N; ++t) delayed(t, 0) = t >= 3 ? data.u(t - 3, 0) + 0.1 * normal(rng) : 0.0;
+    const auto xc = diagnosis::cross_correlation(data, r, 20);
+    for (int k = 0; k < 41; ++k, ++total) inside += std::abs(xc.values[0][0](k)) <= xc.band(0, 0) ? 1 : 0;
+    EXPECT_NEAR(xc.band(0, 0), 1.96 / std::sqrt(N), 0.3 / std::sqrt(N));
+    const auto peak = diagnosis::cross_correlation(data, delayed, 20);
+    Eigen::Index at = 0;
+    peak.values[0][0].cwiseAbs().maxCoeff(&at);
+    EXPECT_EQ(at - 20, 3);
+  }
+  EXPECT_GT(static_cast<double>(inside) / total, 0.91);
+}
+
+TEST(DiagnosisPieces, ModelFileRoundTrips) {
+  ModelSpec model;
+  model.preset = Preset::RealWorld;
+  model = model.with(find_effect("cartpole", "param:cart_mass"), Vector::Constant(1, 1.25));
+  model = model.with(find_effect("cartpole", "actuator_gain"), Vector::Constant(1, 0.9));
+  model = model.with(find_effect("cartpole", "pole_viscous_damping"), Vector::Constant(1, 0.0123456789));
+  const fs::path file = test::temporary_dir("model_file") / "m.toml";
+  diagnosis::write_model_file(file, model, {"a comment"});
+  const ModelSpec back = diagnosis::read_model_file(file, "cartpole");
+  EXPECT_EQ(back.preset, Preset::RealWorld);
+  EXPECT_EQ(back.parameters, model.parameters);
+  EXPECT_EQ(back.actuator_gain, 0.9);
+  ASSERT_EQ(back.forces.size(), 1u);
+  EXPECT_EQ(back.forces[0].second(0), 0.0123456789);
+  EXPECT_THROW(diagnosis::read_model_file(file, "quadrotor"), InputError);
+  const auto request = diagnosis::parse_add_option("quadratic_drag=0.25", "cartpole");
+  ASSERT_TRUE(request.values.has_value());
+  EXPECT_EQ((*request.values)(0), 0.25);
+  EXPECT_FALSE(diagnosis::parse_add_option("quadratic_drag", "cartpole").values.has_value());
+}
+
+}  // namespace
+}  // namespace gpilqg
