@@ -78,20 +78,13 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
   RunConfig c;
   c.system = f.string("system.name");
   if (c.system != system) f.fail("system.name", fmt::format("is '{}' but the command runs '{}'", c.system, system));
-  SystemSignature signature;
-  try {
-    signature = system_signature(c.system);
-  } catch (const std::invalid_argument& e) {
-    f.fail("system.name", e.what());
-  }
+  const SystemSignature signature = f.system("system.name");
   const int n = static_cast<int>(signature.states.size());
   const int m = static_cast<int>(signature.controls.size());
 
   c.dt = f.number("system.dt");
   if (c.dt <= 0.0) f.fail("system.dt", "must be > 0");
-  const std::string integrator = f.string("system.integrator");
-  if (auto i = parse_integrator(integrator)) c.integrator = *i;
-  else f.fail("system.integrator", fmt::format("'{}'; expected \"euler\" or \"rk4\"", integrator));
+  c.integrator = f.integrator("system.integrator");
   c.substeps = positive_integer(f, "system.substeps", 1);
 
   c.noise.multiplicative_std = non_negative(f, "noise.actuator_multiplicative", m, Vector());

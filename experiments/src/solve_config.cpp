@@ -30,21 +30,14 @@ SolveConfig read_solve_config(const std::filesystem::path& file) {
 
   SolveConfig c;
   c.system = f.string("system.name");
-  SystemSignature signature;
-  try {
-    signature = system_signature(c.system);
-  } catch (const std::invalid_argument& e) {
-    f.fail("system.name", e.what());
-  }
+  const SystemSignature signature = f.system("system.name");
   const int n = static_cast<int>(signature.states.size());
   const int m = static_cast<int>(signature.controls.size());
 
   const std::string preset = f.string("system.preset", "sim");
   if (auto p = parse_preset(preset)) c.preset = *p;
   else f.fail("system.preset", fmt::format("'{}'; expected \"sim\" or \"real\"", preset));
-  const std::string integrator = f.string("system.integrator", "euler");
-  if (auto i = parse_integrator(integrator)) c.integrator = *i;
-  else f.fail("system.integrator", fmt::format("'{}'; expected \"euler\" or \"rk4\"", integrator));
+  c.integrator = f.integrator("system.integrator", "euler");
   c.dt = f.number("system.dt");
   if (c.dt <= 0.0) f.fail("system.dt", "must be > 0");
   c.substeps = f.integer_in("system.substeps", 1, kMaxSubsteps, 1);

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 
 namespace gpilqg {
@@ -156,6 +157,21 @@ Vector TomlFields::vector(const std::string& path, int size, std::optional<Vecto
     if (!std::isfinite(v(static_cast<Eigen::Index>(i)))) fail(path, fmt::format("entry {} is not finite", i));
   }
   return v;
+}
+
+SystemSignature TomlFields::system(const std::string& path) const {
+  const std::string name = string(path);
+  try {
+    return system_signature(name);
+  } catch (const std::invalid_argument& e) {
+    fail(path, e.what());
+  }
+}
+
+Integrator TomlFields::integrator(const std::string& path, std::optional<std::string> fallback) const {
+  const std::string name = string(path, std::move(fallback));
+  if (auto i = parse_integrator(name)) return *i;
+  fail(path, fmt::format("'{}'; expected \"euler\" or \"rk4\"", name));
 }
 
 }  // namespace gpilqg

@@ -11,6 +11,8 @@
 
 #include <toml++/toml.h>
 
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/quantity.hpp"
 #include "gpilqg/core/types.hpp"
 
 namespace gpilqg {
@@ -43,6 +45,10 @@ class TomlFields {
   /// An array of numbers; `size` >= 0 requires that many entries.
   Vector vector(const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) const;
   bool has(const std::string& path) const;
+  /// A built-in system's name (DESIGN.md section 3) and its signature; unknown names fail listing the systems.
+  SystemSignature system(const std::string& path) const;
+  /// "euler" or "rk4".
+  Integrator integrator(const std::string& path, std::optional<std::string> fallback = std::nullopt) const;
 
   /// "<file>:line N: field 'a.b': <problem>" (line when the node is known).
   [[noreturn]] void fail(const std::string& path, const std::string& problem) const;
