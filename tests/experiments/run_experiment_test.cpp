@@ -194,6 +194,33 @@ TEST(RunExperiment, ResultFileHasTheDocumentedLayoutAndPlots) {
     EXPECT_TRUE(std::filesystem::exists(dir / "figures" / png)) << png;
 }
 
+TEST(RunExperiment, ComparesGpBackendsOnTheSameSeedsAndLinksTheFirstAsGpIlqg) {
+  RunConfig config = parse_run_config("cartpole", kTinyRun, "tiny.toml");
+  config.tasks.resize(1);
+  config.iterations = 1;
+  config.pddp = false;
+  config.backend_settings.inducing = 10;
+  config.backend_settings.frequencies = 10;
+  RunOptions options;
+  options.seeds = {7};
+  options.backends = {"exact", "fitc", "ssgp"};
+  const RunResults r = run_experiment(config, options);
+  EXPECT_EQ(r.tasks[0].algorithms,
+            (std::vector<std::string>{"ilqg_real", "ilqg_sim", "gp_ilqg_exact", "gp_ilqg_fitc", "gp_ilqg_ssgp"}));
+  // Same seed, same start: every backend's iteration 0 is iLQG on the simulator, the same policy.
+  const auto& exact = find(r.tasks[0], 0, "gp_ilqg_exact");
+  const auto& ssgp = find(r.tasks[0], 0, "gp_ilqg_ssgp");
+  EXPECT_EQ(exact.iterations[0].evaluation.costs, ssgp.iterations[0].evaluation.costs);
+  EXPECT_EQ(ssgp.iterations[1].hyperparameters.size(), 4u);  // it fitted its own GPs
+  const auto file = test::temporary_dir("run_backends") / "run.h5";
+  write_run_results(file, r);
+  H5::H5File h5(file.string(), H5F_ACC_RDONLY);
+  RowMajorMatrix linked(2, 1), direct(2, 1);
+  h5.openDataSet("/first/gp_ilqg/cost").read(linked.data(), H5::PredType::NATIVE_DOUBLE);
+  h5.openDataSet("/first/gp_ilqg_exact/cost").read(direct.data(), H5::PredType::NATIVE_DOUBLE);
+  EXPECT_EQ(linked, direct);
+}
+
 TEST(RunCli, RunsFromAConfigFileAndRejectsBadOptions) {
   const auto dir = test::temporary_dir("run_cli");
   {
