@@ -57,44 +57,29 @@ cholmod_sparse lower_view(const LowerPattern& pattern, const std::vector<double>
   return a;
 }
 
-/// Smallest squared diagonal entry of a supernodal LL' factor.
-double smallest_pivot(const cholmod_factor& l) {
+/// Copies a supernodal numerical factor (int indices) into plain arrays.
+void copy_supernodal(const cholmod_factor& l, SupernodalFactor& out) {
+  const auto n = static_cast<int>(l.n);
+  const auto supernodes = static_cast<std::size_t>(l.nsuper);
   const auto* super = static_cast<const int*>(l.super);
   const auto* pi = static_cast<const int*>(l.pi);
   const auto* px = static_cast<const int*>(l.px);
-  const auto* x = static_cast<const double*>(l.x);
-  double smallest = std::numeric_limits<double>::infinity();
-  for (std::size_t s = 0; s < l.nsuper; ++s) {
-    const int columns = super[s + 1] - super[s];
-    const int rows = pi[s + 1] - pi[s];
-    for (int c = 0; c < columns; ++c) {
-      const double diagonal = x[px[s] + c * rows + c];
-      smallest = std::isfinite(diagonal) ? std::min(smallest, diagonal * diagonal) : -1.0;
-      if (smallest < 0.0) return smallest;
-    }
-  }
-  return smallest;
-}
-
-void copy_simplicial(const cholmod_factor& l, SimplicialFactor& out) {
-  const auto n = static_cast<int>(l.n);
-  const auto* p = static_cast<const int*>(l.p);
-  const auto* i = static_cast<const int*>(l.i);
+  const auto* ls = static_cast<const int*>(l.s);
   const auto* x = static_cast<const double*>(l.x);
   const auto* perm = static_cast<const int*>(l.Perm);
   out.size = n;
-  out.column_start.assign(p, p + n + 1);
-  out.row.assign(i, i + p[n]);
-  out.value.assign(x, x + p[n]);
+  out.first_column.assign(super, super + supernodes + 1);
+  out.row_start.assign(pi, pi + supernodes + 1);
+  out.value_start.assign(px, px + supernodes + 1);
+  out.rows.assign(ls, ls + pi[supernodes]);
+  out.value.assign(x, x + px[supernodes]);
   out.permutation.assign(perm, perm + n);
   out.inverse_permutation.resize(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) {
-    out.inverse_permutation[static_cast<std::size_t>(perm[k])] = k;
-    if (out.row[static_cast<std::size_t>(p[k])] != k)
-      throw std::logic_error("CHOLMOD simplicial factor: column " + std::to_string(k) +
-                             " does not start with its diagonal");
-  }
-  out.compute_elimination_tree();
+  for (int k = 0; k < n; ++k) out.inverse_permutation[static_cast<std::size_t>(perm[k])] = k;
+  for (std::size_t s = 0; s < supernodes; ++s)
+    for (int c = 0; c < super[s + 1] - super[s]; ++c)
+      if (ls[pi[s] + c] != super[s] + c)
+        throw std::logic_error("CHOLMOD supernode " + std::to_string(s) + " does not list its own columns first");
 }
 
 }  // namespace
@@ -104,7 +89,7 @@ CholmodFactorizer::~CholmodFactorizer() = default;
 
 SparseFactorOutcome CholmodFactorizer::factorize(const LowerPattern& pattern, const std::vector<double>& values,
                                                  double noise_variance, double scale, const JitterSchedule& schedule,
-                                                 std::int64_t max_factor_nonzeros, SimplicialFactor& factor) {
+                                                 std::int64_t max_factor_nonzeros, SupernodalFactor& factor) {
   cholmod_common* c = &impl_->common;
   cholmod_sparse a = lower_view(pattern, values);
   Impl::FactorPtr l(cholmod_analyze(&a, c), Impl::FactorDeleter{c});
@@ -123,8 +108,9 @@ SparseFactorOutcome CholmodFactorizer::factorize(const LowerPattern& pattern, co
     double beta[2] = {noise_variance + jitter, 0.0};
     cholmod_factorize_p(&a, beta, nullptr, 0, l.get(), c);
     if (c->status < CHOLMOD_OK) impl_->fail("numerical factorisation");
-    if (c->status == CHOLMOD_NOT_POSDEF || l->minor < l->n) return false;
-    return smallest_pivot(*l) > 16.0 * std::numeric_limits<double>::epsilon() * (largest_diagonal + beta[0]);
+    if (c->status == CHOLMOD_NOT_POSDEF || l->minor < l->n || !l->is_super) return false;
+    copy_supernodal(*l, factor);
+    return factor.smallest_pivot() > 16.0 * std::numeric_limits<double>::epsilon() * (largest_diagonal + beta[0]);
   };
   bool ok = attempt(0.0);
   if (ok) {
@@ -141,9 +127,6 @@ SparseFactorOutcome CholmodFactorizer::factorize(const LowerPattern& pattern, co
     }
     outcome.status = FactorStatus::JitterAdded;
   }
-  if (!cholmod_change_factor(CHOLMOD_REAL, 1, 0, 1, 1, l.get(), c))
-    impl_->fail("conversion to a simplicial factor");
-  copy_simplicial(*l, factor);
   return outcome;
 }
 

@@ -2,15 +2,15 @@
 /// @file cholmod_factor.hpp
 /// Internal: sparse Cholesky factorisation with SuiteSparse CHOLMOD behind a small RAII wrapper, with
 /// the same escalating-jitter contract as the dense factorisation (dense_cholesky.hpp), and the
-/// result copied into a plain simplicial factor that the rest of the compact backend works on
-/// (sparse_factor.hpp), so that no CHOLMOD object outlives one factorisation.
+/// result copied into a plain supernodal factor that the rest of the compact backend works on
+/// (supernodal_factor.hpp), so that no CHOLMOD object outlives one factorisation.
 
 #include <cstdint>
 #include <memory>
 
 #include "compact_pattern.hpp"
 #include "gpilqg/gp/backend.hpp"
-#include "sparse_factor.hpp"
+#include "supernodal_factor.hpp"
 
 namespace gpilqg::gp::detail {
 
@@ -37,13 +37,13 @@ class CholmodFactorizer {
   /// for the smallest e of {0, schedule.first * scale, ... <= schedule.last * scale} that succeeds.
   /// "Succeeds" means CHOLMOD finds every pivot positive and every squared diagonal entry of L exceeds
   /// 16 eps times the largest diagonal entry of the factorised matrix (a smaller pivot is rounding
-  /// noise: numerically singular, as in sparse_linalg.hpp). On success `factor` holds the simplicial
+  /// noise: numerically singular, as in sparse_linalg.hpp). On success `factor` holds the supernodal
   /// LL' factor. Over budget (analysis nnz(L) > max_factor_nonzeros): Failed with over_budget, no
   /// numerical work done. Never throws on numerical trouble; throws std::runtime_error when CHOLMOD
   /// reports an error other than "not positive definite" (e.g. out of memory).
   SparseFactorOutcome factorize(const LowerPattern& pattern, const std::vector<double>& values, double noise_variance,
                                 double scale, const JitterSchedule& schedule, std::int64_t max_factor_nonzeros,
-                                SimplicialFactor& factor);
+                                SupernodalFactor& factor);
 
  private:
   struct Impl;

@@ -11,6 +11,9 @@ void CompactOptions::validate() const {
   if (initial_neighbours < 1)
     throw std::invalid_argument("CompactOptions::initial_neighbours = " + std::to_string(initial_neighbours) +
                                 "; expected >= 1");
+  if (max_neighbours < initial_neighbours)
+    throw std::invalid_argument("CompactOptions::max_neighbours = " + std::to_string(max_neighbours) +
+                                "; expected >= initial_neighbours = " + std::to_string(initial_neighbours));
   if (max_factor_nonzeros < 1)
     throw std::invalid_argument("CompactOptions::max_factor_nonzeros = " + std::to_string(max_factor_nonzeros) +
                                 "; expected >= 1");
@@ -66,7 +69,7 @@ void build_compact_system(const Matrix& inputs, const WendlandKernel& kernel, co
                                         jitter, options.max_factor_nonzeros, system.factor);
 }
 
-double compact_nlml(const SimplicialFactor& factor, const Vector& targets, Vector& alpha) {
+double compact_nlml(const SupernodalFactor& factor, const Vector& targets, Vector& alpha) {
   factor.solve(targets, alpha);
   return 0.5 * targets.dot(alpha) + factor.half_log_determinant() +
          0.5 * static_cast<double>(targets.size()) * std::log(2.0 * std::numbers::pi);

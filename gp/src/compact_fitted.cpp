@@ -7,6 +7,7 @@
 
 #include "compact_internal.hpp"
 #include "parallel.hpp"
+#include "sparse_factor.hpp"
 
 namespace gpilqg::gp::detail {
 
@@ -36,10 +37,10 @@ class CompactFittedGp final : public FittedGp {
     if (system.outcome.status == FactorStatus::Failed)
       throw std::runtime_error("CompactBackend::condition: K is not positive definite even with jitter " +
                                std::to_string(system.outcome.jitter) + " on " + n + " points (CHOLMOD)");
-    factor_ = std::move(system.factor);
     report_.status = system.outcome.status;
     report_.jitter = system.outcome.jitter;
-    report_.negative_log_marginal_likelihood = compact_nlml(factor_, data_.targets, alpha_);
+    report_.negative_log_marginal_likelihood = compact_nlml(system.factor, data_.targets, alpha_);
+    factor_ = system.factor.simplicial();
   }
 
   std::string_view backend_name() const override { return "compact"; }

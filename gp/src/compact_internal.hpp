@@ -10,7 +10,7 @@
 #include "compact_kernel.hpp"
 #include "compact_pattern.hpp"
 #include "gpilqg/gp/compact.hpp"
-#include "sparse_factor.hpp"
+#include "supernodal_factor.hpp"
 
 namespace gpilqg::gp::detail {
 
@@ -19,7 +19,7 @@ namespace gpilqg::gp::detail {
 struct CompactSystem {
   LowerPattern pattern;
   std::vector<double> values;  ///< Kf on `pattern`
-  SimplicialFactor factor;
+  SupernodalFactor factor;
   SparseFactorOutcome outcome;
 };
 
@@ -31,7 +31,7 @@ void build_compact_system(const Matrix& inputs, const WendlandKernel& kernel, co
                           CholmodFactorizer& factorizer, CompactSystem& system);
 
 /// 0.5 y' alpha + sum log L_ii + N/2 log(2 pi), alpha = K^-1 y written into `alpha`.
-double compact_nlml(const SimplicialFactor& factor, const Vector& targets, Vector& alpha);
+double compact_nlml(const SupernodalFactor& factor, const Vector& targets, Vector& alpha);
 
 /// Throws std::invalid_argument unless the vector has D + 2 finite entries.
 void check_compact_parameters(const VectorCRef& parameters, int input_dim, const char* who);

@@ -20,22 +20,26 @@ class CompactObjective final : public MarginalLikelihoodObjective {
         compact_(compact),
         min_noise_std_(options.min_noise_std),
         min_noise_ratio_(options.min_noise_ratio),
-        jitter_(options.jitter) {}
-
-  int parameter_count() const override { return Hyperparameters::count(data_.input_dim()); }
-  int input_dim() const override { return data_.input_dim(); }
-  ParameterBounds bounds() const override { return hyperparameter_bounds(data_, min_noise_std_, min_noise_ratio_); }
-
-  /// initial_hyperparameters with the spreads scaled by support_scale_for_neighbours, so that a point
-  /// starts with about CompactOptions::initial_neighbours neighbours (clipped to the bounds).
-  Vector initial_parameters() const override {
+        jitter_(options.jitter) {
+    // initial_hyperparameters with the spreads scaled by support_scale_for_neighbours, so that a point
+    // starts with about CompactOptions::initial_neighbours neighbours; the box caps the growth of the
+    // support at max_neighbours / initial_neighbours in volume.
+    const int d = data_.input_dim();
     Hyperparameters h = initial_hyperparameters(data_);
     const double c = support_scale_for_neighbours(data_.inputs, h.lengthscales(), compact_.initial_neighbours);
     h.log_lengthscales.array() += std::log(c);
-    Vector theta = h.pack();
-    const ParameterBounds b = bounds();
-    return theta.cwiseMax(b.lower).cwiseMin(b.upper);
+    bounds_ = hyperparameter_bounds(data_, min_noise_std_, min_noise_ratio_);
+    const double growth =
+        std::log(static_cast<double>(compact_.max_neighbours) / compact_.initial_neighbours) / static_cast<double>(d);
+    bounds_.upper.head(d) = bounds_.upper.head(d).cwiseMin((h.log_lengthscales.array() + growth).matrix());
+    bounds_.lower.head(d) = bounds_.lower.head(d).cwiseMin(bounds_.upper.head(d));
+    start_ = h.pack().cwiseMax(bounds_.lower).cwiseMin(bounds_.upper);
   }
+
+  int parameter_count() const override { return Hyperparameters::count(data_.input_dim()); }
+  int input_dim() const override { return data_.input_dim(); }
+  ParameterBounds bounds() const override { return bounds_; }
+  Vector initial_parameters() const override { return start_; }
 
   /// As the default, but the log length-scale offsets are uniform in +-1.2/sqrt(D): the number of
   /// neighbours scales with prod_d l_d, so independent offsets of +-1.5 would change it by up to
@@ -80,8 +84,7 @@ class CompactObjective final : public MarginalLikelihoodObjective {
  private:
   void accumulate_gradient(const WendlandKernel& kernel, double noise_variance, Vector& gradient) {
     const int d = data_.input_dim();
-    const SimplicialFactor& factor = system_.factor;
-    const std::vector<double> inverse = factor.inverse_subset();
+    const std::vector<double> inverse = system_.factor.inverse_subset();
     gather_inverse_on_pattern(inverse);
     gradient.setZero(parameter_count());
     const LowerPattern& p = system_.pattern;
@@ -112,23 +115,23 @@ class CompactObjective final : public MarginalLikelihoodObjective {
 
   /// inverse_on_pattern_[q] = Z at the q-th entry of Kf's lower pattern: entry (i, j) sits at
   /// (max, min) of (P i, P j) in L's permuted pattern. Grouped by permuted column (a counting sort),
-  /// then one scatter of each column of L: O(nnz(L) + nnz(Kf)).
+  /// then one scatter of each supernode's rows: O(nnz(L) + nnz(Kf)).
   void gather_inverse_on_pattern(const std::vector<double>& inverse) {
     const LowerPattern& p = system_.pattern;
-    const SimplicialFactor& f = system_.factor;
+    const SupernodalFactor& f = system_.factor;
     const auto n = static_cast<std::size_t>(p.size);
     const std::size_t nnz = p.row.size();
     bucket_start_.assign(n + 1, 0);
-    auto permuted = [&](std::size_t q, int column, int& low, int& high) {
+    auto permuted = [&](std::size_t q, std::size_t column, int& low, int& high) {
       const int a = f.inverse_permutation[static_cast<std::size_t>(p.row[q])];
-      const int b = f.inverse_permutation[static_cast<std::size_t>(column)];
+      const int b = f.inverse_permutation[column];
       low = std::min(a, b);
       high = std::max(a, b);
     };
     int low = 0, high = 0;
     for (std::size_t j = 0; j < n; ++j)
       for (auto q = static_cast<std::size_t>(p.column_start[j]); q < static_cast<std::size_t>(p.column_start[j + 1]); ++q) {
-        permuted(q, static_cast<int>(j), low, high);
+        permuted(q, j, low, high);
         ++bucket_start_[static_cast<std::size_t>(low) + 1];
       }
     for (std::size_t c = 0; c < n; ++c) bucket_start_[c + 1] += bucket_start_[c];
@@ -137,22 +140,26 @@ class CompactObjective final : public MarginalLikelihoodObjective {
     fill_.assign(bucket_start_.begin(), bucket_start_.end() - 1);
     for (std::size_t j = 0; j < n; ++j)
       for (auto q = static_cast<std::size_t>(p.column_start[j]); q < static_cast<std::size_t>(p.column_start[j + 1]); ++q) {
-        permuted(q, static_cast<int>(j), low, high);
+        permuted(q, j, low, high);
         const auto slot = static_cast<std::size_t>(fill_[static_cast<std::size_t>(low)]++);
         bucket_entry_[slot] = static_cast<std::int64_t>(q);
         bucket_row_[slot] = high;
       }
     inverse_on_pattern_.resize(nnz);
-    position_.assign(n, -1);
-    for (std::size_t c = 0; c < n; ++c) {
-      const auto first = static_cast<std::size_t>(f.column_start[c]), last = static_cast<std::size_t>(f.column_start[c + 1]);
-      for (std::size_t q = first; q < last; ++q) position_[static_cast<std::size_t>(f.row[q])] = static_cast<std::int64_t>(q);
-      for (auto s = static_cast<std::size_t>(bucket_start_[c]); s < static_cast<std::size_t>(bucket_start_[c + 1]); ++s) {
-        const std::int64_t at = position_[static_cast<std::size_t>(bucket_row_[s])];
-        if (at < 0) throw std::logic_error("compact objective: an entry of K lies outside the pattern of its factor");
-        inverse_on_pattern_[static_cast<std::size_t>(bucket_entry_[s])] = inverse[static_cast<std::size_t>(at)];
+    relative_.assign(n, -1);
+    auto at = [](int i) { return static_cast<std::size_t>(i); };
+    for (int s = 0; s < f.supernodes(); ++s) {
+      const int first_row = f.row_start[at(s)], height = f.row_start[at(s + 1)] - first_row;
+      for (int r = 0; r < height; ++r) relative_[at(f.rows[at(first_row + r)])] = r;
+      for (int column = f.first_column[at(s)]; column < f.first_column[at(s + 1)]; ++column) {
+        const std::int64_t offset = f.value_start[at(s)] + static_cast<std::int64_t>(column - f.first_column[at(s)]) * height;
+        for (auto e = static_cast<std::size_t>(bucket_start_[at(column)]); e < static_cast<std::size_t>(bucket_start_[at(column) + 1]); ++e) {
+          const int r = relative_[at(bucket_row_[e])];
+          if (r < 0) throw std::logic_error("compact objective: an entry of K lies outside the pattern of its factor");
+          inverse_on_pattern_[static_cast<std::size_t>(bucket_entry_[e])] = inverse[static_cast<std::size_t>(offset + r)];
+        }
       }
-      for (std::size_t q = first; q < last; ++q) position_[static_cast<std::size_t>(f.row[q])] = -1;
+      for (int r = 0; r < height; ++r) relative_[at(f.rows[at(first_row + r)])] = -1;
     }
   }
 
@@ -161,12 +168,14 @@ class CompactObjective final : public MarginalLikelihoodObjective {
   double min_noise_std_;
   double min_noise_ratio_;
   JitterSchedule jitter_;
+  ParameterBounds bounds_;
+  Vector start_;
   CholmodFactorizer factorizer_;
   CompactSystem system_;
   Vector alpha_;
   Vector squared_delta_ = Vector::Zero(data_.input_dim());
-  std::vector<std::int64_t> bucket_start_, fill_, bucket_entry_, position_;
-  std::vector<int> bucket_row_;
+  std::vector<std::int64_t> bucket_start_, fill_, bucket_entry_;
+  std::vector<int> bucket_row_, relative_;
   std::vector<double> inverse_on_pattern_;
 };
 

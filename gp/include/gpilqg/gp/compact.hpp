@@ -43,7 +43,8 @@
 /// (the reach is closed under elimination-tree ancestors). Far from all data S is empty: mean 0,
 /// variance sf^2, zero gradients.
 ///
-/// Cost control: the sparsity depends on the length-scales. An evaluation whose kernel matrix would
+/// Cost control: the sparsity depends on the length-scales. The fitter's box caps the support radii
+/// (CompactOptions::max_neighbours). An evaluation whose kernel matrix would
 /// have more than `max_factor_nonzeros` entries, or whose symbolic factor would (CHOLMOD's analysis,
 /// before any numerical work), is reported as FactorStatus::Failed (value +infinity), so the fitter
 /// backtracks to shorter supports instead of running out of memory; condition() throws for it.
@@ -58,6 +59,11 @@ struct CompactOptions {
   /// The data-driven start scales the input spreads by one common factor so that a training point
   /// has about this many neighbours within the support (the median over up to 512 sampled points).
   int initial_neighbours = 32;
+  /// Upper bound on the support for the fitter: log l_d <= log l_d(start) + log(max_neighbours /
+  /// initial_neighbours) / D, so that the neighbour count (proportional to prod_d l_d) grows at most
+  /// by that ratio. A box the optimiser can handle, unlike the hard budget below, which stays as the
+  /// safety net. Must be >= initial_neighbours.
+  int max_neighbours = 256;
   /// Largest number of nonzeros of K's lower triangle and of the Cholesky factor L (each costs 12
   /// bytes; the factor is held twice during a gradient: L and the inverse subset Z). 5e7 is about
   /// 0.6 GB per copy.
