@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   gpilqg::cli::add_data_command(app, action);
   gpilqg::cli::add_solve_command(app, action);
   gpilqg::cli::add_simulate_command(app, action);
+  gpilqg::cli::add_profile_command(app, action);
 
   try {
     app.parse(argc, argv);

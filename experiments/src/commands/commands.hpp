@@ -21,4 +21,7 @@ void add_solve_command(CLI::App& app, CommandAction& action);
 /// `gpilqg simulate --system NAME --out FILE [...]`
 void add_simulate_command(CLI::App& app, CommandAction& action);
 
+/// `gpilqg profile DATA --backends LIST [--sizes LIST] [--json] [--out F.h5] [--plots DIR]`
+void add_profile_command(CLI::App& app, CommandAction& action);
+
 }  // namespace gpilqg::cli
