@@ -99,6 +99,7 @@ nlohmann::json profile_json(const ProfileReport& report) {
             {"restarts", o.fit.restarts},
             {"max_evaluations", o.fit.max_evaluations},
             {"seed", o.fit.seed},
+            {"start", o.start_from_reference ? "reference" : "data"},
             {"inducing", o.settings.inducing},
             {"frequencies", o.settings.frequencies},
             {"compact_neighbours", o.settings.compact_neighbours},

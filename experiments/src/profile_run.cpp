@@ -65,6 +65,8 @@ void ProfileOptions::validate(const ProfileData& data) const {
                                    data.train.size(), data.name));
   if (!(memory_budget_bytes > 0.0)) throw InputError("--memory-budget-gb: expected a positive number");
   if (max_test_points && *max_test_points < 1) throw InputError("--max-test: expected >= 1");
+  if (start_from_reference && !data.reference)
+    throw InputError("--start reference: " + data.name + " has no /reference_hyperparameters");
   try {
     settings.validate();
     fit.validate();
@@ -143,7 +145,12 @@ ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& 
       settings.exact_points = size;
       const auto backend = gp::make_backend(name, settings);
       try {
-        const gp::FitResult fit = backend->fit(subset, options.fit);
+        gp::FitOptions fit_options = options.fit;
+        if (options.start_from_reference) {  // the full vector: reference hyperparameters + the backend's extras
+          fit_options.warm_start = backend->objective(subset, fit_options)->initial_parameters();
+          fit_options.warm_start.head(gp::Hyperparameters::count(subset.input_dim())) = data.reference->pack();
+        }
+        const gp::FitResult fit = backend->fit(subset, fit_options);
         row.fit_seconds = fit.summary.seconds;
         row.evaluations = fit.summary.evaluations;
         row.termination = std::string(gp::to_string(fit.summary.termination));

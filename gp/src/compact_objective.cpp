@@ -22,15 +22,14 @@ class CompactObjective final : public MarginalLikelihoodObjective {
         min_noise_ratio_(options.min_noise_ratio),
         jitter_(options.jitter) {
     // initial_hyperparameters with the spreads scaled by support_scale_for_neighbours, so that a point
-    // starts with about CompactOptions::initial_neighbours neighbours; the box caps the growth of the
-    // support at max_neighbours / initial_neighbours in volume.
+    // starts with about CompactOptions::initial_neighbours neighbours; the box lets each l_d grow by
+    // max_neighbours / initial_neighbours.
     const int d = data_.input_dim();
     Hyperparameters h = initial_hyperparameters(data_);
     const double c = support_scale_for_neighbours(data_.inputs, h.lengthscales(), compact_.initial_neighbours);
     h.log_lengthscales.array() += std::log(c);
     bounds_ = hyperparameter_bounds(data_, min_noise_std_, min_noise_ratio_);
-    const double growth =
-        std::log(static_cast<double>(compact_.max_neighbours) / compact_.initial_neighbours) / static_cast<double>(d);
+    const double growth = std::log(static_cast<double>(compact_.max_neighbours) / compact_.initial_neighbours);
     bounds_.upper.head(d) = bounds_.upper.head(d).cwiseMin((h.log_lengthscales.array() + growth).matrix());
     bounds_.lower.head(d) = bounds_.lower.head(d).cwiseMin(bounds_.upper.head(d));
     start_ = h.pack().cwiseMax(bounds_.lower).cwiseMin(bounds_.upper);

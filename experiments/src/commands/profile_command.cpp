@@ -25,6 +25,7 @@ struct ProfileCommandOptions {
   std::string plots;
   ProfileDataOptions data;
   std::string target = "residual";
+  std::string start = "data";
   int restarts = 0;
   int max_evaluations = 100;
   std::uint64_t seed = 1;
@@ -82,6 +83,9 @@ int run_profile_command(ProfileCommandOptions& o) {
   options.fit.seed = o.seed;
   options.memory_budget_bytes = o.memory_budget_gb * static_cast<double>(1ull << 30);
   if (o.max_test > 0) options.max_test_points = o.max_test;
+  if (o.start != "data" && o.start != "reference")
+    throw InputError("--start '" + o.start + "': expected 'data' or 'reference'");
+  options.start_from_reference = o.start == "reference";
   const ProfileData data = read_profile_data(o.file, o.data);
   options.validate(data);
   const ProfileReport report = run_profile(o.file, data, options, [&](const ProfileRow& row) {
@@ -126,6 +130,10 @@ void add_profile_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--plots", o->plots, "Write profile_pareto.png (accuracy against time) into this folder");
   cmd->add_option("--restarts", o->restarts, "Random restarts per fit")->capture_default_str();
   cmd->add_option("--max-evaluations", o->max_evaluations, "NLML evaluations per start")->capture_default_str();
+  cmd->add_option("--start", o->start,
+                  "'data': fits start from data-driven values (and restarts); 'reference': also from the data "
+                  "set's reference hyperparameters, tried first")
+      ->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the subsets and the restarts")->capture_default_str();
   cmd->add_option("--max-test", o->max_test, "Score on this many test points (a fixed random subset; 0: all)")
       ->capture_default_str();

@@ -68,6 +68,9 @@ struct ProfileOptions {
   gp::FitOptions fit;                    ///< restarts, max_evaluations, seed
   double memory_budget_bytes = 4.0 * (1ull << 30);  ///< for the exact GP's dense matrices
   std::optional<int> max_test_points;    ///< score on the first n of a fixed permutation of the test set
+  /// Start every fit from the reference hyperparameters (the backend's extras at its data-driven
+  /// values) besides its own data-driven start; needs reference hyperparameters in the data.
+  bool start_from_reference = false;
   /// Throws InputError naming the option.
   void validate(const ProfileData& data) const;
 };

@@ -60,9 +60,10 @@ struct CompactOptions {
   /// has about this many neighbours within the support (the median over up to 512 sampled points).
   int initial_neighbours = 32;
   /// Upper bound on the support for the fitter: log l_d <= log l_d(start) + log(max_neighbours /
-  /// initial_neighbours) / D, so that the neighbour count (proportional to prod_d l_d) grows at most
-  /// by that ratio. A box the optimiser can handle, unlike the hard budget below, which stays as the
-  /// safety net. Must be >= initial_neighbours.
+  /// initial_neighbours), i.e. one input alone can widen the support by that ratio (so that ARD can
+  /// switch irrelevant inputs off; the neighbour count is proportional to prod_d l_d). A box the
+  /// optimiser handles well; the joint growth of all l_d is stopped by max_factor_nonzeros below (an
+  /// evaluation beyond it is Failed, and L-BFGS backtracks). Must be >= initial_neighbours.
   int max_neighbours = 256;
   /// Largest number of nonzeros of K's lower triangle and of the Cholesky factor L (each costs 12
   /// bytes; the factor is held twice during a gradient: L and the inverse subset Z). 5e7 is about
