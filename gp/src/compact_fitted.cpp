@@ -6,6 +6,7 @@
 #include <string>
 
 #include "compact_internal.hpp"
+#include "conditioned_gp.hpp"
 #include "parallel.hpp"
 #include "sparse_factor.hpp"
 
@@ -13,13 +14,12 @@ namespace gpilqg::gp::detail {
 
 namespace {
 
-class CompactFittedGp final : public FittedGp {
+class CompactFittedGp final : public ConditionedGp {
  public:
   CompactFittedGp(TrainingSet data, const VectorCRef& parameters, const JitterSchedule& jitter,
                   const CompactOptions& options)
-      : data_(std::move(data)),
+      : ConditionedGp(std::move(data), parameters),
         threads_(options.threads),
-        parameters_(parameters),
         kernel_((check_compact_parameters(parameters, data_.input_dim(), "CompactBackend::condition"), parameters),
                 data_.input_dim()),
         grid_(data_.inputs, kernel_.inverse_lengthscales()) {
@@ -44,10 +44,6 @@ class CompactFittedGp final : public FittedGp {
   }
 
   std::string_view backend_name() const override { return "compact"; }
-  int input_dim() const override { return data_.input_dim(); }
-  const TrainingSet& training_set() const override { return data_; }
-  const Vector& parameters() const override { return parameters_; }
-  const ConditioningReport& conditioning() const override { return report_; }
 
   /// Workspace use (sizes fixed by N and D, so no allocation after the first query):
   ///   cross   3N + D: k(x_s, z) | g(r_s) | w_s for the support points s = 0 .. |S|-1 | scaled z
@@ -55,9 +51,7 @@ class CompactFittedGp final : public FittedGp {
   ///   indices 3N: marks | support (original indices) | reach.
   void predict(const VectorCRef& z, Prediction& out, const PredictionRequest& request) const override {
     const int d = input_dim();
-    if (z.size() != d)
-      throw std::invalid_argument("CompactGp::predict: input has " + std::to_string(z.size()) +
-                                  " entries; expected " + std::to_string(d));
+    check_query(z, "CompactGp");
     const int n = data_.size();
     PredictionWorkspace& ws = out.workspace;
     if (ws.cross.size() != 3 * n + d) ws.cross.resize(3 * n + d);
@@ -127,14 +121,11 @@ class CompactFittedGp final : public FittedGp {
     out.array() *= kernel_.inverse_squared_lengthscales().array();
   }
 
-  TrainingSet data_;
   int threads_;
-  Vector parameters_;
   WendlandKernel kernel_;
   NeighbourGrid grid_;
   SimplicialFactor factor_;
   Vector alpha_;
-  ConditioningReport report_;
 };
 
 }  // namespace
