@@ -103,6 +103,7 @@ nlohmann::json profile_json(const ProfileReport& report) {
             {"inducing", o.settings.inducing},
             {"frequencies", o.settings.frequencies},
             {"compact_neighbours", o.settings.compact_neighbours},
+            {"compact_max_neighbours", o.settings.compact_max_neighbours},
             {"threads", o.settings.threads},
             {"memory_budget_gib", o.memory_budget_bytes / (1ull << 30)}}},
           {"rows", rows}};

@@ -49,6 +49,7 @@ const std::vector<RegistryEntry>& registry() {
        [](const BackendSettings& s) -> std::unique_ptr<GpBackend> {
          CompactOptions options;
          options.initial_neighbours = s.compact_neighbours;
+         options.max_neighbours = s.compact_max_neighbours;
          options.threads = s.threads;
          return std::make_unique<CompactBackend>(options);
        }},
@@ -73,6 +74,9 @@ void BackendSettings::validate() const {
   positive(inducing, "inducing");
   positive(frequencies, "frequencies");
   positive(compact_neighbours, "compact_neighbours");
+  if (compact_max_neighbours < compact_neighbours)
+    throw std::invalid_argument(fmt::format("backend settings: compact_max_neighbours = {} must be >= compact_neighbours = {}",
+                                            compact_max_neighbours, compact_neighbours));
   positive(threads, "threads");
 }
 

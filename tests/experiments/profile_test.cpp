@@ -80,7 +80,7 @@ fs::path write_benchmark(const fs::path& file, const Benchmark& b, bool with_tes
 
 /// Scores of `backend` conditioned on all training points with `parameters`, computed here.
 gp::RegressionScores direct_scores(const Benchmark& b, const std::string& backend, const Vector& parameters) {
-  const auto model = gp::make_backend(backend, gp::BackendSettings{1000, 100, 100, 32, 1})->condition(b.train, parameters);
+  const auto model = gp::make_backend(backend, gp::BackendSettings{1000, 100, 100, 32, 256, 1})->condition(b.train, parameters);
   Vector mean, variance;
   model->predict(b.test_inputs, mean, variance);
   return gp::regression_scores(b.test_targets, mean, (variance.array() + model->noise_variance()).matrix(),

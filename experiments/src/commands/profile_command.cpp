@@ -145,6 +145,9 @@ void add_profile_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--compact-neighbours", o->settings.compact_neighbours,
                   "compact: neighbours per point at the start of the fit")
       ->capture_default_str();
+  cmd->add_option("--compact-max-neighbours", o->settings.compact_max_neighbours,
+                  "compact: each support radius may grow by this / --compact-neighbours during the fit")
+      ->capture_default_str();
   cmd->add_option("--threads", o->settings.threads, "Threads inside one fit")->capture_default_str();
   cmd->add_option("--system", o->data.system, "Measurement sets: the system (cartpole, quadrotor)");
   cmd->add_option("--output", o->data.output, "Measurement sets: the state whose target is learned (default: the first)");

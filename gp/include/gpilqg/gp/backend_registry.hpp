@@ -19,6 +19,7 @@ struct BackendSettings {
   int inducing = 100;       ///< "fitc": M pseudo-inputs
   int frequencies = 100;    ///< "ssgp": m spectral points
   int compact_neighbours = 32;  ///< "compact": neighbours per point at the data-driven start
+  int compact_max_neighbours = 256;  ///< "compact": CompactOptions::max_neighbours (>= compact_neighbours)
   int threads = 1;          ///< threads inside one NLML evaluation
   /// Throws std::invalid_argument naming the field when a size is < 1.
   void validate() const;
