@@ -1,8 +1,9 @@
 #pragma once
 /// @file conditioned_gp.hpp
 /// Internal: what every fitted model that keeps its training set holds (the data, the parameter vector,
-/// the conditioning report), with the FittedGp accessors and the check of a query's size, so that the
-/// exact and compact models implement only conditioning and prediction.
+/// the conditioning report), with the FittedGp accessors and the check of a query's size, so that a
+/// model implements only conditioning and prediction (the compact model; the exact one can move onto it
+/// once main's exact_prediction refactoring is merged).
 
 #include <stdexcept>
 #include <string>

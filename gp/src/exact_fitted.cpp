@@ -4,7 +4,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "conditioned_gp.hpp"
 #include "dense_cholesky.hpp"
 #include "exact_gp_internal.hpp"
 #include "parallel.hpp"
@@ -21,10 +20,10 @@ namespace {
 /// swamps the small variances near the data that the residual model's G is made of.
 constexpr int kMaxPointsWithCachedInverseFactor = 3000;
 
-class ExactFittedGp final : public ConditionedGp {
+class ExactFittedGp final : public FittedGp {
  public:
   ExactFittedGp(TrainingSet data, const VectorCRef& parameters, const JitterSchedule& jitter, int threads)
-      : ConditionedGp(std::move(data), parameters), threads_(threads) {
+      : data_(std::move(data)), threads_(threads), parameters_(parameters) {
     const int d = data_.input_dim();
     check_exact_parameters(parameters_, d, "ExactGpBackend::condition");
     const Hyperparameters h = Hyperparameters::unpack(parameters_, d);
@@ -52,6 +51,10 @@ class ExactFittedGp final : public ConditionedGp {
   }
 
   std::string_view backend_name() const override { return "exact"; }
+  int input_dim() const override { return data_.input_dim(); }
+  const TrainingSet& training_set() const override { return data_; }
+  const Vector& parameters() const override { return parameters_; }
+  const ConditioningReport& conditioning() const override { return report_; }
 
   /// mean = k' alpha, variance = sf^2 - |v|^2 with v = L^-1 k (GPML eqs. 2.25, 2.26, algorithm 2.1);
   /// with r_i = x_i - z,
@@ -59,7 +62,9 @@ class ExactFittedGp final : public ConditionedGp {
   ///   d variance / dz_d = -(2/l_d^2) sum_i w_i k_i r_id,  w = K^-1 k = L^-T v.
   void predict(const VectorCRef& z, Prediction& out, const PredictionRequest& request) const override {
     const int d = input_dim();
-    check_query(z, "ExactGp");
+    if (z.size() != d)
+      throw std::invalid_argument("ExactGp::predict: input has " + std::to_string(z.size()) + " entries; expected " +
+                                  std::to_string(d));
     const Eigen::Index n = data_.size();
     PredictionWorkspace& ws = out.workspace;
     ws.cross.resize(n);
@@ -149,7 +154,10 @@ class ExactFittedGp final : public ConditionedGp {
     variance = (signal_variance_ - variance.array()).max(0.0).matrix();
   }
 
+  TrainingSet data_;
   int threads_;
+  Vector parameters_;
+  ConditioningReport report_;
   Vector inverse_squared_lengthscales_;
   double signal_variance_ = 0.0;
   Vector alpha_;
