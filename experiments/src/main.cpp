@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   gpilqg::cli::add_simulate_command(app, action);
   gpilqg::cli::add_diagnose_command(app, action);
   gpilqg::cli::add_run_command(app, action);
+  gpilqg::cli::add_profile_command(app, action);
 
   try {
     app.parse(argc, argv);

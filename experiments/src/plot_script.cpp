@@ -25,6 +25,7 @@ int run_process(const std::vector<std::string>& argv) {
   const pid_t pid = fork();
   if (pid < 0) return -1;
   if (pid == 0) {
+    dup2(STDERR_FILENO, STDOUT_FILENO);  // a script's chatter never mixes into a command's --json output
     execv(args[0], args.data());
     _exit(127);
   }

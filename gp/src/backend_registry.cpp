@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "gpilqg/gp/compact.hpp"
 #include "gpilqg/gp/exact_gp.hpp"
 #include "gpilqg/gp/fitc.hpp"
 #include "gpilqg/gp/ssgp.hpp"
@@ -44,6 +45,14 @@ const std::vector<RegistryEntry>& registry() {
          options.threads = s.threads;
          return std::make_unique<SsgpBackend>(options);
        }},
+      {"compact",
+       [](const BackendSettings& s) -> std::unique_ptr<GpBackend> {
+         CompactOptions options;
+         options.initial_neighbours = s.compact_neighbours;
+         options.max_neighbours = s.compact_max_neighbours;
+         options.threads = s.threads;
+         return std::make_unique<CompactBackend>(options);
+       }},
   };
   return entries;
 }
@@ -64,6 +73,10 @@ void BackendSettings::validate() const {
   positive(exact_points, "exact_points");
   positive(inducing, "inducing");
   positive(frequencies, "frequencies");
+  positive(compact_neighbours, "compact_neighbours");
+  if (compact_max_neighbours < compact_neighbours)
+    throw std::invalid_argument(fmt::format("backend settings: compact_max_neighbours = {} must be >= compact_neighbours = {}",
+                                            compact_max_neighbours, compact_neighbours));
   positive(threads, "threads");
 }
 

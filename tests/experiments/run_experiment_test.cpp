@@ -36,6 +36,7 @@ max_evaluations = 40
 max_iterations = 30
 [pddp]
 max_iterations = 2
+own = true
 own_initial_rollouts = 1
 [[tasks]]
 name = "first"
@@ -93,7 +94,7 @@ TEST(RunExperiment, AlgorithmsSeeTheDataTheProtocolPromisesAndSeedsRepeat) {
   const RunResults b = tiny_run({5, 6});
   ASSERT_EQ(a.tasks.size(), 2u);
   const std::vector<std::string> expected = {"ilqg_real", "ilqg_sim", "gp_ilqg", "pddp", "pddp_own"};
-  EXPECT_EQ(a.tasks[0].algorithms, expected);
+  ASSERT_EQ(a.tasks[0].algorithms, expected);
 
   for (std::size_t t = 0; t < 2; ++t) {
     // The same seed gives the same run, bit for bit (seed 5 is the first seed of both runs).

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gpilqg/gp/compact.hpp"
 #include "gpilqg/gp/exact_gp.hpp"
 #include "gpilqg/gp/fitc.hpp"
 #include "gpilqg/gp/ssgp.hpp"
@@ -23,12 +24,17 @@ TEST(BackendRegistry, SettingsReachTheBackends) {
   settings.exact_points = 123;
   settings.inducing = 17;
   settings.frequencies = 9;
+  settings.compact_neighbours = 21;
+  settings.threads = 2;
   const auto exact = make_backend("exact", settings);
   EXPECT_EQ(dynamic_cast<const ExactGpBackend&>(*exact).options().max_training_points, 123);
   const auto fitc = make_backend("fitc", settings);
   EXPECT_EQ(dynamic_cast<const FitcBackend&>(*fitc).options().inducing, 17);
   const auto ssgp = make_backend("ssgp", settings);
   EXPECT_EQ(dynamic_cast<const SsgpBackend&>(*ssgp).options().frequencies, 9);
+  const auto compact = make_backend("compact", settings);
+  EXPECT_EQ(dynamic_cast<const CompactBackend&>(*compact).options().initial_neighbours, 21);
+  EXPECT_EQ(dynamic_cast<const CompactBackend&>(*compact).options().threads, 2);
 }
 
 TEST(BackendRegistry, UnknownNameListsTheKnownOnes) {
@@ -37,7 +43,7 @@ TEST(BackendRegistry, UnknownNameListsTheKnownOnes) {
     FAIL() << "expected an error";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("'gpflow'"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("exact, fitc, ssgp"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("exact, fitc, ssgp, compact"), std::string::npos) << e.what();
   }
   BackendSettings bad;
   bad.inducing = 0;

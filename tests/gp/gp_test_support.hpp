@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gpilqg/gp/backend.hpp"
+#include "gpilqg/gp/compact.hpp"
 #include "gpilqg/gp/exact_gp.hpp"
 #include "gpilqg/gp/fitc.hpp"
 #include "gpilqg/gp/ssgp.hpp"
@@ -111,7 +112,16 @@ struct SsgpCase {
   static constexpr bool reverts_to_prior = false;
 };
 
-using BackendCases = ::testing::Types<ExactCase, FitcCase, SsgpCase>;
+/// Exact GP with Wendland's compactly supported kernel (CHOLMOD). With the oracle's length-scales as
+/// support radii, K(X, X) on its 20 points is sparse but not diagonal.
+struct CompactCase {
+  static constexpr const char* name = "compact";
+  static std::unique_ptr<GpBackend> make() { return std::make_unique<CompactBackend>(); }
+  static constexpr double gradient_tolerance = 1e-6;
+  static constexpr bool reverts_to_prior = true;
+};
+
+using BackendCases = ::testing::Types<ExactCase, FitcCase, SsgpCase, CompactCase>;
 
 /// The backend's full parameter vector for `data` with the shared part set to `hyp` and the extras
 /// (pseudo-inputs, frequencies) at the objective's data-driven initial values.

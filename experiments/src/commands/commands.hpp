@@ -27,4 +27,7 @@ void add_diagnose_command(CLI::App& app, CommandAction& action);
 /// `gpilqg run cartpole|quadrotor [--config F] [--seeds N] [--iterations K] [--backends LIST] [--out F.h5] [--plots DIR]`
 void add_run_command(CLI::App& app, CommandAction& action);
 
+/// `gpilqg profile DATA --backends LIST [--sizes LIST] [--json] [--out F.h5] [--plots DIR]`
+void add_profile_command(CLI::App& app, CommandAction& action);
+
 }  // namespace gpilqg::cli

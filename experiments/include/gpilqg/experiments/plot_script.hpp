@@ -18,7 +18,8 @@ std::filesystem::path plot_script_dir();
 /// run_plot_script; commands call it before long work so that a missing package fails fast.
 void require_plotting(const std::string& script);
 
-/// Runs `<interpreter> <dir>/<script> <input> <out_dir>` (out_dir created), without a shell.
+/// Runs `<interpreter> <dir>/<script> <input> <out_dir>` (out_dir created), without a shell, with the
+/// script's stdout sent to stderr (so `--json` output stays one document).
 /// Throws std::runtime_error naming the interpreter and the missing packages when matplotlib or h5py
 /// cannot be imported, and naming the script and its exit status when it fails.
 void run_plot_script(const std::string& script, const std::filesystem::path& input, const std::filesystem::path& out_dir);

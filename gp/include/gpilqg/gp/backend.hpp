@@ -22,6 +22,7 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "gpilqg/core/types.hpp"
 #include "gpilqg/gp/hyperparameters.hpp"
@@ -58,6 +59,7 @@ struct PredictionWorkspace {
   Vector weighted;         ///< the cached inverse applied to `cross`
   Matrix cross_gradient;   ///< d cross / d z when gradients are asked for (rows(cross) x D)
   Vector extra;            ///< any further vector a backend needs
+  std::vector<int> indices;  ///< integer scratch (compact: neighbour indices and the sparse solve's reach)
 };
 
 /// What to compute besides the mean.

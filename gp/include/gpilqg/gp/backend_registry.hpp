@@ -18,12 +18,14 @@ struct BackendSettings {
   int exact_points = 300;   ///< "exact": size of the uniform subsample (the paper's 300)
   int inducing = 100;       ///< "fitc": M pseudo-inputs
   int frequencies = 100;    ///< "ssgp": m spectral points
+  int compact_neighbours = 32;  ///< "compact": neighbours per point at the data-driven start
+  int compact_max_neighbours = 256;  ///< "compact": CompactOptions::max_neighbours (>= compact_neighbours)
   int threads = 1;          ///< threads inside one NLML evaluation
   /// Throws std::invalid_argument naming the field when a size is < 1.
   void validate() const;
 };
 
-/// The registry names, in a fixed order: "exact", "fitc", "ssgp", ...
+/// The registry names, in a fixed order: "exact", "fitc", "ssgp", "compact".
 std::vector<std::string> backend_names();
 
 /// The backend called `name`. Throws std::invalid_argument naming `name` and listing the known names.

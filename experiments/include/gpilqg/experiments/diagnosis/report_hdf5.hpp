@@ -1,7 +1,7 @@
 #pragma once
 /// @file report_hdf5.hpp
 /// The diagnosis as an HDF5 file, written to a temporary file and renamed into place. The plotting
-/// script (experiments/scripts/diagnose_plots.py) reads only this file. Layout (schema_version 1):
+/// script (experiments/plots/diagnose_plots.py) reads only this file. Layout (schema_version 1):
 ///
 ///   / attrs: schema_version, gpilqg_version, system, created, status (the verdict), verdict_effect,
 ///            consistent (int), model (TOML), model_next (TOML), report (the JSON document),

@@ -1,0 +1,162 @@
+/// `gpilqg profile DATA --backends LIST [--sizes LIST] [--json] [--out F.h5] [--plots DIR] [...]`:
+/// every GP backend on growing subsets of a data set, timed and scored (profile.hpp).
+
+#include <fmt/format.h>
+
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "commands.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/profile.hpp"
+
+namespace gpilqg::cli {
+
+namespace {
+
+struct ProfileCommandOptions {
+  std::string file;
+  std::string backends;
+  std::string sizes = "all";
+  bool json = false;
+  std::string out;
+  std::string plots;
+  ProfileDataOptions data;
+  std::string target = "residual";
+  std::string start = "data";
+  int restarts = 0;
+  int max_evaluations = 100;
+  std::uint64_t seed = 1;
+  int max_test = 0;
+  double memory_budget_gb = 4.0;
+  gp::BackendSettings settings;
+};
+
+/// "1000, 5000,all" -> {1000, 5000, 0}; InputError naming the entry.
+std::vector<int> parse_sizes(const std::string& list) {
+  std::vector<int> sizes;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = list.find(',', start);
+    std::string entry = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    entry.erase(0, entry.find_first_not_of(" \t"));
+    entry.erase(entry.find_last_not_of(" \t") + 1);
+    if (entry == "all") {
+      sizes.push_back(0);
+    } else {
+      std::size_t used = 0;
+      int value = 0;
+      try {
+        value = std::stoi(entry, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != entry.size() || entry.empty() || value < 1)
+        throw InputError(fmt::format("--sizes '{}': entry '{}' is not a positive integer or 'all'", list, entry));
+      sizes.push_back(value);
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return sizes;
+}
+
+int run_profile_command(ProfileCommandOptions& o) {
+  if (o.target == "residual")
+    o.data.target = ProfileTarget::Residual;
+  else if (o.target == "increment")
+    o.data.target = ProfileTarget::Increment;
+  else
+    throw InputError("--target '" + o.target + "': expected 'residual' or 'increment'");
+  ProfileOptions options;
+  try {
+    options.backends = gp::parse_backend_list(o.backends);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("--backends: ") + e.what());
+  }
+  options.sizes = parse_sizes(o.sizes);
+  options.settings = o.settings;
+  options.fit.restarts = o.restarts;
+  options.fit.max_evaluations = o.max_evaluations;
+  options.fit.seed = o.seed;
+  options.memory_budget_bytes = o.memory_budget_gb * static_cast<double>(1ull << 30);
+  if (o.max_test > 0) options.max_test_points = o.max_test;
+  if (o.start != "data" && o.start != "reference")
+    throw InputError("--start '" + o.start + "': expected 'data' or 'reference'");
+  options.start_from_reference = o.start == "reference";
+  const ProfileData data = read_profile_data(o.file, o.data);
+  options.validate(data);
+  const ProfileReport report = run_profile(o.file, data, options, [&](const ProfileRow& row) {
+    std::cerr << fmt::format("profile: {} N={} {} fit {:.3f} s, predict {:.3f} s{}\n", row.backend, row.size, row.status,
+                             row.fit_seconds, row.predict_seconds, row.reason.empty() ? "" : " (" + row.reason + ")");
+  });
+  std::filesystem::path h5 = o.out;
+  if (!o.out.empty()) write_profile_hdf5(o.out, report);
+  if (!o.plots.empty()) {
+    if (h5.empty()) {
+      std::filesystem::create_directories(o.plots);
+      h5 = std::filesystem::path(o.plots) / "profile.h5";
+      write_profile_hdf5(h5, report);
+    }
+    plot_profile(h5, o.plots);
+  }
+  if (o.json)
+    std::cout << profile_json(report).dump(2) << '\n';
+  else
+    std::cout << format_profile(report);
+  return kExitSuccess;
+}
+
+}  // namespace
+
+void add_profile_command(CLI::App& app, CommandAction& action) {
+  CLI::App* cmd = app.add_subcommand(
+      "profile",
+      "Train GP backends on growing subsets of a data set; report fit and prediction time and the test "
+      "scores SMSE, MNLP, MSLL");
+  auto o = std::make_shared<ProfileCommandOptions>();
+  cmd->add_option("DATA", o->file,
+                  "Benchmark HDF5 (X_train, y_train, X_test, y_test[, reference_hyperparameters]) or a "
+                  "measurement set (.csv / .h5 with /episodes; needs --system)")
+      ->required();
+  cmd->add_option("--backends", o->backends, "Comma-separated backends: " + fmt::format("{}", fmt::join(gp::backend_names(), ", ")))
+      ->required();
+  cmd->add_option("--sizes", o->sizes, "Comma-separated training-set sizes, 'all' for the whole set (nested subsets)")
+      ->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the table");
+  cmd->add_option("--out", o->out, "Write the results to this HDF5 file (temporary file, then renamed)");
+  cmd->add_option("--plots", o->plots, "Write profile_pareto.png (accuracy against time) into this folder");
+  cmd->add_option("--restarts", o->restarts, "Random restarts per fit")->capture_default_str();
+  cmd->add_option("--max-evaluations", o->max_evaluations, "NLML evaluations per start")->capture_default_str();
+  cmd->add_option("--start", o->start,
+                  "'data': fits start from data-driven values (and restarts); 'reference': also from the data "
+                  "set's reference hyperparameters, tried first")
+      ->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the subsets and the restarts")->capture_default_str();
+  cmd->add_option("--max-test", o->max_test, "Score on this many test points (a fixed random subset; 0: all)")
+      ->capture_default_str();
+  cmd->add_option("--memory-budget-gb", o->memory_budget_gb,
+                  "Skip exact-GP sizes whose dense N x N matrices (16 N^2 bytes fitted, 8 N^2 conditioned) exceed this")
+      ->capture_default_str();
+  cmd->add_option("--inducing", o->settings.inducing, "fitc: pseudo-inputs M")->capture_default_str();
+  cmd->add_option("--frequencies", o->settings.frequencies, "ssgp: spectral points m")->capture_default_str();
+  cmd->add_option("--compact-neighbours", o->settings.compact_neighbours,
+                  "compact: neighbours per point at the start of the fit")
+      ->capture_default_str();
+  cmd->add_option("--compact-max-neighbours", o->settings.compact_max_neighbours,
+                  "compact: each support radius may grow by this / --compact-neighbours during the fit")
+      ->capture_default_str();
+  cmd->add_option("--threads", o->settings.threads, "Threads inside one fit")->capture_default_str();
+  cmd->add_option("--system", o->data.system, "Measurement sets: the system (cartpole, quadrotor)");
+  cmd->add_option("--output", o->data.output, "Measurement sets: the state whose target is learned (default: the first)");
+  cmd->add_option("--target", o->target,
+                  "Measurement sets: 'residual' (x' - simulator step, RK4 'sim' preset) or 'increment' (x' - x)")
+      ->capture_default_str();
+  cmd->add_option("--test-every", o->data.test_every, "Measurement sets: every k-th sample is held out for testing")
+      ->capture_default_str();
+  cmd->callback([o, &action] { action = [o] { return run_profile_command(*o); }; });
+}
+
+}  // namespace gpilqg::cli

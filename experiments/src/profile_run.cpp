@@ -1,0 +1,168 @@
+/// Running `gpilqg profile`: every backend at every size, the exact GP under the reference
+/// hyperparameters as the baseline, memory budget for the dense exact GP (profile.hpp).
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/profile.hpp"
+#include "gpilqg/gp/exact_gp.hpp"
+#include "gpilqg/gp/metrics.hpp"
+
+namespace gpilqg {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+/// The first `count` of one fixed permutation of [0, size) (seeded), in permutation order.
+std::vector<int> nested_subset(int size, int count, std::uint64_t seed) {
+  std::vector<int> order(static_cast<std::size_t>(size));
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 rng(seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  order.resize(static_cast<std::size_t>(std::min(count, size)));
+  return order;
+}
+
+/// Predicts the test set and scores it into `row`.
+void score(const gp::FittedGp& model, const Matrix& test_inputs, const Vector& test_targets,
+           const Vector& training_targets, ProfileRow& row) {
+  const auto start = Clock::now();
+  Vector mean, variance;
+  model.predict(test_inputs, mean, variance);
+  row.predict_seconds = seconds_since(start);
+  const Vector predictive = (variance.array() + model.noise_variance()).matrix();
+  const gp::RegressionScores s = gp::regression_scores(test_targets, mean, predictive, training_targets);
+  row.smse = s.smse;
+  row.mnlp = s.mnlp;
+  row.msll = s.msll;
+  row.nlml = model.negative_log_marginal_likelihood();
+  row.conditioning = std::string(gp::to_string(model.conditioning().status));
+  row.parameters = model.parameters().head(gp::Hyperparameters::count(model.input_dim()));
+  row.status = "ok";
+}
+
+}  // namespace
+
+double exact_memory_bytes(std::int64_t n, bool fitted) {
+  return (fitted ? 16.0 : 8.0) * static_cast<double>(n) * static_cast<double>(n);
+}
+
+void ProfileOptions::validate(const ProfileData& data) const {
+  if (backends.empty()) throw InputError("--backends: expected at least one backend");
+  if (sizes.empty()) throw InputError("--sizes: expected at least one size");
+  for (int size : sizes)
+    if (size < 0 || size > data.train.size())
+      throw InputError(fmt::format("--sizes: {} is outside [1, {}] (the training set of {}; 'all' for all)", size,
+                                   data.train.size(), data.name));
+  if (!(memory_budget_bytes > 0.0)) throw InputError("--memory-budget-gb: expected a positive number");
+  if (max_test_points && *max_test_points < 1) throw InputError("--max-test: expected >= 1");
+  if (start_from_reference && !data.reference)
+    throw InputError("--start reference: " + data.name + " has no /reference_hyperparameters");
+  try {
+    settings.validate();
+    fit.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+}
+
+ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options,
+                          const std::function<void(const ProfileRow&)>& progress) {
+  options.validate(data);
+  ProfileReport report;
+  report.file = file.string();
+  report.data.name = data.name;
+  report.data.format = data.format;
+  report.data.target = data.target;
+  report.data.train.inputs.resize(0, data.train.input_dim());
+  report.options = options;
+  Matrix test_inputs = data.test_inputs;
+  Vector test_targets = data.test_targets;
+  if (options.max_test_points && *options.max_test_points < data.test_inputs.rows()) {
+    const auto rows = nested_subset(static_cast<int>(data.test_inputs.rows()), *options.max_test_points, options.fit.seed + 1);
+    test_inputs.resize(static_cast<Eigen::Index>(rows.size()), data.test_inputs.cols());
+    test_targets.resize(static_cast<Eigen::Index>(rows.size()));
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      test_inputs.row(static_cast<Eigen::Index>(r)) = data.test_inputs.row(rows[r]);
+      test_targets(static_cast<Eigen::Index>(r)) = data.test_targets(rows[r]);
+    }
+  }
+  report.test_points = static_cast<int>(test_inputs.rows());
+  const auto order = nested_subset(data.train.size(), data.train.size(), options.fit.seed);
+  auto emit = [&](ProfileRow row) {
+    if (progress) progress(row);
+    report.rows.push_back(std::move(row));
+  };
+  auto over_budget = [&](ProfileRow& row, bool fitted) {
+    const double need = exact_memory_bytes(row.size, fitted);
+    if (need <= options.memory_budget_bytes) return false;
+    row.status = "skipped";
+    row.reason = fmt::format("the dense exact GP needs {:.2f} GiB at N = {} ({} N x N matrices), over the budget of {:.2f} GiB",
+                             need / (1ull << 30), row.size, fitted ? 2 : 1, options.memory_budget_bytes / (1ull << 30));
+    return true;
+  };
+  for (int requested : options.sizes) {
+    const int size = requested == 0 ? data.train.size() : requested;
+    const std::vector<int> rows(order.begin(), order.begin() + size);
+    const gp::TrainingSet subset = data.train.subset(rows);
+    if (data.reference) {
+      ProfileRow row;
+      row.backend = "exact_reference";
+      row.size = size;
+      row.termination = "not optimised";
+      if (!over_budget(row, false)) {
+        const gp::ExactGpBackend exact(gp::ExactGpOptions{gp::ExactGpOptions::kAllPoints, options.settings.threads});
+        const auto start = Clock::now();
+        try {
+          const auto model = exact.condition(subset, data.reference->pack(), options.fit.jitter);
+          row.fit_seconds = seconds_since(start);
+          score(*model, test_inputs, test_targets, subset.targets, row);
+        } catch (const std::runtime_error& e) {
+          row.status = "failed";
+          row.reason = e.what();
+        }
+      }
+      emit(row);
+    }
+    for (const std::string& name : options.backends) {
+      ProfileRow row;
+      row.backend = name;
+      row.size = size;
+      if (name == "exact" && over_budget(row, true)) {
+        emit(row);
+        continue;
+      }
+      gp::BackendSettings settings = options.settings;
+      settings.exact_points = size;
+      const auto backend = gp::make_backend(name, settings);
+      try {
+        gp::FitOptions fit_options = options.fit;
+        if (options.start_from_reference) {  // the full vector: reference hyperparameters + the backend's extras
+          fit_options.warm_start = backend->objective(subset, fit_options)->initial_parameters();
+          fit_options.warm_start.head(gp::Hyperparameters::count(subset.input_dim())) = data.reference->pack();
+        }
+        const gp::FitResult fit = backend->fit(subset, fit_options);
+        row.fit_seconds = fit.summary.seconds;
+        row.evaluations = fit.summary.evaluations;
+        row.termination = std::string(gp::to_string(fit.summary.termination));
+        score(*fit.model, test_inputs, test_targets, subset.targets, row);
+      } catch (const std::runtime_error& e) {  // e.g. conditioning failed even with jitter
+        row.status = "failed";
+        row.reason = e.what();
+      }
+      emit(row);
+    }
+  }
+  return report;
+}
+
+}  // namespace gpilqg
