@@ -4,6 +4,8 @@
 
 #include <H5Cpp.h>
 
+#include "hdf5_common.hpp"
+
 namespace gpilqg {
 
 struct Hdf5Writer::Impl {
@@ -51,24 +53,7 @@ struct Hdf5Writer::Impl {
   }
 };
 
-namespace {
-
-template <class Action>
-void guarded(const std::filesystem::path& file, const std::string& object, const char* what, Action&& action) {
-  try {
-    action();
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error(file.string() + ": " + what + " '" + object + "' failed (HDF5: " + e.getDetailMsg() + ")");
-  }
-}
-
-H5::StrType string_type() {
-  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-  type.setCset(H5T_CSET_UTF8);
-  return type;
-}
-
-}  // namespace
+using hdf5_detail::guarded;
 
 Hdf5Writer::Hdf5Writer(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()), file_(file) {
   guarded(file, "/", "creating", [&] {
@@ -123,7 +108,7 @@ void Hdf5Writer::attribute(const std::string& object, const std::string& name, c
   guarded(file_, object + "@" + name, "writing attribute", [&] {
     H5::Group g;
     H5::DataSet d;
-    const H5::StrType type = string_type();
+    const H5::StrType type = hdf5_detail::utf8_string_type();
     const char* data[1] = {value.c_str()};
     impl_->object(object, g, d).createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, data);
   });
@@ -153,7 +138,7 @@ void Hdf5Writer::attribute(const std::string& object, const std::string& name, c
   guarded(file_, object + "@" + name, "writing attribute", [&] {
     H5::Group g;
     H5::DataSet d;
-    const H5::StrType type = string_type();
+    const H5::StrType type = hdf5_detail::utf8_string_type();
     std::vector<const char*> data;
     for (const auto& v : values) data.push_back(v.c_str());
     const hsize_t dims[1] = {values.size()};

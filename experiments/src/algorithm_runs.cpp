@@ -45,13 +45,18 @@ using DataPlanner = std::function<Plan(const TransitionData& data, const Plan* p
 /// run had at its iteration k, and nothing is collected.
 AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, TransitionData initial, std::uint64_t seed,
                            const DataPlanner& planner, const AlgorithmRun* borrowed = nullptr) {
+  std::optional<AlgorithmRun> restored = c.journal != nullptr ? c.journal->restore(c, seed, name) : std::nullopt;
   AlgorithmRun run;
-  run.name = name;
-  run.data = std::move(initial);
+  if (restored) {
+    run = std::move(*restored);
+  } else {
+    run.name = name;
+    run.data = std::move(initial);
+  }
   const std::uint64_t id = stream_id(name);
   const int K = c.config.iterations;
-  bool stopped = false;
-  for (int k = 0; k <= K; ++k) {
+  bool stopped = run.converged_at >= 0 && borrowed == nullptr;
+  for (int k = static_cast<int>(run.iterations.size()); k <= K; ++k) {
     const IterationRecord* previous = k > 0 ? &run.iterations.back() : nullptr;
     const TransitionData data =
         borrowed != nullptr ? borrowed->data.head(borrowed->iterations.at(static_cast<std::size_t>(k)).data_rows)
@@ -62,31 +67,32 @@ AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, Transi
       copy.rollout_seconds = copy.fit_seconds = 0.0;
       copy.plan.solve_seconds = copy.evaluation.seconds = 0.0;
       run.iterations.push_back(std::move(copy));
-      continue;
-    }
-    IterationRecord record;
-    record.data_rows = data.size();
-    record.plan = planner(data, previous != nullptr ? &previous->plan : nullptr, record);
-    record.evaluation = evaluate(c, record.plan, seed);
-    if (previous != nullptr) {
-      record.policy_change = record.plan.policy.distance(previous->plan.policy);
-      if (record.policy_change <= c.config.policy_tolerance && run.converged_at < 0) {
-        run.converged_at = k;
-        stopped = borrowed == nullptr;  // a borrowing run follows its source's data to the end
+    } else {
+      IterationRecord record;
+      record.data_rows = data.size();
+      record.plan = planner(data, previous != nullptr ? &previous->plan : nullptr, record);
+      record.evaluation = evaluate(c, record.plan, seed);
+      if (previous != nullptr) {
+        record.policy_change = record.plan.policy.distance(previous->plan.policy);
+        if (record.policy_change <= c.config.policy_tolerance && run.converged_at < 0) {
+          run.converged_at = k;
+          stopped = borrowed == nullptr;  // a borrowing run follows its source's data to the end
+        }
       }
-    }
-    if (borrowed == nullptr && !stopped && k < K) {
-      const auto start = std::chrono::steady_clock::now();
-      for (int r = 0; r < c.config.rollouts; ++r) {
-        auto rng = make_rng(seed, c.task_index, RandomStream::DataRollout,
-                            {id, static_cast<std::uint64_t>(k), static_cast<std::uint64_t>(r)});
-        run.data.append(roll_out(c, record.plan, c.config.exploration_std, rng), k);
+      if (borrowed == nullptr && !stopped && k < K) {
+        const auto start = std::chrono::steady_clock::now();
+        for (int r = 0; r < c.config.rollouts; ++r) {
+          auto rng = make_rng(seed, c.task_index, RandomStream::DataRollout,
+                              {id, static_cast<std::uint64_t>(k), static_cast<std::uint64_t>(r)});
+          run.data.append(roll_out(c, record.plan, c.config.exploration_std, rng), k);
+        }
+        record.rollout_seconds = seconds_since(start);
       }
-      record.rollout_seconds = seconds_since(start);
+      report(c, name, k, record);
+      run.final_model = record.plan.model;
+      run.iterations.push_back(std::move(record));
     }
-    report(c, name, k, record);
-    run.final_model = record.plan.model;
-    run.iterations.push_back(std::move(record));
+    if (c.journal != nullptr) c.journal->save(c, seed, run);
   }
   return run;
 }
@@ -131,6 +137,11 @@ TransitionData TransitionData::head(int rows) const {
 
 AlgorithmRun run_fixed_model(const TaskContext& c, const std::string& name, std::shared_ptr<const StepModel> model,
                              std::uint64_t seed) {
+  if (auto restored = c.journal != nullptr ? c.journal->restore(c, seed, name) : std::nullopt) {
+    for (auto& record : restored->iterations) record.plan.model = model;
+    restored->final_model = std::move(model);
+    return std::move(*restored);
+  }
   AlgorithmRun run;
   run.name = name;
   IterationRecord record;
@@ -142,12 +153,12 @@ AlgorithmRun run_fixed_model(const TaskContext& c, const std::string& name, std:
   record.repeated = true;
   record.plan.solve_seconds = record.evaluation.seconds = 0.0;
   for (int k = 1; k <= c.config.iterations; ++k) run.iterations.push_back(record);
+  if (c.journal != nullptr) c.journal->save(c, seed, run);
   return run;
 }
 
 AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp::GpBackend& backend,
                          TransitionData initial, std::uint64_t seed) {
-  std::shared_ptr<const gp::ResidualModel> last;
   const DataPlanner planner = [&](const TransitionData& data, const Plan* previous, IterationRecord& record) {
     // Algorithm 1: without data, iLQG on the simulator (Robust-iLQG without G is iLQG).
     if (data.size() == 0) return plan_with_ddp(c, c.models.simulator, DdpVariant::ILQG, warm_start(previous));
@@ -159,6 +170,8 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     for (int i = 0; i < data.size(); ++i)
       if (data.iteration[static_cast<std::size_t>(i)] == newest) recent.push_back(i);
     const gp::ResidualData validation = all.subset(recent);
+    // The previous iteration's GP (warm start, re-sample rule) is the model its plan was made on.
+    const auto last = previous != nullptr ? std::dynamic_pointer_cast<const gp::ResidualModel>(previous->model) : nullptr;
     gp::ResidualModelOptions options;
     options.fit = fit_options(c, seed, name, data.size());
     options.threads = 2;
@@ -167,7 +180,6 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     record.fit_seconds = seconds_since(start);
     const int D = static_cast<int>(all.inputs.cols());
     for (int i = 0; i < model->state_dim(); ++i) record.hyperparameters.push_back(model->output(i).parameters().head(D + 2));
-    last = model;
     return plan_with_ddp(c, model, c.config.gp_variant, warm_start(previous));
   };
   return learning_loop(c, name, std::move(initial), seed, planner);

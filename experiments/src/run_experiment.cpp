@@ -26,6 +26,7 @@ RunResults run_experiment(const RunConfig& config, const RunOptions& options) {
   RunResults results;
   results.config = config;
   results.options = options;
+  results.options.journal = nullptr;  // the journal does not outlive the run
   const RunModels models = make_run_models(config);
   const std::vector<std::string> backends = options.backends.empty() ? std::vector<std::string>{config.backend} : options.backends;
   const auto gp_name = [&](const std::string& backend) {
@@ -40,7 +41,7 @@ RunResults run_experiment(const RunConfig& config, const RunOptions& options) {
       const RunTask& task = config.tasks[t];
       const QuadraticCost cost = make_task_cost(config, task);
       const auto prefix = fmt::format("[seed {} ({}/{})] ", seed, s + 1, options.seeds.size());
-      TaskContext context{config, task, static_cast<int>(t), models, cost, nullptr};
+      TaskContext context{config, task, static_cast<int>(t), models, cost, nullptr, options.journal};
       if (options.progress) context.progress = [&](const std::string& line) { options.progress(prefix + line); };
       const auto carried_data = [&](const std::string& name) {
         const AlgorithmRun* earlier = task.transfer ? find_run(previous_task, name) : nullptr;

@@ -12,6 +12,8 @@
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
+#include "gpilqg/experiments/run_config.hpp"
 #include "gpilqg/experiments/solve_config.hpp"
 
 namespace gpilqg::fuzz {
@@ -358,6 +360,10 @@ struct TomlLoader {
 /// InputError.
 constexpr TomlLoader kTomlLoaders[] = {
     {"gpilqg solve config", [](const std::filesystem::path& file) { check_solve_config(read_solve_config(file)); }},
+    {"gpilqg run cartpole config", [](const std::filesystem::path& file) { load_run_config("cartpole", file); }},
+    {"gpilqg run quadrotor config", [](const std::filesystem::path& file) { load_run_config("quadrotor", file); }},
+    {"gpilqg diagnose cartpole model", [](const std::filesystem::path& file) { diagnosis::read_model_file(file, "cartpole"); }},
+    {"gpilqg diagnose quadrotor model", [](const std::filesystem::path& file) { diagnosis::read_model_file(file, "quadrotor"); }},
 };
 
 }  // namespace

@@ -1,5 +1,5 @@
 /// `gpilqg run cartpole|quadrotor [--config F] [--seeds N] [--iterations K] [--backends LIST] [--out F.h5]
-/// [--plots DIR]`: the paper's experiments (run_experiment.hpp), results in HDF5 (run_results_io.hpp),
+/// [--plots DIR] [--resume]`: the paper's experiments (run_experiment.hpp), results in HDF5 (run_results_io.hpp),
 /// figures by experiments/plots/plot_run.py.
 
 #include <cmath>
@@ -9,8 +9,10 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "stop_signal.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/plot_script.hpp"
+#include "gpilqg/experiments/run_checkpoint.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
 
 namespace gpilqg::cli {
@@ -26,6 +28,7 @@ struct RunArguments {
   std::string out;
   std::string plots;
   bool no_plots = false;
+  bool resume = false;
 };
 
 /// Mean and standard deviation over seeds of each iteration's normalised cost, one line per algorithm.
@@ -76,8 +79,23 @@ int run_command(const RunArguments& a) {
   const std::filesystem::path out = a.out.empty() ? std::filesystem::path("out") / ("run_" + a.system + ".h5") : std::filesystem::path(a.out);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
 
-  const RunResults results = run_experiment(config, options);
+  // Every completed iteration goes to the checkpoint folder beside the result (run_checkpoint.hpp);
+  // Ctrl-C stops at the next iteration boundary, leaving any previous result file as it was.
+  const std::filesystem::path folder = RunCheckpoint::folder_for(out);
+  RunCheckpoint checkpoint = a.resume ? RunCheckpoint::resume(folder, config, options) : RunCheckpoint::create(folder, config, options);
+  const StopSignalGuard stop_signal;
+  checkpoint.set_stop_requested(&StopSignalGuard::stop_requested);
+  options.journal = &checkpoint;
+  RunResults results;
+  try {
+    results = run_experiment(config, options);
+  } catch (const RunInterrupted& e) {
+    std::cerr << fmt::format("interrupted: {}\n{}continue with the same command and --resume\n", e.what(),
+                             std::filesystem::exists(out) ? fmt::format("{} is unchanged; ", out.string()) : "");
+    return kExitSignalBase + StopSignalGuard::signal_number();
+  }
   write_run_results(out, results);
+  checkpoint.remove();
   print_summary(results);
   std::cout << fmt::format("\nresults: {}\n", out.string());
   if (a.no_plots) return kExitSuccess;
@@ -102,6 +120,8 @@ void add_run_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--out", args->out, "result file (default out/run_SYSTEM.h5)");
   cmd->add_option("--plots", args->plots, "folder for the PNG figures (default: beside the result)");
   cmd->add_flag("--no-plots", args->no_plots, "write the result only");
+  cmd->add_flag("--resume", args->resume, "continue an interrupted run from OUT.checkpoint/ (same arguments as the "
+                                          "interrupted run); the result equals an uninterrupted run's");
   cmd->callback([&action, args] { action = [args] { return run_command(*args); }; });
 }
 

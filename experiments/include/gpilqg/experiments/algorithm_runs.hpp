@@ -15,6 +15,7 @@
 /// and repeats its last iteration, marked `repeated`; so does a fixed-model algorithm.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,20 @@ struct AlgorithmRun {
   int converged_at = -1;  ///< first iteration whose policy change fell below the tolerance (-1: never)
   TransitionData data;    ///< everything it collected, including data carried over from an earlier task
   std::shared_ptr<const StepModel> final_model;  ///< the last plan's model (GP-ILQG: the residual model)
+};
+
+/// Where each algorithm's progress is kept, so that an interrupted run can continue from its last
+/// completed iteration (run_checkpoint.hpp). Every algorithm asks `restore` before it starts and calls
+/// `save` after each completed iteration with everything it has so far; a restored run continues
+/// exactly as if it had never stopped (its random streams depend on (seed, task, iteration) only).
+class RunJournal {
+ public:
+  virtual ~RunJournal() = default;
+  /// What `save` last received for algorithm `name` on this task and seed, or nothing.
+  virtual std::optional<AlgorithmRun> restore(const TaskContext& context, std::uint64_t seed,
+                                              const std::string& name) const = 0;
+  /// Keeps `run` (its completed iterations, data and final model). May throw to stop the run.
+  virtual void save(const TaskContext& context, std::uint64_t seed, const AlgorithmRun& run) = 0;
 };
 
 /// ilqg_real (world) or ilqg_sim (simulator): one iLQG plan, evaluated once, repeated.

@@ -2,7 +2,8 @@
 /// @file cli_errors.hpp
 /// The command line's error contract (DESIGN.md section 8): exit 0 on success; exit 2 on bad input
 /// (usage, file, data, config) with a message on stderr that starts with "error:" and names the file
-/// and the line, field or dataset; exit 1 on an internal failure.
+/// and the line, field or dataset; exit 1 on an internal failure; exit 128 + signal when a command
+/// stopped early on SIGINT or SIGTERM (`gpilqg run`, after saving its progress).
 
 #include <functional>
 #include <iosfwd>
@@ -14,6 +15,9 @@ namespace gpilqg {
 inline constexpr int kExitSuccess = 0;
 inline constexpr int kExitInternalFailure = 1;
 inline constexpr int kExitBadInput = 2;
+/// A command stopped by a signal at a safe point exits 128 + the signal's number, as a shell reports
+/// a process killed by it (130 for SIGINT).
+inline constexpr int kExitSignalBase = 128;
 
 /// Bad input found by a command (an option value, a config field). The message names the option
 /// or the file and field.

@@ -20,6 +20,9 @@ struct RunOptions {
   /// for each and "gp_ilqg" is the first of them.
   std::vector<std::string> backends;
   std::function<void(const std::string&)> progress;  ///< one line per finished iteration (may be empty)
+  /// Keeps every completed iteration and restores what an interrupted run had (run_checkpoint.hpp);
+  /// null: nothing is kept. Not owned.
+  RunJournal* journal = nullptr;
 };
 
 /// A 1-D picture of the learned model (the paper's Figure 1): one state output of the GP-corrected

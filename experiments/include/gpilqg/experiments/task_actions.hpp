@@ -34,6 +34,8 @@ struct Plan {
 
 /// The context of one task: config, task, models and cost (all outlive the actions), and where
 /// progress lines go (may be empty).
+class RunJournal;
+
 struct TaskContext {
   const RunConfig& config;
   const RunTask& task;
@@ -41,6 +43,7 @@ struct TaskContext {
   const RunModels& models;
   const Cost& cost;
   std::function<void(const std::string&)> progress;
+  RunJournal* journal = nullptr;  ///< where completed iterations are kept for --resume (null: nowhere)
 };
 
 /// DDP on `model` (kept alive by the plan, for MPC) from the controls `u_start` (m x T; empty: config.u_init repeated), limited by

@@ -1,0 +1,57 @@
+#pragma once
+/// @file hdf5_reader.hpp
+/// The reading side of hdf5_writer.hpp: datasets and attributes addressed by '/'-separated paths,
+/// values converted to double whatever their stored numeric type, 2-D datasets read in row-major order
+/// into an Eigen matrix of the same shape (so what Hdf5Writer::write_matrix wrote comes back equal bit
+/// for bit). Every failure throws std::runtime_error naming the file, the object and what was expected;
+/// the HDF5 C++ API stays inside core.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gpilqg/core/types.hpp"
+
+namespace gpilqg {
+
+class Hdf5Reader {
+ public:
+  /// Opens `file` read-only. Throws std::runtime_error naming the file when it is missing or not HDF5.
+  explicit Hdf5Reader(const std::filesystem::path& file);
+  ~Hdf5Reader();
+  Hdf5Reader(const Hdf5Reader&) = delete;
+  Hdf5Reader& operator=(const Hdf5Reader&) = delete;
+
+  const std::filesystem::path& file() const { return file_; }
+
+  /// Whether a group or dataset exists at `path` (every parent must be a group).
+  bool exists(const std::string& path) const;
+  /// The full paths of every dataset below `group` ("/": the whole file), depth first, sorted by name.
+  std::vector<std::string> datasets(const std::string& group = "/") const;
+  /// The shape of the dataset at `path` (empty for a scalar).
+  std::vector<std::uint64_t> shape(const std::string& path) const;
+
+  /// A 2-D dataset (a 1-D one of length N reads as N x 1).
+  Matrix read_matrix(const std::string& path) const;
+  /// A 1-D dataset (or a scalar, as one entry).
+  Vector read_vector(const std::string& path) const;
+  /// A scalar dataset, or a dataset with exactly one value.
+  double read_scalar(const std::string& path) const;
+  /// Any dataset, flattened in row-major (C) order; its shape is shape(path).
+  std::vector<double> read_array(const std::string& path) const;
+
+  /// Attributes of a group or dataset ("/" is the root).
+  std::string string_attribute(const std::string& object, const std::string& name) const;
+  double number_attribute(const std::string& object, const std::string& name) const;
+  std::vector<std::string> string_list_attribute(const std::string& object, const std::string& name) const;
+  bool has_attribute(const std::string& object, const std::string& name) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::filesystem::path file_;
+};
+
+}  // namespace gpilqg

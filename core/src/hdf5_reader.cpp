@@ -1,0 +1,191 @@
+#include "gpilqg/core/hdf5_reader.hpp"
+
+#include <algorithm>
+#include <functional>
+#include <stdexcept>
+
+#include <H5Cpp.h>
+
+#include "hdf5_common.hpp"
+
+namespace gpilqg {
+
+using hdf5_detail::guarded;
+
+struct Hdf5Reader::Impl {
+  H5::H5File file;
+
+  /// Opens the attribute holder at `path`: a group, or a dataset.
+  H5::H5Object& object(const std::string& path, H5::Group& group_holder, H5::DataSet& dataset_holder) {
+    if (path == "/" || path.empty() || file.childObjType(path) == H5O_TYPE_GROUP) {
+      group_holder = file.openGroup(path.empty() ? "/" : path);
+      return group_holder;
+    }
+    dataset_holder = file.openDataSet(path);
+    return dataset_holder;
+  }
+};
+
+namespace {
+
+std::string join(const std::string& group, const std::string& name) {
+  return group == "/" ? "/" + name : group + "/" + name;
+}
+
+std::string shape_text(const std::vector<std::uint64_t>& dims) {
+  if (dims.empty()) return "a scalar";
+  std::string text = "(";
+  for (std::size_t i = 0; i < dims.size(); ++i) text += (i ? ", " : "") + std::to_string(dims[i]);
+  return text + ")";
+}
+
+}  // namespace
+
+Hdf5Reader::Hdf5Reader(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()), file_(file) {
+  H5::Exception::dontPrint();
+  if (!std::filesystem::exists(file)) throw std::runtime_error(file.string() + ": no such file");
+  guarded(file, "/", "opening", [&] { impl_->file = H5::H5File(file.string(), H5F_ACC_RDONLY); });
+}
+
+Hdf5Reader::~Hdf5Reader() = default;
+
+bool Hdf5Reader::exists(const std::string& path) const {
+  if (path.empty() || path == "/") return true;
+  // Walk the path so that a missing parent is "absent", not an HDF5 error.
+  H5::Group current = impl_->file.openGroup("/");
+  std::size_t start = path.front() == '/' ? 1 : 0;
+  while (start <= path.size()) {
+    const std::size_t slash = path.find('/', start);
+    const std::string name = path.substr(start, slash == std::string::npos ? std::string::npos : slash - start);
+    if (name.empty()) return true;
+    if (!current.nameExists(name)) return false;
+    if (slash == std::string::npos) return true;
+    if (current.childObjType(name) != H5O_TYPE_GROUP) return false;
+    current = current.openGroup(name);
+    start = slash + 1;
+  }
+  return true;
+}
+
+std::vector<std::string> Hdf5Reader::datasets(const std::string& group) const {
+  std::vector<std::string> out;
+  const std::function<void(const std::string&)> walk = [&](const std::string& path) {
+    const H5::Group g = impl_->file.openGroup(path);
+    std::vector<std::string> names;
+    for (hsize_t i = 0; i < g.getNumObjs(); ++i) names.push_back(g.getObjnameByIdx(i));
+    std::sort(names.begin(), names.end());
+    for (const auto& name : names) {
+      H5L_info_t info;
+      // Soft links are aliases of objects listed elsewhere: not followed.
+      if (H5Lget_info(g.getId(), name.c_str(), &info, H5P_DEFAULT) >= 0 && info.type == H5L_TYPE_SOFT) continue;
+      const std::string child = join(path, name);
+      if (g.childObjType(name) == H5O_TYPE_GROUP) walk(child);
+      else if (g.childObjType(name) == H5O_TYPE_DATASET) out.push_back(child);
+    }
+  };
+  guarded(file_, group, "listing group", [&] { walk(group.empty() ? "/" : group); });
+  return out;
+}
+
+std::vector<std::uint64_t> Hdf5Reader::shape(const std::string& path) const {
+  return guarded(file_, path, "reading the shape of dataset", [&] {
+    const H5::DataSpace space = impl_->file.openDataSet(path).getSpace();
+    std::vector<hsize_t> dims(static_cast<std::size_t>(space.getSimpleExtentNdims()));
+    if (!dims.empty()) space.getSimpleExtentDims(dims.data());
+    return std::vector<std::uint64_t>(dims.begin(), dims.end());
+  });
+}
+
+std::vector<double> Hdf5Reader::read_array(const std::string& path) const {
+  return guarded(file_, path, "reading dataset", [&] {
+    const H5::DataSet set = impl_->file.openDataSet(path);
+    if (set.getTypeClass() != H5T_FLOAT && set.getTypeClass() != H5T_INTEGER)
+      throw std::runtime_error(file_.string() + ": dataset '" + path + "' is not numeric");
+    const auto count = static_cast<std::size_t>(set.getSpace().getSimpleExtentNpoints());
+    std::vector<double> values(count);
+    if (count > 0) set.read(values.data(), H5::PredType::NATIVE_DOUBLE);
+    return values;
+  });
+}
+
+Matrix Hdf5Reader::read_matrix(const std::string& path) const {
+  const auto dims = shape(path);
+  if (dims.size() != 1 && dims.size() != 2)
+    throw std::runtime_error(file_.string() + ": dataset '" + path + "' has shape " + shape_text(dims) +
+                             "; expected a matrix (2-D)");
+  const std::vector<double> values = read_array(path);
+  const auto rows = static_cast<Eigen::Index>(dims[0]);
+  const auto cols = dims.size() == 2 ? static_cast<Eigen::Index>(dims[1]) : Eigen::Index{1};
+  return Eigen::Map<const RowMajorMatrix>(values.data(), rows, cols);
+}
+
+Vector Hdf5Reader::read_vector(const std::string& path) const {
+  const auto dims = shape(path);
+  if (dims.size() > 1)
+    throw std::runtime_error(file_.string() + ": dataset '" + path + "' has shape " + shape_text(dims) +
+                             "; expected a vector (1-D)");
+  const std::vector<double> values = read_array(path);
+  return Eigen::Map<const Vector>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+double Hdf5Reader::read_scalar(const std::string& path) const {
+  const std::vector<double> values = read_array(path);
+  if (values.size() != 1)
+    throw std::runtime_error(file_.string() + ": dataset '" + path + "' has shape " + shape_text(shape(path)) +
+                             "; expected one value");
+  return values.front();
+}
+
+bool Hdf5Reader::has_attribute(const std::string& object, const std::string& name) const {
+  return guarded(file_, object, "opening", [&] {
+    H5::Group g;
+    H5::DataSet d;
+    return impl_->object(object, g, d).attrExists(name);
+  });
+}
+
+std::string Hdf5Reader::string_attribute(const std::string& object, const std::string& name) const {
+  return guarded(file_, object + "@" + name, "reading attribute", [&] {
+    H5::Group g;
+    H5::DataSet d;
+    const H5::Attribute a = impl_->object(object, g, d).openAttribute(name);
+    if (a.getTypeClass() != H5T_STRING)
+      throw std::runtime_error(file_.string() + ": attribute '" + object + "@" + name + "' is not a string");
+    std::string value;
+    a.read(a.getStrType(), value);
+    return value;
+  });
+}
+
+double Hdf5Reader::number_attribute(const std::string& object, const std::string& name) const {
+  return guarded(file_, object + "@" + name, "reading attribute", [&] {
+    H5::Group g;
+    H5::DataSet d;
+    const H5::Attribute a = impl_->object(object, g, d).openAttribute(name);
+    if ((a.getTypeClass() != H5T_FLOAT && a.getTypeClass() != H5T_INTEGER) || a.getSpace().getSimpleExtentNpoints() != 1)
+      throw std::runtime_error(file_.string() + ": attribute '" + object + "@" + name + "' is not one number");
+    double value = 0.0;
+    a.read(H5::PredType::NATIVE_DOUBLE, &value);
+    return value;
+  });
+}
+
+std::vector<std::string> Hdf5Reader::string_list_attribute(const std::string& object, const std::string& name) const {
+  return guarded(file_, object + "@" + name, "reading attribute", [&] {
+    H5::Group g;
+    H5::DataSet d;
+    const H5::Attribute a = impl_->object(object, g, d).openAttribute(name);
+    const H5::StrType type = a.getStrType();
+    if (!type.isVariableStr())
+      throw std::runtime_error(file_.string() + ": attribute '" + object + "@" + name +
+                               "' is not a list of variable-length strings");
+    const auto count = static_cast<std::size_t>(a.getSpace().getSimpleExtentNpoints());
+    std::vector<char*> raw(count, nullptr);
+    if (count > 0) a.read(type, raw.data());
+    std::vector<std::string> values(raw.begin(), raw.end());
+    if (count > 0) H5Dvlen_reclaim(type.getId(), a.getSpace().getId(), H5P_DEFAULT, raw.data());
+    return values;
+  });
+}
+
+}  // namespace gpilqg

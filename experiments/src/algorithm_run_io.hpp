@@ -1,0 +1,35 @@
+#pragma once
+/// @file algorithm_run_io.hpp
+/// One AlgorithmRun as an HDF5 file and back, bit for bit (the unit of run_checkpoint.hpp):
+///
+///   /                        attrs name, converged_at, iterations (completed)
+///   /data/{x, u, x_next}     (N x n, N x m, N x n); /data/iteration (N)
+///   /iter_<k>/policy/{x_bar (n x T+1), u_bar (m x T), k (m x T), K (T x m x n), u_min, u_max}
+///   /iter_<k>/{predicted_cost, solve_seconds, variant, data_rows, fit_seconds, rollout_seconds,
+///              policy_change, repeated}
+///   /iter_<k>/summary/{termination, iterations, initial_cost, final_cost, final_gradient_norm,
+///              final_backward_failed}   (the DDP summary without its per-iteration trace)
+///   /iter_<k>/evaluation/{mean_cost, costs, example_x, example_u, diverged, seconds}
+///   /iter_<k>/hyperparameters (outputs x D+2; 0 x 0 without a GP)
+///   /model                   the final residual model (gp_io.hpp layout) when final_model is one
+///
+/// Plan models are code or GPs: on reading, only the last iteration's plan gets a model (the restored
+/// residual model, which is also final_model); fixed-model runs set theirs (algorithm_runs.cpp).
+
+#include <filesystem>
+
+#include "gpilqg/experiments/algorithm_runs.hpp"
+#include "gpilqg/gp/backend.hpp"
+
+namespace gpilqg {
+
+/// Writes `run` to a new file `file` (not atomically: the caller renames it into place).
+void write_algorithm_run(const std::filesystem::path& file, const AlgorithmRun& run);
+
+/// Reads what write_algorithm_run wrote. The residual model, when present, is rebuilt around
+/// `simulator` with the backend named in the file, made with `settings`. Throws std::runtime_error
+/// naming the file and object on a missing or malformed entry.
+AlgorithmRun read_algorithm_run(const std::filesystem::path& file, std::shared_ptr<const StepModel> simulator,
+                                const gp::BackendSettings& settings);
+
+}  // namespace gpilqg

@@ -1,0 +1,129 @@
+#include "gpilqg/experiments/run_checkpoint.hpp"
+
+#include <fmt/format.h>
+
+#include "algorithm_run_io.hpp"
+#include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/hdf5_reader.hpp"
+#include "gpilqg/core/hdf5_writer.hpp"
+
+namespace gpilqg {
+namespace {
+
+constexpr std::int64_t kFormatVersion = 1;
+constexpr const char* kManifest = "manifest.h5";
+
+std::vector<std::string> seed_texts(const std::vector<std::uint64_t>& seeds) {
+  std::vector<std::string> out;
+  for (const auto s : seeds) out.push_back(std::to_string(s));
+  return out;
+}
+
+/// The run's identity as stored in the manifest: a resumed run must match it in every field.
+struct Identity {
+  std::string system, config;
+  std::int64_t iterations = 0;
+  std::vector<std::string> seeds, backends;
+};
+
+Identity identity_of(const RunConfig& config, const RunOptions& options) {
+  return {config.system, config.text, config.iterations, seed_texts(options.seeds), options.backends};
+}
+
+std::string list_text(const std::vector<std::string>& values) {
+  return values.empty() ? std::string("(none)") : fmt::format("{}", fmt::join(values, ","));
+}
+
+}  // namespace
+
+std::filesystem::path RunCheckpoint::folder_for(const std::filesystem::path& result_file) {
+  return std::filesystem::path(result_file.string() + ".checkpoint");
+}
+
+RunCheckpoint RunCheckpoint::create(const std::filesystem::path& folder, const RunConfig& config, const RunOptions& options) {
+  if (std::filesystem::exists(folder))
+    throw std::invalid_argument(fmt::format("{}: a checkpoint of an interrupted run is in the way; continue that run with "
+                                         "--resume, or delete the folder to start over",
+                                         folder.string()));
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) throw std::runtime_error(fmt::format("{}: cannot create the checkpoint folder ({})", folder.string(), error.message()));
+  const Identity id = identity_of(config, options);
+  write_atomically(folder / kManifest, [&](const std::filesystem::path& temporary) {
+    Hdf5Writer h5(temporary);
+    h5.attribute("/", "format_version", kFormatVersion);
+    h5.attribute("/", "system", id.system);
+    h5.attribute("/", "config", id.config);
+    h5.attribute("/", "iterations", id.iterations);
+    h5.attribute("/", "seeds", id.seeds);
+    h5.attribute("/", "backends", id.backends.empty() ? std::vector<std::string>{""} : id.backends);
+    h5.close();
+  });
+  return RunCheckpoint(folder);
+}
+
+RunCheckpoint RunCheckpoint::resume(const std::filesystem::path& folder, const RunConfig& config, const RunOptions& options) {
+  const std::filesystem::path manifest = folder / kManifest;
+  if (!std::filesystem::exists(manifest))
+    throw std::invalid_argument(fmt::format("{}: no checkpoint to resume from (expected {}); run without --resume to start",
+                                         folder.string(), manifest.string()));
+  const Hdf5Reader h5(manifest);
+  const auto version = static_cast<std::int64_t>(h5.number_attribute("/", "format_version"));
+  if (version != kFormatVersion)
+    throw std::runtime_error(fmt::format("{}: checkpoint format_version {}, this program reads {}", manifest.string(), version,
+                                         kFormatVersion));
+  const Identity want = identity_of(config, options);
+  std::vector<std::string> stored_backends = h5.string_list_attribute("/", "backends");
+  if (stored_backends == std::vector<std::string>{""}) stored_backends.clear();
+  const auto mismatch = [&](const std::string& field, const std::string& stored, const std::string& requested) {
+    return std::invalid_argument(fmt::format("{}: the checkpoint was made with {} {}, this run asks for {}; resume with the "
+                                          "same arguments, or delete the folder to start over",
+                                          manifest.string(), field, stored, requested));
+  };
+  if (h5.string_attribute("/", "system") != want.system) throw mismatch("system", h5.string_attribute("/", "system"), want.system);
+  if (h5.string_attribute("/", "config") != want.config)
+    throw mismatch("a different config", "(stored in its 'config' attribute)", "this one");
+  const auto iterations = static_cast<std::int64_t>(h5.number_attribute("/", "iterations"));
+  if (iterations != want.iterations)
+    throw mismatch("iterations", std::to_string(iterations), std::to_string(want.iterations));
+  const auto seeds = h5.string_list_attribute("/", "seeds");
+  if (seeds != want.seeds) throw mismatch("seeds", list_text(seeds), list_text(want.seeds));
+  if (stored_backends != want.backends) throw mismatch("backends", list_text(stored_backends), list_text(want.backends));
+  return RunCheckpoint(folder);
+}
+
+std::filesystem::path RunCheckpoint::unit_file(const TaskContext& context, std::uint64_t seed, const std::string& name) const {
+  return folder_ / fmt::format("seed-{}_task-{}_{}.h5", seed, context.task_index, name);
+}
+
+std::optional<AlgorithmRun> RunCheckpoint::restore(const TaskContext& context, std::uint64_t seed,
+                                                   const std::string& name) const {
+  const std::filesystem::path file = unit_file(context, seed, name);
+  if (!std::filesystem::exists(file)) return std::nullopt;
+  AlgorithmRun run = read_algorithm_run(file, context.models.simulator, context.config.backend_settings);
+  if (run.name != name)
+    throw std::runtime_error(fmt::format("{}: holds algorithm '{}', expected '{}'", file.string(), run.name, name));
+  if (static_cast<int>(run.iterations.size()) > context.config.iterations + 1)
+    throw std::runtime_error(fmt::format("{}: holds {} iterations, the run has {}", file.string(), run.iterations.size(),
+                                         context.config.iterations + 1));
+  ++restored_;
+  if (context.progress)
+    context.progress(fmt::format("{} {}: resumed after iteration {}", context.task.name, name, run.iterations.size() - 1));
+  return run;
+}
+
+void RunCheckpoint::save(const TaskContext& context, std::uint64_t seed, const AlgorithmRun& run) {
+  write_atomically(unit_file(context, seed, run.name),
+                   [&](const std::filesystem::path& temporary) { write_algorithm_run(temporary, run); });
+  if (stop_requested_ && stop_requested_())
+    throw RunInterrupted(fmt::format("stopped after {} iteration {} of {} (seed {}); progress is in {}", context.task.name,
+                                     run.iterations.size() - 1, run.name, seed, folder_.string()));
+}
+
+void RunCheckpoint::remove() {
+  std::error_code error;
+  std::filesystem::remove_all(folder_, error);
+  if (error) throw std::runtime_error(fmt::format("{}: cannot delete the checkpoint folder ({})", folder_.string(), error.message()));
+}
+
+}  // namespace gpilqg

@@ -1,0 +1,277 @@
+/// Resumable `gpilqg run` (run_checkpoint.hpp): a run stopped after any completed iteration and
+/// resumed computes exactly what an uninterrupted run computes; the real program stops on SIGINT with
+/// exit 130 and leaves a previous result file untouched, and survives SIGKILL at any moment; a
+/// checkpoint refuses to serve a different run.
+
+#include "gpilqg/experiments/run_checkpoint.hpp"
+
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/hdf5_reader.hpp"
+#include "gpilqg/experiments/run_results_io.hpp"
+#include "test_support.hpp"
+#include "tiny_run_config.hpp"
+
+extern char** environ;
+
+namespace gpilqg {
+namespace {
+
+RunConfig tiny_config() { return parse_run_config("cartpole", test::kTinyRun, "tiny.toml"); }
+
+RunOptions two_seeds() {
+  RunOptions options;
+  options.seeds = {3, 4};
+  return options;
+}
+
+/// Every number of two runs that does not measure wall-clock time, bit for bit.
+void expect_same_results(const RunResults& resumed, const RunResults& reference) {
+  ASSERT_EQ(resumed.tasks.size(), reference.tasks.size());
+  for (std::size_t t = 0; t < reference.tasks.size(); ++t) {
+    const TaskResults& a = resumed.tasks[t];
+    const TaskResults& b = reference.tasks[t];
+    ASSERT_EQ(a.algorithms, b.algorithms);
+    EXPECT_EQ(a.slice.mean, b.slice.mean) << "figure-1 slice, task " << t;
+    EXPECT_EQ(a.slice.std, b.slice.std) << "figure-1 slice, task " << t;
+    for (std::size_t s = 0; s < b.seeds.size(); ++s) {
+      for (std::size_t i = 0; i < b.algorithms.size(); ++i) {
+        const AlgorithmRun& x = a.seeds[s][i];
+        const AlgorithmRun& y = b.seeds[s][i];
+        SCOPED_TRACE("task " + std::to_string(t) + ", seed index " + std::to_string(s) + ", " + y.name);
+        EXPECT_EQ(x.converged_at, y.converged_at);
+        EXPECT_EQ(x.data.x, y.data.x);
+        EXPECT_EQ(x.data.u, y.data.u);
+        EXPECT_EQ(x.data.x_next, y.data.x_next);
+        EXPECT_EQ(x.data.iteration, y.data.iteration);
+        ASSERT_EQ(x.iterations.size(), y.iterations.size());
+        for (std::size_t k = 0; k < y.iterations.size(); ++k) {
+          const IterationRecord& p = x.iterations[k];
+          const IterationRecord& q = y.iterations[k];
+          EXPECT_EQ(p.evaluation.costs, q.evaluation.costs) << "iteration " << k;
+          EXPECT_EQ(p.evaluation.example.x, q.evaluation.example.x) << "iteration " << k;
+          EXPECT_EQ(p.plan.policy.x_bar, q.plan.policy.x_bar) << "iteration " << k;
+          EXPECT_EQ(p.plan.policy.u_bar, q.plan.policy.u_bar) << "iteration " << k;
+          EXPECT_EQ(p.plan.policy.K, q.plan.policy.K) << "iteration " << k;
+          EXPECT_EQ(p.plan.predicted_cost, q.plan.predicted_cost) << "iteration " << k;
+          EXPECT_EQ(p.hyperparameters, q.hyperparameters) << "iteration " << k;
+          EXPECT_EQ(p.policy_change, q.policy_change) << "iteration " << k;
+          EXPECT_EQ(p.repeated, q.repeated) << "iteration " << k;
+          EXPECT_EQ(p.data_rows, q.data_rows) << "iteration " << k;
+        }
+      }
+    }
+  }
+}
+
+TEST(RunResume, StoppedAfterAnyIterationAndResumedEqualsAnUninterruptedRun) {
+  const RunConfig config = tiny_config();
+  const RunResults reference = run_experiment(config, two_seeds());
+
+  // Count the saves of a whole run, then stop after a spread of them: fixed-model runs, the middle
+  // of gp_ilqg's and PDDP's loops, the transfer task, the second seed, the very last save.
+  const auto folder = test::temporary_dir("run_resume") / "run.h5.checkpoint";
+  int total = 0;
+  {
+    RunOptions options = two_seeds();
+    RunCheckpoint counting = RunCheckpoint::create(folder, config, options);
+    counting.set_stop_requested([&total] { return ++total < 0; });
+    options.journal = &counting;
+    run_experiment(config, options);
+    counting.remove();
+  }
+  ASSERT_GT(total, 20);
+  for (const int stop_after : {1, 3, 4, 6, total / 2 + 1, total - 5, total}) {
+    SCOPED_TRACE("stopped after save " + std::to_string(stop_after) + " of " + std::to_string(total));
+    RunOptions options = two_seeds();
+    {
+      RunCheckpoint first = RunCheckpoint::create(folder, config, options);
+      int saves = 0;
+      first.set_stop_requested([&saves, stop_after] { return ++saves == stop_after; });
+      options.journal = &first;
+      EXPECT_THROW(run_experiment(config, options), RunInterrupted);
+    }
+    RunCheckpoint second = RunCheckpoint::resume(folder, config, options);
+    options.journal = &second;
+    const RunResults resumed = run_experiment(config, options);
+    EXPECT_GT(second.restored_count(), 0);
+    expect_same_results(resumed, reference);
+    second.remove();
+  }
+  std::filesystem::remove_all(folder.parent_path());
+}
+
+TEST(RunResume, ACheckpointServesOnlyTheRunItWasMadeFor) {
+  const auto dir = test::temporary_dir("run_resume_identity");
+  const auto folder = dir / "r.h5.checkpoint";
+  const RunConfig config = tiny_config();
+  const auto message_of = [&](const RunConfig& c, const RunOptions& o) {
+    try {
+      RunCheckpoint::resume(folder, c, o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message_of(config, two_seeds()).find("no checkpoint to resume from"), std::string::npos);
+  RunCheckpoint::create(folder, config, two_seeds());
+  try {
+    RunCheckpoint::create(folder, config, two_seeds());
+    ADD_FAILURE() << "a second create over an existing checkpoint must fail";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--resume"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(RunCheckpoint::resume(folder, config, two_seeds()));
+  RunOptions other_seeds = two_seeds();
+  other_seeds.seeds = {3};
+  EXPECT_NE(message_of(config, other_seeds).find("seeds 3,4, this run asks for 3"), std::string::npos)
+      << message_of(config, other_seeds);
+  RunOptions other_backends = two_seeds();
+  other_backends.backends = {"exact", "fitc"};
+  EXPECT_NE(message_of(config, other_backends).find("backends"), std::string::npos);
+  RunConfig more_iterations = config;
+  more_iterations.iterations = 5;
+  EXPECT_NE(message_of(more_iterations, two_seeds()).find("iterations 2, this run asks for 5"), std::string::npos);
+  const RunConfig other_config = parse_run_config("cartpole", std::string(test::kTinyRun) + "[control]\nu_max = [9.0]\n", "t.toml");
+  EXPECT_NE(message_of(other_config, two_seeds()).find("a different config"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// ---- the real program, with real signals -------------------------------------------------------
+
+std::string read_bytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+/// Starts `gpilqg run cartpole --config CONFIG --out OUT --no-plots`, output to LOG.
+pid_t start_run(const std::filesystem::path& config, const std::filesystem::path& out, const std::filesystem::path& log) {
+  const std::string program = GPILQG_CLI_PATH;
+  const std::string config_s = config.string(), out_s = out.string();
+  std::vector<std::string> args = {program, "run", "cartpole", "--config", config_s, "--out", out_s, "--no-plots"};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = -1;
+  const int error = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (error != 0) throw std::runtime_error("cannot start " + program);
+  return pid;
+}
+
+/// Waits until the checkpoint folder holds `files` entries (the manifest and the first saves).
+bool wait_for_checkpoint_files(const std::filesystem::path& folder, int files, pid_t child) {
+  for (int i = 0; i < 120000; ++i) {
+    int count = 0;
+    std::error_code error;
+    for (auto it = std::filesystem::directory_iterator(folder, error); !error && it != std::filesystem::directory_iterator(); ++it)
+      count += is_atomic_temporary(it->path()) ? 0 : 1;
+    if (count >= files) return true;
+    if (waitpid(child, nullptr, WNOHANG) == child) return false;
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  return false;
+}
+
+/// Every dataset of two result files except the wall-clock timings.
+void expect_same_result_files(const std::filesystem::path& resumed, const std::filesystem::path& reference) {
+  const Hdf5Reader a(resumed), b(reference);
+  const auto names = b.datasets();
+  ASSERT_EQ(a.datasets(), names);
+  int compared = 0;
+  for (const auto& name : names) {
+    const std::string leaf = name.substr(name.find_last_of('/') + 1);
+    if (leaf.rfind("time_", 0) == 0 || leaf == "solve_time") continue;
+    EXPECT_EQ(a.shape(name), b.shape(name)) << name;
+    const auto x = a.read_array(name), y = b.read_array(name);
+    bool same = x.size() == y.size();
+    for (std::size_t i = 0; same && i < x.size(); ++i) same = x[i] == y[i] || (std::isnan(x[i]) && std::isnan(y[i]));
+    EXPECT_TRUE(same) << name;
+    ++compared;
+  }
+  EXPECT_GT(compared, 100);
+}
+
+class RunSignals : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::temporary_dir("run_signals");
+    // Three data rounds on 25-step tasks: long enough that the signal lands mid-run.
+    std::string text = test::kTinyRun;
+    text.replace(text.find("iterations = 2"), 14, "iterations = 3");
+    for (std::size_t at = text.find("horizon = 15"); at != std::string::npos; at = text.find("horizon = 15"))
+      text.replace(at, 12, "horizon = 25");
+    config_ = dir_ / "signals.toml";
+    std::ofstream(config_) << text;
+    reference_ = dir_ / "reference.h5";
+    const auto done = test::run_cli("run cartpole --config '" + config_.string() + "' --out '" + reference_.string() + "' --no-plots");
+    ASSERT_EQ(done.status, 0) << done.err;
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  /// Resumes the interrupted run of `out` and checks it against the uninterrupted reference.
+  void resume_and_compare(const std::filesystem::path& out) {
+    const auto resumed = test::run_cli("run cartpole --config '" + config_.string() + "' --out '" + out.string() +
+                                       "' --no-plots --resume");
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_NE(resumed.err.find("resumed after iteration"), std::string::npos) << resumed.err;
+    EXPECT_FALSE(std::filesystem::exists(RunCheckpoint::folder_for(out))) << "the checkpoint outlived the finished run";
+    expect_same_result_files(out, reference_);
+  }
+
+  std::filesystem::path dir_, config_, reference_;
+};
+
+TEST_F(RunSignals, SigintStopsAtAnIterationLeavesThePreviousResultAndResumesToTheSameResult) {
+  const auto out = dir_ / "result.h5";
+  const std::string previous = "a previous result that must survive";
+  std::ofstream(out, std::ios::binary) << previous;
+  const pid_t child = start_run(config_, out, dir_ / "interrupted.log");
+  ASSERT_TRUE(wait_for_checkpoint_files(RunCheckpoint::folder_for(out), 2, child)) << "the run ended before its first save";
+  ASSERT_EQ(kill(child, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  const std::string log = read_bytes(dir_ / "interrupted.log");
+  ASSERT_TRUE(WIFEXITED(status)) << log;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << log;
+  EXPECT_NE(log.find("interrupted: stopped after"), std::string::npos) << log;
+  EXPECT_NE(log.find("--resume"), std::string::npos) << log;
+  EXPECT_EQ(read_bytes(out), previous);
+  for (const auto& entry : std::filesystem::directory_iterator(dir_))
+    EXPECT_FALSE(is_atomic_temporary(entry.path())) << "left behind: " << entry.path();
+  resume_and_compare(out);
+}
+
+TEST_F(RunSignals, SigkillAtAnyMomentLeavesACheckpointThatResumesToTheSameResult) {
+  // No chance to stop cleanly: whatever the moment, each checkpoint file is the old or the new one.
+  const auto out = dir_ / "killed.h5";
+  const pid_t child = start_run(config_, out, dir_ / "killed.log");
+  ASSERT_TRUE(wait_for_checkpoint_files(RunCheckpoint::folder_for(out), 4, child)) << "the run ended before its third save";
+  ASSERT_EQ(kill(child, SIGKILL), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  EXPECT_FALSE(std::filesystem::exists(out));
+  resume_and_compare(out);
+}
+
+}  // namespace
+}  // namespace gpilqg
