@@ -2,7 +2,6 @@
 
 #include <H5Cpp.h>
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -11,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/experiments/profile.hpp"
 #include "gpilqg/experiments/plot_script.hpp"
 
@@ -129,12 +129,10 @@ std::string format_profile(const ProfileReport& report) {
 }
 
 void write_profile_hdf5(const std::filesystem::path& file, const ProfileReport& report) {
-  std::filesystem::path temporary = file;
-  temporary += fmt::format(".tmp-{}", static_cast<long>(::getpid()));
   H5::Exception::dontPrint();
-  try {
-    {
-      H5::H5File h5(temporary.c_str(), H5F_ACC_TRUNC);
+  write_atomically(file, [&](const std::filesystem::path& temporary) {
+    try {
+      H5::H5File h5(temporary.c_str(), H5F_ACC_EXCL);
       H5::Group root = h5.openGroup("/");
       write_int_attribute(root, "schema_version", 1);
       write_string_attribute(root, "gpilqg_version", "0.1.0");
@@ -162,17 +160,10 @@ void write_profile_hdf5(const std::filesystem::path& file, const ProfileReport& 
       write_column(rows, "msll", r, value(&ProfileRow::msll));
       write_column(rows, "nlml", r, value(&ProfileRow::nlml));
       write_column(rows, "evaluations", r, [](const ProfileRow& row) { return static_cast<double>(row.evaluations); });
+    } catch (const H5::Exception& e) {
+      throw std::runtime_error(file.string() + ": writing the profile failed (HDF5: " + e.getDetailMsg() + ")");
     }
-    std::filesystem::rename(temporary, file);
-  } catch (const H5::Exception& e) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw std::runtime_error(file.string() + ": writing the profile failed (HDF5: " + e.getDetailMsg() + ")");
-  } catch (const std::filesystem::filesystem_error& e) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw std::runtime_error(file.string() + ": cannot move the finished file into place (" + e.what() + ")");
-  }
+  });
 }
 
 void plot_profile(const std::filesystem::path& h5, const std::filesystem::path& directory) {
