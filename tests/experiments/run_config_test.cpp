@@ -27,7 +27,7 @@ TEST(RunConfig, EmbeddedDefaultsDescribeThePapersExperiments) {
   EXPECT_FALSE(cartpole.tasks[0].transfer);
   EXPECT_TRUE(cartpole.tasks[1].transfer);
   EXPECT_EQ(cartpole.backend, "exact");
-  EXPECT_EQ(cartpole.backend_settings.exact_points, 300);  // the paper's subsample
+  EXPECT_EQ(cartpole.backend_settings.exact_points, 600);  // twice the paper's subsample (README: why)
   EXPECT_EQ(cartpole.gp_variant, DdpVariant::RobustILQG);
   EXPECT_FALSE(cartpole.mpc);
 
@@ -63,7 +63,7 @@ track_line = false
 transfer = false
 )", "user.toml");
   EXPECT_EQ(c.iterations, 2);
-  EXPECT_EQ(c.rollouts, 3);  // untouched defaults stay
+  EXPECT_EQ(c.rollouts, 5);  // untouched defaults stay
   EXPECT_EQ(c.backend, "fitc");
   EXPECT_EQ(c.backend_settings.inducing, 40);
   ASSERT_EQ(c.tasks.size(), 1u);
