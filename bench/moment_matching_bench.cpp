@@ -2,6 +2,8 @@
 // (gp/moment_matching.hpp), with and without the derivatives PDDP needs, at N = 300 training points:
 //   cart-pole  D = 5  (4 states + 1 control), E = 4 outputs  (belief dimension 4 + 10 = 14)
 //   quadrotor  D = 16 (12 states + 4 controls), E = 12 outputs (belief dimension 12 + 78 = 90)
+// The ...PerOutputCentres variants give every output its own N = 300 centres (FITC's case, each output
+// its own pseudo-inputs): the same work as shared centres, so the figures should match.
 // Run e.g. build/bench/gpilqg_moment_matching_bench --benchmark_min_time=0.5
 
 #include <benchmark/benchmark.h>
@@ -18,29 +20,35 @@ using gpilqg::Matrix;
 using gpilqg::Vector;
 using namespace gpilqg::gp;
 
-/// E GPs on N random inputs in [-2, 2]^D with smooth targets and length-scales between 0.8 and 2.
-SeArdMomentMatcher make_matcher(int n, int d, int e) {
+/// E GPs on N random inputs in [-2, 2]^D with smooth targets and length-scales between 0.8 and 2;
+/// shared inputs, or (per_output) fresh inputs for every output.
+SeArdMomentMatcher make_matcher(int n, int d, int e, bool per_output = false) {
   std::mt19937 gen(17);
   std::uniform_real_distribution<double> uniform(-2.0, 2.0);
   std::uniform_real_distribution<double> log_l(std::log(0.8), std::log(2.0));
   Matrix x(n, d);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < d; ++j) x(i, j) = uniform(gen);
+  std::vector<Matrix> centres;
   std::vector<SeArdOutput> outputs;
   for (int a = 0; a < e; ++a) {
+    if (a == 0 || per_output)
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < d; ++j) x(i, j) = uniform(gen);
+    centres.push_back(x);
     Vector y(n);
     for (int i = 0; i < n; ++i) y(i) = std::sin(x(i, a % d) + 0.3 * a) + 0.2 * x(i, (a + 1) % d) * x(i, 0);
     Vector lengthscales(d);
     for (int j = 0; j < d; ++j) lengthscales(j) = log_l(gen);
     outputs.push_back(condition_se_ard_output(x, y, lengthscales, 0.0, std::log(0.05)));
   }
+  if (per_output) return SeArdMomentMatcher(std::move(centres), std::move(outputs));
   return SeArdMomentMatcher(std::move(x), std::move(outputs));
 }
 
 /// A belief with the last `controls` inputs deterministic (zero rows and columns), as in PDDP.
-void propagate(benchmark::State& state, int d, int e, int controls, MomentDerivatives derivatives) {
+void propagate(benchmark::State& state, int d, int e, int controls, MomentDerivatives derivatives,
+               bool per_output = false) {
   const int n = static_cast<int>(state.range(0));
-  const SeArdMomentMatcher matcher = make_matcher(n, d, e);
+  const SeArdMomentMatcher matcher = make_matcher(n, d, e, per_output);
   const Vector mu = Vector::LinSpaced(d, -0.5, 0.5);
   Matrix sigma = Matrix::Zero(d, d);
   const int states = d - controls;
@@ -62,9 +70,18 @@ void BM_QuadrotorMomentsAndDerivatives(benchmark::State& state) {
   propagate(state, 16, 12, 4, MomentDerivatives::All);
 }
 
+void BM_QuadrotorMomentsPerOutputCentres(benchmark::State& state) {
+  propagate(state, 16, 12, 4, MomentDerivatives::None, true);
+}
+void BM_QuadrotorMomentsAndDerivativesPerOutputCentres(benchmark::State& state) {
+  propagate(state, 16, 12, 4, MomentDerivatives::All, true);
+}
+
 BENCHMARK(BM_CartpoleMoments)->Arg(300)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_CartpoleMomentsAndDerivatives)->Arg(300)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_QuadrotorMoments)->Arg(300)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuadrotorMomentsAndDerivatives)->Arg(300)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QuadrotorMomentsPerOutputCentres)->Arg(300)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QuadrotorMomentsAndDerivativesPerOutputCentres)->Arg(300)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -197,10 +197,8 @@ DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uin
     Matrix inputs(data.size(), n + m);
     inputs << data.x, data.u;
     const Matrix increments = data.x_next - data.x;
-    gp::ExactGpOptions exact;
-    exact.max_training_points = c.config.backend_settings.exact_points;
-    const gp::ExactGpBackend backend(exact);
-    const auto dynamics = gp::GpBeliefDynamics::fit(n, m, c.config.dt, inputs, increments, backend,
+    const auto backend = gp::make_backend(c.config.pddp_backend, c.config.backend_settings);
+    const auto dynamics = gp::GpBeliefDynamics::fit(n, m, c.config.dt, inputs, increments, *backend,
                                                     fit_options(c, seed, name, data.size()));
     record.fit_seconds = seconds_since(start);
 

@@ -9,6 +9,7 @@
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
+#include "gpilqg/gp/fitted_moment_matcher.hpp"
 
 namespace gpilqg {
 namespace {
@@ -140,6 +141,12 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
 
   c.pddp = boolean(f, root, "pddp.enabled");
   c.pddp_max_iterations = positive_integer(f, "pddp.max_iterations", 1);
+  c.pddp_backend = f.string("pddp.backend");
+  try {
+    gp::require_moment_matching(c.pddp_backend, "");
+  } catch (const std::invalid_argument& e) {
+    f.fail("pddp.backend", e.what());
+  }
   c.pddp_own = boolean(f, root, "pddp.own");
   c.pddp_own_initial_rollouts = positive_integer(f, "pddp.own_initial_rollouts", 1);
   c.pddp_own_amplitude = non_negative(f, "pddp.own_amplitude", m);

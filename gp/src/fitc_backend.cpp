@@ -76,6 +76,10 @@ std::pair<Vector, ParameterBounds> fitc_start(const FitcLayout& layout, const Tr
 
 }  // namespace
 
+const FitcPredictor* fitc_posterior(const FittedGp& model) {
+  return sparse_detail::posterior_of<FitcTraits>(model);
+}
+
 FitcBackend::FitcBackend(FitcOptions options) : options_(std::move(options)) { options_.validate(); }
 
 std::unique_ptr<MarginalLikelihoodObjective> FitcBackend::objective(const TrainingSet& data,

@@ -4,15 +4,19 @@
 #include <stdexcept>
 #include <string>
 
+#include "gpilqg/gp/fitted_moment_matcher.hpp"
+#include "gpilqg/gp/moment_matching.hpp"
+
 namespace gpilqg::gp {
 
-GpBeliefDynamics::GpBeliefDynamics(int n, int m, double dt, SeArdMomentMatcher matcher)
+GpBeliefDynamics::GpBeliefDynamics(int n, int m, double dt, std::shared_ptr<const MomentMatcher> matcher)
     : n_(n), m_(m), dt_(dt), matcher_(std::move(matcher)) {
   if (n < 1 || m < 0) throw std::invalid_argument("GpBeliefDynamics: need n >= 1 and m >= 0");
   if (!std::isfinite(dt) || dt <= 0.0) throw std::invalid_argument("GpBeliefDynamics: dt must be > 0");
-  if (matcher_.output_dim() != n || matcher_.input_dim() != n + m)
-    throw std::invalid_argument("GpBeliefDynamics: the matcher has " + std::to_string(matcher_.output_dim()) +
-                                " outputs over " + std::to_string(matcher_.input_dim()) + " inputs; expected " +
+  if (!matcher_) throw std::invalid_argument("GpBeliefDynamics: the matcher is null");
+  if (matcher_->output_dim() != n || matcher_->input_dim() != n + m)
+    throw std::invalid_argument("GpBeliefDynamics: the matcher has " + std::to_string(matcher_->output_dim()) +
+                                " outputs over " + std::to_string(matcher_->input_dim()) + " inputs; expected " +
                                 std::to_string(n) + " over " + std::to_string(n + m) + " (z = [x; u] -> dx)");
 }
 
@@ -32,35 +36,24 @@ GpBeliefDynamics GpBeliefDynamics::condition(int n, int m, double dt, const Matr
                                   std::to_string(h.size()) + " entries; expected D + 2 = " + std::to_string(D + 2));
     outputs.push_back(condition_se_ard_output(inputs, increments.col(a), h.head(D), h(D), h(D + 1)));
   }
-  return GpBeliefDynamics(n, m, dt, SeArdMomentMatcher(inputs, std::move(outputs)));
+  return GpBeliefDynamics(n, m, dt, std::make_shared<const SeArdMomentMatcher>(inputs, std::move(outputs)));
 }
 
 GpBeliefDynamics GpBeliefDynamics::fit(int n, int m, double dt, const Matrix& inputs, const Matrix& increments,
                                        const GpBackend& backend, const FitOptions& options,
                                        std::vector<FitSummary>* summaries) {
-  if (backend.name() != "exact")
-    throw std::invalid_argument("GpBeliefDynamics::fit: backend '" + std::string(backend.name()) +
-                                "' has no exact SE-ARD moment matching; use the exact backend");
+  require_moment_matching(backend.name(), "GpBeliefDynamics::fit");
   if (increments.cols() != n || increments.rows() != inputs.rows())
     throw std::invalid_argument("GpBeliefDynamics::fit: increments must be N x n with N = rows of inputs");
-  std::vector<Vector> hyperparameters;
-  Matrix support_inputs;
-  Matrix support_increments;
+  std::vector<std::unique_ptr<FittedGp>> models;
+  std::vector<const FittedGp*> outputs;
   for (int a = 0; a < n; ++a) {
-    const TrainingSet data{inputs, increments.col(a)};
-    FitResult fitted = backend.fit(data, options);
-    const TrainingSet& used = fitted.model->training_set();
-    if (a == 0) {
-      support_inputs = used.inputs;
-      support_increments.resize(used.size(), n);
-    } else if (used.inputs != support_inputs) {
-      throw std::logic_error("GpBeliefDynamics::fit: outputs were fitted on different subsamples");
-    }
-    support_increments.col(a) = used.targets;
-    hyperparameters.push_back(fitted.model->parameters().head(inputs.cols() + 2));
+    FitResult fitted = backend.fit(TrainingSet{inputs, increments.col(a)}, options);
+    outputs.push_back(fitted.model.get());
+    models.push_back(std::move(fitted.model));
     if (summaries) summaries->push_back(fitted.summary);
   }
-  return condition(n, m, dt, support_inputs, support_increments, hyperparameters);
+  return GpBeliefDynamics(n, m, dt, moment_matcher_for(outputs));
 }
 
 void GpBeliefDynamics::propagate(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
@@ -80,7 +73,7 @@ void GpBeliefDynamics::propagate(const VectorCRef& v, const VectorCRef& u, Vecto
   mu_z.tail(m) = u;
   Sigma_z.setZero(D, D);
   Sigma_z.topLeftCorner(n, n) = Sigma;
-  matcher_.propagate(mu_z, Sigma_z, mm, jacobians ? MomentDerivatives::All : MomentDerivatives::None);
+  matcher_->propagate(mu_z, Sigma_z, mm, jacobians ? MomentDerivatives::All : MomentDerivatives::None);
 
   const Matrix& C = mm.cross_covariance;  // D x n
   Sigma_next = Sigma + mm.covariance;

@@ -2,7 +2,8 @@
 /// SeArdMomentMatcher: construction, validation, the predictive mean M, the input-output covariance C
 /// and their derivatives. The covariance S is in moment_matching_covariance.cpp.
 ///
-/// Notation (per output a; see moment_matching.hpp): w = diag(W_a), V = X - 1 mu' (rows nu_i'),
+/// Notation (per output a; see moment_matching.hpp): w = diag(W_a), V = V_a = X_a - 1 mu' (rows nu_i',
+/// one per centre of output a),
 /// Rt_a = W^1/2 Sigma W^1/2 + I (eigenvalues >= 1 for a PSD Sigma), and
 ///
 ///   P_a = (Sigma + Lambda_a)^-1 = W^1/2 Rt_a^-1 W^1/2,   |Sigma W_a + I| = |Rt_a|,
@@ -25,6 +26,7 @@
 
 #include "gpilqg/gp/moment_matching.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -34,15 +36,13 @@
 namespace gpilqg::gp {
 
 using detail::tiled_product;
+using detail::shape;
+using detail::view;
 
 namespace {
 
 [[noreturn]] void fail(const std::string& message) {
   throw std::invalid_argument("SeArdMomentMatcher: " + message);
-}
-
-std::string shape(Eigen::Index rows, Eigen::Index cols) {
-  return std::to_string(rows) + " x " + std::to_string(cols);
 }
 
 }  // namespace
@@ -93,31 +93,61 @@ SeArdOutput condition_se_ard_output(const MatrixCRef& inputs, const VectorCRef& 
 // ------------------------------------------------------------------------------------------------
 // Construction
 
-SeArdMomentMatcher::SeArdMomentMatcher(Matrix inputs, std::vector<SeArdOutput> outputs)
-    : inputs_(std::move(inputs)) {
-  const Eigen::Index n = inputs_.rows();
-  const Eigen::Index d = inputs_.cols();
-  if (n == 0 || d == 0) fail("inputs is " + shape(n, d) + ", need at least one row and one column");
-  if (!inputs_.allFinite()) fail("inputs has a non-finite entry");
+namespace {
+
+/// Throws unless `x` (named `label`) has at least one row and column (exactly `d` columns when d > 0)
+/// and finite entries.
+void check_centres(const Matrix& x, const std::string& label, Eigen::Index d) {
+  if (x.rows() == 0 || x.cols() == 0)
+    fail(label + " is " + shape(x.rows(), x.cols()) + ", need at least one row and one column");
+  if (d > 0 && x.cols() != d)
+    fail(label + " has " + std::to_string(x.cols()) + " columns, expected D = " + std::to_string(d) +
+         " (the columns of centres[0])");
+  if (!x.allFinite()) fail(label + " has a non-finite entry");
+}
+
+}  // namespace
+
+SeArdMomentMatcher::SeArdMomentMatcher(Matrix inputs, std::vector<SeArdOutput> outputs) {
+  check_centres(inputs, "inputs", 0);
   if (outputs.empty()) fail("outputs is empty, need at least one output");
+  std::vector<Matrix> centres(outputs.size(), inputs);
+  build(std::move(centres), std::move(outputs), true);
+}
+
+SeArdMomentMatcher::SeArdMomentMatcher(std::vector<Matrix> centres, std::vector<SeArdOutput> outputs) {
+  if (outputs.empty()) fail("outputs is empty, need at least one output");
+  if (centres.size() != outputs.size())
+    fail("centres has " + std::to_string(centres.size()) + " matrices for " + std::to_string(outputs.size()) +
+         " outputs; expected one per output");
+  for (std::size_t a = 0; a < centres.size(); ++a)
+    check_centres(centres[a], "centres[" + std::to_string(a) + "]", a == 0 ? 0 : centres[0].cols());
+  build(std::move(centres), std::move(outputs), false);
+}
+
+void SeArdMomentMatcher::build(std::vector<Matrix> centres, std::vector<SeArdOutput> outputs, bool shared) {
+  const Eigen::Index d = centres[0].cols();
+  input_dim_ = static_cast<int>(d);
   outputs_.reserve(outputs.size());
   for (std::size_t a = 0; a < outputs.size(); ++a) {
     SeArdOutput& src = outputs[a];
+    const Eigen::Index n = centres[a].rows();
     const std::string name = "outputs[" + std::to_string(a) + "]";
+    const std::string rows = shared ? "rows of inputs" : "rows of centres[" + std::to_string(a) + "]";
     if (src.log_lengthscales.size() != d)
       fail(name + ".log_lengthscales has " + std::to_string(src.log_lengthscales.size()) +
-           " entries, expected D = " + std::to_string(d) + " (columns of inputs)");
+           " entries, expected D = " + std::to_string(d) + " (columns of the centres)");
     if (src.beta.size() != n)
       fail(name + ".beta has " + std::to_string(src.beta.size()) + " entries, expected N = " +
-           std::to_string(n) + " (rows of inputs)");
+           std::to_string(n) + " (" + rows + ")");
     if (src.Kinv.rows() != n || src.Kinv.cols() != n)
-      fail(name + ".Kinv is " + shape(src.Kinv.rows(), src.Kinv.cols()) + ", expected N x N = " +
-           shape(n, n));
+      fail(name + ".Kinv is " + shape(src.Kinv.rows(), src.Kinv.cols()) + ", expected N x N = " + shape(n, n));
     if (!src.log_lengthscales.allFinite()) fail(name + ".log_lengthscales has a non-finite entry");
     if (!std::isfinite(src.log_signal_std)) fail(name + ".log_signal_std is not finite");
     if (!src.beta.allFinite()) fail(name + ".beta has a non-finite entry");
     if (!src.Kinv.allFinite()) fail(name + ".Kinv has a non-finite entry");
     OutputData o;
+    o.centres = std::move(centres[a]);
     o.inverse_squared_lengthscales = (-2.0 * src.log_lengthscales.array()).exp().matrix();
     o.sqrt_w = (-src.log_lengthscales.array()).exp().matrix();
     o.lengthscales = src.log_lengthscales.array().exp().matrix();
@@ -132,6 +162,7 @@ SeArdMomentMatcher::SeArdMomentMatcher(Matrix inputs, std::vector<SeArdOutput> o
       fail(name + ".log_signal_std out of range (sf^2 overflows)");
     o.beta = std::move(src.beta);
     o.Kinv = std::move(src.Kinv);
+    max_centres_ = std::max(max_centres_, n);
     outputs_.push_back(std::move(o));
   }
 }
@@ -140,41 +171,31 @@ SeArdMomentMatcher::SeArdMomentMatcher(Matrix inputs, std::vector<SeArdOutput> o
 // Propagation
 
 void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives) const {
-  const Eigen::Index n = inputs_.rows();
-  const Eigen::Index d = inputs_.cols();
+  const Eigen::Index n = max_centres_;
+  const Eigen::Index d = input_dim_;
   const Eigen::Index e = static_cast<Eigen::Index>(outputs_.size());
-  out.mean.resize(e);
-  out.covariance.resize(e, e);
-  out.cross_covariance.resize(d, e);
-  if (derivatives) {
-    out.dmean_dmu.resize(e, d);
-    out.dmean_dsigma.resize(e, d * d);
-    out.dcovariance_dmu.resize(e * e, d);
-    out.dcovariance_dsigma.resize(e * e, d * d);
-    out.dcross_dmu.resize(d * e, d);
-    out.dcross_dsigma.resize(d * e, d * d);
-  }
   MomentMatchScratch& s = out.scratch;
   s.sigma.resize(d, d);
-  s.centred.resize(n, d);
-  const auto size_all = [e](std::vector<Matrix>& v, Eigen::Index rows, Eigen::Index cols) {
-    v.resize(static_cast<std::size_t>(e));
-    for (Matrix& m : v) m.resize(rows, cols);
+  // Per output: rows(a) rows (N_a) by `cols` columns.
+  const auto size_all = [this](std::vector<Matrix>& v, bool per_output_rows, Eigen::Index rows, Eigen::Index cols) {
+    v.resize(outputs_.size());
+    for (std::size_t a = 0; a < outputs_.size(); ++a) v[a].resize(per_output_rows ? outputs_[a].centres.rows() : rows, cols);
   };
-  const auto size_all_vectors = [e](std::vector<Vector>& v, Eigen::Index size) {
-    v.resize(static_cast<std::size_t>(e));
-    for (Vector& x : v) x.resize(size);
+  const auto size_all_vectors = [this](std::vector<Vector>& v, bool per_output, Eigen::Index size) {
+    v.resize(outputs_.size());
+    for (std::size_t a = 0; a < outputs_.size(); ++a) v[a].resize(per_output ? outputs_[a].centres.rows() : size);
   };
-  size_all(s.precision, d, d);
-  size_all(s.precision_lambda, d, d);
-  size_all(s.solved, n, d);
-  size_all(s.scaled, n, d);
-  size_all(s.hessian, d, d);
-  size_all_vectors(s.weighted, n);
-  size_all_vectors(s.kernel_mean, n);
-  size_all_vectors(s.log_shift, n);
-  size_all(s.shrink, d, d);
-  size_all_vectors(s.gradient, d);
+  size_all(s.centred, true, 0, d);
+  size_all(s.precision, false, d, d);
+  size_all(s.precision_lambda, false, d, d);
+  size_all(s.solved, true, 0, d);
+  size_all(s.scaled, true, 0, d);
+  size_all(s.hessian, false, d, d);
+  size_all_vectors(s.weighted, true, 0);
+  size_all_vectors(s.kernel_mean, true, 0);
+  size_all_vectors(s.log_shift, true, 0);
+  size_all(s.shrink, false, d, d);
+  size_all_vectors(s.gradient, false, d);
   s.log_det.resize(e);
   for (Matrix* m : {&s.rt, &s.rt_inverse, &s.xi, &s.gain, &s.pair_precision, &s.dd, &s.dd2, &s.inner})
     m->resize(d, d);
@@ -186,8 +207,8 @@ void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives) const {
   if (derivatives) {
     s.outer.resize(n, d * d);
     s.third.resize(d, d * d);
-    size_all_vectors(s.scaled_sum, d);
-    size_all(s.scaled_scatter, d, d);
+    size_all_vectors(s.scaled_sum, false, d);
+    size_all(s.scaled_scatter, false, d, d);
     for (Matrix* m : {&s.pair_shrink, &s.delta_a, &s.delta_b}) m->resize(d, d);
   }
 }
@@ -210,48 +231,24 @@ double SeArdMomentMatcher::factor_scaled(MomentMatchScratch& s, const Vector& sq
   return 2.0 * diagonal.array().log().sum();
 }
 
-void SeArdMomentMatcher::propagate(const VectorCRef& mu, const MatrixCRef& sigma, MomentMatch& out,
-                                   MomentDerivatives derivatives) const {
-  const Eigen::Index d = inputs_.cols();
-  if (mu.size() != d)
-    throw std::invalid_argument("SeArdMomentMatcher::propagate: mu has " + std::to_string(mu.size()) +
-                                " entries, expected D = " + std::to_string(d));
-  if (sigma.rows() != d || sigma.cols() != d)
-    throw std::invalid_argument("SeArdMomentMatcher::propagate: Sigma is " + shape(sigma.rows(), sigma.cols()) +
-                                ", expected D x D = " + shape(d, d));
-  if (!mu.allFinite()) throw std::invalid_argument("SeArdMomentMatcher::propagate: mu has a non-finite entry");
-  if (!sigma.allFinite())
-    throw std::invalid_argument("SeArdMomentMatcher::propagate: Sigma has a non-finite entry");
-
-  const bool with_derivatives = derivatives == MomentDerivatives::All;
-  out.has_derivatives = false;
-  prepare(out, with_derivatives);
+void SeArdMomentMatcher::evaluate(const VectorCRef& mu, const MatrixCRef& sigma, MomentMatch& out,
+                                  bool derivatives) const {
+  prepare(out, derivatives);
   MomentMatchScratch& s = out.scratch;
   s.sigma = 0.5 * (sigma + sigma.transpose());
-  s.centred = inputs_.rowwise() - mu.transpose();
-
-  propagate_mean(out, with_derivatives);
-  propagate_covariance(out, with_derivatives);
-
-  bool finite = out.mean.allFinite() && out.covariance.allFinite() && out.cross_covariance.allFinite();
-  if (with_derivatives)
-    finite = finite && out.dmean_dmu.allFinite() && out.dmean_dsigma.allFinite() &&
-             out.dcovariance_dmu.allFinite() && out.dcovariance_dsigma.allFinite() &&
-             out.dcross_dmu.allFinite() && out.dcross_dsigma.allFinite();
-  if (!finite)
-    throw std::invalid_argument(
-        "SeArdMomentMatcher::propagate: a moment or derivative overflowed (mu, Sigma or the GP weights "
-        "are out of range)");
-  out.has_derivatives = with_derivatives;
+  for (std::size_t a = 0; a < outputs_.size(); ++a) s.centred[a] = outputs_[a].centres.rowwise() - mu.transpose();
+  propagate_mean(out, derivatives);
+  propagate_covariance(out, derivatives);
 }
 
 void SeArdMomentMatcher::propagate_mean(MomentMatch& out, bool derivatives) const {
   MomentMatchScratch& s = out.scratch;
-  const Eigen::Index d = inputs_.cols();
-  const Matrix& v = s.centred;
+  const Eigen::Index d = input_dim_;
   for (std::size_t a = 0; a < outputs_.size(); ++a) {
     const OutputData& o = outputs_[a];
     const auto ai = static_cast<Eigen::Index>(a);
+    const Matrix& v = s.centred[a];
+    auto nd = view(s.nd, v.rows(), d);
     const double log_det = factor_scaled(s, o.sqrt_w, a, a);
     s.log_det(ai) = log_det;
 
@@ -283,42 +280,39 @@ void SeArdMomentMatcher::propagate_mean(MomentMatch& out, bool derivatives) cons
     s.dd.diagonal().array() += 1.0;
     Matrix& shrink = s.shrink[a];
     shrink.noalias() = o.sqrt_w.asDiagonal() * s.dd * o.sqrt_w.asDiagonal();
-    tiled_product(v, shrink, s.nd);
-    s.log_shift[a] = 0.5 * s.nd.cwiseProduct(v).rowwise().sum();
+    tiled_product(v, shrink, nd);
+    s.log_shift[a] = 0.5 * nd.cwiseProduct(v).rowwise().sum();
 
     if (!derivatives) continue;
     // u_a = A_a' gamma_a and E_a = A_a' diag(gamma_a) A_a for the covariance derivatives.
     s.scaled_sum[a].noalias() = scaled.transpose() * gamma;
-    s.nd = scaled;
-    s.nd.array().colwise() *= gamma.array();
-    tiled_product(scaled.transpose(), s.nd, s.scaled_scatter[a]);
+    nd = scaled;
+    nd.array().colwise() *= gamma.array();
+    tiled_product(scaled.transpose(), nd, s.scaled_scatter[a]);
     Matrix& h = s.hessian[a];
-    s.nd = t;
-    s.nd.array().colwise() *= gamma.array();
-    tiled_product(t.transpose(), s.nd, h);
+    nd = t;
+    nd.array().colwise() *= gamma.array();
+    tiled_product(t.transpose(), nd, h);
     h -= m * p;
-    out.dmean_dmu.row(ai) = g.transpose();
-    out.dmean_dsigma.row(ai) = 0.5 * Eigen::Map<const Vector>(h.data(), d * d).transpose();
-    out.dcross_dmu.middleRows(ai * d, d).noalias() = s.sigma * h;
+    detail::write_mean_derivatives(out, ai, s.sigma, g, h);
     cross_covariance_derivatives(out, a);
   }
 }
 
 void SeArdMomentMatcher::cross_covariance_derivatives(MomentMatch& out, std::size_t a) const {
   MomentMatchScratch& s = out.scratch;
-  const Eigen::Index d = inputs_.cols();
+  const Eigen::Index d = input_dim_;
   const auto ai = static_cast<Eigen::Index>(a);
   const Matrix& t = s.solved[a];
+
   const Matrix& p = s.precision[a];
   const Matrix& p_lambda = s.precision_lambda[a];
   const Vector& g = s.gradient[a];
 
   // third(k, i + D j) = sum_n gamma_n s_nk t_ni t_nj with s_n = Sigma t_n: one (D x N) (N x D^2) GEMM.
-  for (Eigen::Index j = 0; j < d; ++j)
-    for (Eigen::Index i = 0; i < d; ++i) s.outer.col(i + d * j) = t.col(i).cwiseProduct(t.col(j));
-  tiled_product(t, s.sigma, s.nd);
-  s.nd.array().colwise() *= s.weighted[a].array();
-  tiled_product(s.nd.transpose(), s.outer, s.third);
+  auto sigma_t = view(s.nd, t.rows(), d);
+  tiled_product(t, s.sigma, sigma_t);
+  detail::weighted_third_moment(t, sigma_t, s.weighted[a], view(s.outer, t.rows(), d * d), s.third);
 
   // Symmetrised: 1/2 third_k - 1/2 C_ka P + 1/2 ((P Lambda)_:k g' + g (P Lambda)_:k').
   for (Eigen::Index k = 0; k < d; ++k) {

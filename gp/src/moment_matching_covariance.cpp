@@ -15,7 +15,8 @@
 ///              - 1/2 nu_i' W_a nu_i - 1/2 nu_j' W_b nu_j + 1/2 z_ij' Xi z_ij,   z_ij = a_i + b_j,
 ///   log q_ai = log sf_a^2 - 1/2 log|Rt_a| - 1/2 nu_i' W_a nu_i + c_ai,   c_ai = 1/2 nu_i' B_a nu_i,
 ///
-/// with a_i = W_a nu_i, b_j = W_b nu_j (-1/2 nu' P_a nu = -1/2 nu' W_a nu + 1/2 nu' B_a nu).
+/// with a_i = W_a nu_ai, b_j = W_b nu_bj (-1/2 nu' P_a nu = -1/2 nu' W_a nu + 1/2 nu' B_a nu). Rows i
+/// run over output a's N_a centres, columns j over output b's N_b (the same set for the exact GP).
 ///
 /// Centred form. Q_ij = q_ai q_bj exp(D_ij), where the kernel terms -1/2 nu' W nu and log sf^2 cancel
 /// exactly and are never formed:
@@ -57,10 +58,11 @@
 ///
 /// Summing the first part with r = Omega 1, c = Omega' 1:
 ///
-///   dS_ab/dmu    = G (W_a V' r + W_b V' c) + M_b Delta_a u_a + M_a Delta_b u_b,
+///   dS_ab/dmu    = G (W_a V_a' r + W_b V_b' c) + M_b Delta_a u_a + M_a Delta_b u_b,
 ///   dS_ab/dSigma = -1/2 (1'r) P + 1/2 G J G' - 1/2 M_a M_b (B_a + B_b - B)
 ///                  + 1/2 M_b (Delta_a E_a G' + G_a E_a Delta_a') + 1/2 M_a (Delta_b E_b G' + G_b E_b Delta_b'),
-///   J = W_a V' diag(r) V W_a + W_b V' diag(c) V W_b + W_a (V' Omega V) W_b + W_b (V' Omega' V) W_a
+///   J = W_a V_a' diag(r) V_a W_a + W_b V_b' diag(c) V_b W_b + W_a (V_a' Omega V_b) W_b
+///       + W_b (V_b' Omega' V_a) W_a
 ///       + u_a u_b' + u_b u_a'.
 ///
 /// (The uncentred form used Omega = diag(beta_a) Q diag(beta_b) - delta_ab Kinv .* Q and subtracted
@@ -78,6 +80,7 @@
 namespace gpilqg::gp {
 
 using detail::tiled_product;
+using detail::view;
 
 namespace {
 
@@ -89,10 +92,7 @@ constexpr double kMaxLogRatio = 700.0;
 
 void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives) const {
   MomentMatchScratch& s = out.scratch;
-  const Eigen::Index n = inputs_.rows();
-  const Eigen::Index d = inputs_.cols();
-  const auto e = static_cast<Eigen::Index>(outputs_.size());
-  const Matrix& v = s.centred;
+  const Eigen::Index d = input_dim_;
 
   for (std::size_t a = 0; a < outputs_.size(); ++a) {
     for (std::size_t b = a; b < outputs_.size(); ++b) {
@@ -103,6 +103,18 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives
       const bool same = a == b;
       const Vector& gamma_a = s.weighted[a];
       const Vector& gamma_b = s.weighted[b];
+      // Output a's centres index the rows (N_a), output b's the columns (N_b).
+      const Matrix& v_a = s.centred[a];
+      const Matrix& v_b = s.centred[b];
+      const Eigen::Index n_a = v_a.rows();
+      const Eigen::Index n_b = v_b.rows();
+      auto nd_a = view(s.nd, n_a, d);
+      auto nd_b = view(s.nd2, n_b, d);
+      auto nn = view(s.nn, n_a, n_b);
+      auto row_term = view(s.row_term, n_a);
+      auto col_term = view(s.col_term, n_b);
+      auto row_sums = view(s.row_sums, n_a);
+      auto col_sums = view(s.col_sums, n_b);
 
       s.sqrt_w_pair = (oa.inverse_squared_lengthscales + ob.inverse_squared_lengthscales).cwiseSqrt();
       s.lengthscale_pair = s.sqrt_w_pair.cwiseInverse();
@@ -116,21 +128,21 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives
       // D = log(Q / (q_a q_b')): row and column parts, then the cross term, all O(Sigma).
       const Matrix& scaled_a = s.scaled[a];
       const Matrix& scaled_b = s.scaled[b];
-      tiled_product(scaled_a, s.xi, s.nd);
-      s.row_term = 0.5 * s.nd.cwiseProduct(scaled_a).rowwise().sum() - s.log_shift[a];
+      tiled_product(scaled_a, s.xi, nd_a);
+      row_term = 0.5 * nd_a.cwiseProduct(scaled_a).rowwise().sum() - s.log_shift[a];
       if (same) {
-        s.col_term = s.row_term;
+        col_term = row_term;
       } else {
-        tiled_product(scaled_b, s.xi, s.nd2);
-        s.col_term = 0.5 * s.nd2.cwiseProduct(scaled_b).rowwise().sum() - s.log_shift[b];
+        tiled_product(scaled_b, s.xi, nd_b);
+        col_term = 0.5 * nd_b.cwiseProduct(scaled_b).rowwise().sum() - s.log_shift[b];
       }
-      s.row_term.array() += -0.5 * (log_det - s.log_det(ai) - s.log_det(bi));
-      tiled_product(s.nd, scaled_b.transpose(), s.nn);
+      row_term.array() += -0.5 * (log_det - s.log_det(ai) - s.log_det(bi));
+      tiled_product(nd_a, scaled_b.transpose(), nn);
       const auto centred_exp = [&](Eigen::Index j, Eigen::Index start) {
-        const Eigen::Index len = n - start;
-        auto col = s.nn.col(j).tail(len);
+        const Eigen::Index len = n_a - start;
+        auto col = nn.col(j).tail(len);
         for (Eigen::Index i = 0; i < len; ++i)
-          col(i) = std::expm1(std::min(col(i) + s.row_term(start + i) + s.col_term(j), kMaxLogRatio));
+          col(i) = std::expm1(std::min(col(i) + row_term(start + i) + col_term(j), kMaxLogRatio));
       };
 
       const double ma = out.mean(ai);
@@ -138,43 +150,44 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives
       double total = 0.0;  // 1' Omega 1
       if (same) {
         // expm1(D) is symmetric: the lower triangle (the exponentials dominate the cost), mirrored.
+        const Eigen::Index n = n_a;
         for (Eigen::Index j = 0; j < n; ++j) centred_exp(j, j);
-        for (Eigen::Index j = 0; j + 1 < n; ++j) s.nn.row(j).tail(n - j - 1) = s.nn.col(j).tail(n - j - 1).transpose();
+        for (Eigen::Index j = 0; j + 1 < n; ++j) nn.row(j).tail(n - j - 1) = nn.col(j).tail(n - j - 1).transpose();
         const Vector& q = s.kernel_mean[a];
         double centred = 0.0;      // gamma' expm1(D) gamma = beta' (Q - q q') beta
         double kinv_centred = 0.0;  // <Kinv, Q - q q'>
         for (Eigen::Index j = 0; j < n; ++j) {
-          const auto col = s.nn.col(j);
+          const auto col = nn.col(j);
           centred += gamma_a(j) * col.dot(gamma_a);
           kinv_centred += q(j) * col.cwiseProduct(oa.Kinv.col(j)).dot(q);
         }
-        s.row_sums.noalias() = oa.Kinv * q;
-        const double expected_variance = oa.signal_variance - q.dot(s.row_sums) - kinv_centred;
+        row_sums.noalias() = oa.Kinv * q;
+        const double expected_variance = oa.signal_variance - q.dot(row_sums) - kinv_centred;
         const bool clamped = !(expected_variance > 0.0);
         const double sab = centred + (clamped ? 0.0 : expected_variance);
         out.covariance(ai, ai) = sab;
         if (!derivatives) continue;
         // Omega = gamma gamma' .* expm1(D) - Kinv .* Q (the second term dropped when clamped).
         if (clamped) {
-          for (Eigen::Index j = 0; j < n; ++j) s.nn.col(j) = s.nn.col(j).cwiseProduct(gamma_a) * gamma_a(j);
+          for (Eigen::Index j = 0; j < n; ++j) nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_a(j);
         } else {
           for (Eigen::Index j = 0; j < n; ++j)
-            s.nn.col(j) = s.nn.col(j).cwiseProduct(gamma_a) * gamma_a(j) -
-                          (s.nn.col(j).array() + 1.0).matrix().cwiseProduct(oa.Kinv.col(j)).cwiseProduct(q) * q(j);
+            nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_a(j) -
+                        (nn.col(j).array() + 1.0).matrix().cwiseProduct(oa.Kinv.col(j)).cwiseProduct(q) * q(j);
         }
-        total = s.nn.sum();
+        total = nn.sum();
       } else {
-        for (Eigen::Index j = 0; j < n; ++j) centred_exp(j, 0);
+        for (Eigen::Index j = 0; j < n_b; ++j) centred_exp(j, 0);
         // Omega = gamma_a gamma_b' .* expm1(D) = diag(beta_a) (Q - q_a q_b') diag(beta_b).
-        for (Eigen::Index j = 0; j < n; ++j) s.nn.col(j) = s.nn.col(j).cwiseProduct(gamma_a) * gamma_b(j);
-        total = s.nn.sum();
+        for (Eigen::Index j = 0; j < n_b; ++j) nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_b(j);
+        total = nn.sum();
         out.covariance(ai, bi) = total;
         out.covariance(bi, ai) = total;
         if (!derivatives) continue;
       }
 
-      s.row_sums = s.nn.rowwise().sum();
-      s.col_sums = s.nn.colwise().sum().transpose();
+      row_sums = nn.rowwise().sum();
+      col_sums = nn.colwise().sum().transpose();
       s.gain.noalias() = s.sqrt_w_pair.asDiagonal() * s.rt_inverse * s.lengthscale_pair.asDiagonal();
       s.pair_precision.noalias() = s.sqrt_w_pair.asDiagonal() * s.rt_inverse * s.sqrt_w_pair.asDiagonal();
       // Delta_a = G - G_a = (P_a - P) Sigma, exactly 0 at Sigma = 0.
@@ -185,30 +198,28 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives
       const Vector& u_a = s.scaled_sum[a];
       const Vector& u_b = s.scaled_sum[b];
 
-      // d/dmu = G (W_a V' r + W_b V' c) + M_b Delta_a u_a + M_a Delta_b u_b
-      s.dvec.noalias() = v.transpose() * s.row_sums;
-      s.dvec2.noalias() = v.transpose() * s.col_sums;
+      // d/dmu = G (W_a V_a' r + W_b V_b' c) + M_b Delta_a u_a + M_a Delta_b u_b
+      s.dvec.noalias() = v_a.transpose() * row_sums;
+      s.dvec2.noalias() = v_b.transpose() * col_sums;
       s.dvec = oa.inverse_squared_lengthscales.cwiseProduct(s.dvec) +
                ob.inverse_squared_lengthscales.cwiseProduct(s.dvec2);
       s.dvec2.noalias() = s.gain * s.dvec;
       s.dvec2.noalias() += mb * (s.delta_a * u_a);
       s.dvec2.noalias() += ma * (s.delta_b * u_b);
-      out.dcovariance_dmu.row(ai + e * bi) = s.dvec2.transpose();
-      out.dcovariance_dmu.row(bi + e * ai) = s.dvec2.transpose();
 
       // d/dSigma: J, then -1/2 (1'r) P + 1/2 G J G' + the rank-one correction (file comment).
-      s.nd = v;
-      s.nd.array().colwise() *= s.row_sums.array();
-      tiled_product(v.transpose(), s.nd, s.dd);
+      nd_a = v_a;
+      nd_a.array().colwise() *= row_sums.array();
+      tiled_product(v_a.transpose(), nd_a, s.dd);
       s.inner.noalias() = oa.inverse_squared_lengthscales.asDiagonal() * s.dd *
                           oa.inverse_squared_lengthscales.asDiagonal();
-      s.nd = v;
-      s.nd.array().colwise() *= s.col_sums.array();
-      tiled_product(v.transpose(), s.nd, s.dd);
+      nd_b = v_b;
+      nd_b.array().colwise() *= col_sums.array();
+      tiled_product(v_b.transpose(), nd_b, s.dd);
       s.inner.noalias() += ob.inverse_squared_lengthscales.asDiagonal() * s.dd *
                            ob.inverse_squared_lengthscales.asDiagonal();
-      tiled_product(s.nn, v, s.nd2);
-      tiled_product(v.transpose(), s.nd2, s.dd);
+      tiled_product(nn, v_b, nd_a);  // Omega V_b (N_a x D)
+      tiled_product(v_a.transpose(), nd_a, s.dd);
       s.dd2.noalias() = oa.inverse_squared_lengthscales.asDiagonal() * s.dd *
                         ob.inverse_squared_lengthscales.asDiagonal();
       s.inner += s.dd2 + s.dd2.transpose();
@@ -228,11 +239,7 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives
       s.dd.noalias() += (0.5 * ma) * (s.dd2 * s.gain.transpose());
       s.dd2.noalias() = s.precision_lambda[b] * s.scaled_scatter[b];
       s.dd.noalias() += (0.5 * ma) * (s.dd2 * s.delta_b.transpose());
-      for (Eigen::Index j = 0; j < d; ++j)
-        for (Eigen::Index i = 0; i < j; ++i) s.dd(i, j) = s.dd(j, i) = 0.5 * (s.dd(i, j) + s.dd(j, i));
-      const auto flat = Eigen::Map<const Vector>(s.dd.data(), d * d).transpose();
-      out.dcovariance_dsigma.row(ai + e * bi) = flat;
-      out.dcovariance_dsigma.row(bi + e * ai) = flat;
+      detail::write_covariance_derivatives(out, ai, bi, s.dvec2, s.dd);
     }
   }
 }

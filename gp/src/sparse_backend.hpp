@@ -64,6 +64,8 @@ class FittedSparseGp final : public FittedGp {
   const TrainingSet& training_set() const override { return data_; }
   const Vector& parameters() const override { return parameters_; }
   const ConditioningReport& conditioning() const override { return report_; }
+  /// The cached posterior (fitc_posterior / ssgp_posterior hand it out).
+  const Predictor& predictor() const { return predictor_; }
 
   void predict(const VectorCRef& z, Prediction& out, const PredictionRequest& request) const override {
     const int D = predictor_.input_dim();
@@ -94,6 +96,13 @@ class FittedSparseGp final : public FittedGp {
   Predictor predictor_;
   ConditioningReport report_;
 };
+
+/// The cached predictor of `model` when it is a FittedSparseGp<Traits>, else nullptr.
+template <class Traits>
+const typename Traits::Predictor* posterior_of(const FittedGp& model) {
+  const auto* fitted = dynamic_cast<const FittedSparseGp<Traits>*>(&model);
+  return fitted != nullptr ? &fitted->predictor() : nullptr;
+}
 
 /// GpBackend::condition for a sparse backend: checks the data, the jitter schedule, the size
 /// (Layout::from_size) and finiteness of the parameters, then conditions through the likelihood that

@@ -72,6 +72,10 @@ std::pair<Vector, ParameterBounds> ssgp_start(const SsgpLikelihood& likelihood, 
 
 }  // namespace
 
+const SsgpPredictor* ssgp_posterior(const FittedGp& model) {
+  return sparse_detail::posterior_of<SsgpTraits>(model);
+}
+
 SsgpBackend::SsgpBackend(SsgpOptions options) : options_(std::move(options)) { options_.validate(); }
 
 std::unique_ptr<MarginalLikelihoodObjective> SsgpBackend::objective(const TrainingSet& data,

@@ -100,5 +100,17 @@ transfer = true
   EXPECT_THROW(default_run_config_text("pendulum"), InputError);
 }
 
+TEST(RunConfig, PddpBackendIsOneWithExactMomentMatching) {
+  EXPECT_EQ(parse_run_config("cartpole", "", "").pddp_backend, "exact");
+  EXPECT_EQ(parse_run_config("quadrotor", "", "").pddp_backend, "exact");
+  EXPECT_EQ(parse_run_config("cartpole", "[pddp]\nbackend = \"ssgp\"\n", "user.toml").pddp_backend, "ssgp");
+  for (const char* bad : {"compact", "fitcc"}) {
+    const std::string error = error_of("cartpole", std::string("[pddp]\nbackend = \"") + bad + "\"\n");
+    EXPECT_NE(error.find("user.toml:line 2: field 'pddp.backend'"), std::string::npos) << error;
+    EXPECT_NE(error.find("the backends that can are exact, fitc, ssgp"), std::string::npos) << error;
+  }
+  EXPECT_NE(error_of("cartpole", "[pddp]\nbackend = \"compact\"\n").find("Wendland"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace gpilqg

@@ -1,5 +1,5 @@
-/// Practice 1 of DESIGN.md: after a warm-up, prediction and the residual model's step and
-/// uncertainty do not touch the heap. Counted by interposing glibc's malloc in this test program.
+/// Practice 1 of DESIGN.md: after a warm-up, prediction, the residual model's step and uncertainty,
+/// and moment matching (PDDP's belief step) do not touch the heap. Counted by interposing glibc's malloc in this test program.
 
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gp_test_support.hpp"
+#include "moment_matching_checks.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/gp/residual_model.hpp"
@@ -100,6 +101,24 @@ TEST(Allocation, ResidualModelStepAndUncertaintyDoNotAllocateAfterWarmUp) {
     model.uncertainty(x, u, g, true);
   }
   EXPECT_EQ(g_malloc_calls.load() - before, 0);
+}
+
+TEST(Allocation, MomentMatchingDoesNotAllocateAfterWarmUp) {
+  SKIP_WITHOUT_COUNTER();
+  // FITC: per-output centres of different sizes (views into one buffer); SSGP: trigonometric features.
+  for (const FittedOutputs& fits : {fitc_outputs(), ssgp_outputs()}) {
+    const Vector mu = Vector::Constant(3, 0.1);
+    const Matrix sigma = make_sigma(3, 0.3, 1, /*zero_index=*/2);
+    const Matrix wider = 2.0 * sigma;
+    MomentMatch m;
+    fits.matcher->propagate(mu, sigma, m, MomentDerivatives::All);  // warm-up
+    const long before = g_malloc_calls.load();
+    for (int i = 0; i < 5; ++i) {
+      fits.matcher->propagate(mu, wider, m, MomentDerivatives::All);
+      fits.matcher->propagate(mu, sigma, m, MomentDerivatives::None);
+    }
+    EXPECT_EQ(g_malloc_calls.load() - before, 0) << fits.models[0]->backend_name();
+  }
 }
 
 }  // namespace

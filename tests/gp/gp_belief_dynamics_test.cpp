@@ -1,12 +1,22 @@
 // PDDP's GP belief step: its Jacobians against central differences, and the propagated belief against
 // a Monte Carlo estimate of x' = x + f(x, u) with x ~ N(mu, Sigma) and f drawn from the GP posterior.
+// Any backend with exact moment matching serves (fitted_moment_matcher.hpp): fitted with FITC and SSGP
+// on a known smooth system, the step from a point belief is the backend's own prediction; the compact
+// backend is rejected with the reason.
 
 #include <cmath>
+#include <memory>
 #include <random>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "gpilqg/gp/compact.hpp"
+#include "gpilqg/gp/fitc.hpp"
+#include "gpilqg/gp/fitted_moment_matcher.hpp"
 #include "gpilqg/gp/gp_belief_dynamics.hpp"
+#include "gpilqg/gp/ssgp.hpp"
 #include "test_support.hpp"
 
 namespace gpilqg::gp {
@@ -37,8 +47,8 @@ Vector belief(const Vector& mu, const Matrix& Sigma) {
   return v;
 }
 
-TEST(GpBeliefDynamics, JacobiansMatchCentralDifferences) {
-  const GpBeliefDynamics model = make_dynamics();
+/// dv'/dv and dv'/du at a fixed belief (mu, Sigma) and control against central differences with step h.
+void expect_jacobians_match_central_differences(const GpBeliefDynamics& model, double h, const std::string& label) {
   Matrix Sigma(2, 2);
   Sigma << 0.04, 0.01, 0.01, 0.09;
   const Vector v = belief(Vector(Eigen::Vector2d(0.3, -0.2)), Sigma);
@@ -48,8 +58,12 @@ TEST(GpBeliefDynamics, JacobiansMatchCentralDifferences) {
   model.propagate(v, u, next, &jac);
   auto step_v = [&](const Vector& vs) { Vector out(5); model.propagate(vs, u, out); return out; };
   auto step_u = [&](const Vector& us) { Vector out(5); model.propagate(v, us, out); return out; };
-  EXPECT_TRUE(test::matrices_near(jac.dv, test::numeric_jacobian(step_v, v, 1e-6), 1e-7, 1e-6));
-  EXPECT_TRUE(test::matrices_near(jac.du, test::numeric_jacobian(step_u, u, 1e-6), 1e-7, 1e-6));
+  EXPECT_TRUE(test::matrices_near(jac.dv, test::numeric_jacobian(step_v, v, h), 1e-7, 1e-6)) << label;
+  EXPECT_TRUE(test::matrices_near(jac.du, test::numeric_jacobian(step_u, u, h), 1e-7, 1e-6)) << label;
+}
+
+TEST(GpBeliefDynamics, JacobiansMatchCentralDifferences) {
+  expect_jacobians_match_central_differences(make_dynamics(), 1e-6, "exact");
 }
 
 TEST(GpBeliefDynamics, PropagatedBeliefMatchesMonteCarlo) {
@@ -102,6 +116,105 @@ TEST(GpBeliefDynamics, RejectsMismatchedShapes) {
   const GpBeliefDynamics model = make_dynamics();
   Vector out(5);
   EXPECT_THROW(model.propagate(Vector::Zero(4), Vector::Zero(1), out), std::invalid_argument);
+}
+
+// ------------------------------------------------------------------------------------------------
+// Any backend with exact moment matching
+
+/// N = 80 noisy transitions of a damped pendulum, x = [angle, rate], u = torque, dt = 0.05:
+/// inputs z = [x; u] (N x 3) and increments x' - x (N x 2).
+struct PendulumData {
+  Matrix inputs, increments;
+};
+
+PendulumData pendulum_data() {
+  const int N = 80;
+  PendulumData d;
+  d.inputs = test::random_vector(N * kD, -1.5, 1.5, 11).reshaped(N, kD);
+  d.increments.resize(N, kN);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 1e-3);
+  for (int i = 0; i < N; ++i) {
+    const double angle = d.inputs(i, 0), rate = d.inputs(i, 1), torque = d.inputs(i, 2);
+    d.increments(i, 0) = 0.05 * rate + noise(rng);
+    d.increments(i, 1) = 0.05 * (-9.81 * std::sin(angle) - 0.5 * rate + torque) + noise(rng);
+  }
+  return d;
+}
+
+gp::FitOptions quick_fit() {
+  gp::FitOptions fit;
+  fit.restarts = 0;
+  fit.max_evaluations = 60;
+  return fit;
+}
+
+/// Fits the belief dynamics with `backend`, and the same per-output fits again for the backend's own
+/// prediction: from a point belief (Sigma = 0), mu' = mu + m(z) and Sigma' = diag(v(z)), z = [mu; u].
+/// Then the Jacobians against central differences at a nonzero Sigma.
+void expect_belief_step_is_the_prediction(const GpBackend& backend) {
+  const PendulumData data = pendulum_data();
+  const GpBeliefDynamics model = GpBeliefDynamics::fit(kN, kM, 0.05, data.inputs, data.increments, backend, quick_fit());
+  std::vector<std::unique_ptr<FittedGp>> fits;
+  for (int a = 0; a < kN; ++a) fits.push_back(backend.fit(TrainingSet{data.inputs, data.increments.col(a)}, quick_fit()).model);
+  Prediction p;
+  Vector next(5), mu_next;
+  Matrix Sigma_next;
+  for (unsigned trial = 0; trial < 3; ++trial) {
+    const Vector mu = test::random_vector(kN, -1.0, 1.0, 40 + trial);
+    const Vector u = test::random_vector(kM, -1.0, 1.0, 50 + trial);
+    model.propagate(belief(mu, Matrix::Zero(kN, kN)), u, next);
+    unpack_belief(next, kN, mu_next, Sigma_next);
+    Vector z(kD);
+    z << mu, u;
+    for (int a = 0; a < kN; ++a) {
+      fits[static_cast<std::size_t>(a)]->predict(z, p);
+      EXPECT_NEAR(mu_next(a), mu(a) + p.mean, 1e-8) << backend.name() << ": mean " << a << ", trial " << trial;
+      EXPECT_NEAR(Sigma_next(a, a), p.variance, 1e-8) << backend.name() << ": variance " << a << ", trial " << trial;
+    }
+    EXPECT_EQ(Sigma_next(0, 1), 0.0) << backend.name();
+  }
+  // Step 1e-4: the fitted noise is ~1e-3, so FITC's Kinv = Kuu^-1 - (Kuu + Kuf Lambda^-1 Kfu)^-1 is
+  // large and V_a = sf^2 - tr(Kinv Q) carries ~1e-12 of rounding; with h = 1e-6 that is ~3e-6 in a
+  // central difference (checked: the gap scales as 1/h from 1e-6 to 1e-5 and is gone at 1e-4).
+  expect_jacobians_match_central_differences(model, 1e-4, std::string(backend.name()));
+}
+
+TEST(GpBeliefDynamics, FitcServesPddp) {
+  FitcOptions options;
+  options.inducing = 15;
+  expect_belief_step_is_the_prediction(FitcBackend(options));
+}
+
+TEST(GpBeliefDynamics, SsgpServesPddp) {
+  SsgpOptions options;
+  options.frequencies = 15;
+  expect_belief_step_is_the_prediction(SsgpBackend(options));
+}
+
+TEST(GpBeliefDynamics, TheBackendsThatServeAreExactFitcAndSsgp) {
+  EXPECT_EQ(moment_matching_backends(), (std::vector<std::string>{"exact", "fitc", "ssgp"}));
+}
+
+TEST(GpBeliefDynamics, CompactIsRejectedWithTheReason) {
+  const PendulumData data = pendulum_data();
+  const auto expect_reason = [](const auto& f) {
+    try {
+      f();
+      ADD_FAILURE() << "no exception";
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      for (const char* fragment : {"backend 'compact' cannot serve PDDP", "Wendland kernel has no closed-form expectation",
+                                   "the backends that can are exact, fitc, ssgp"})
+        EXPECT_NE(what.find(fragment), std::string::npos) << what;
+    }
+  };
+  const CompactBackend compact;
+  expect_reason([&] { GpBeliefDynamics::fit(kN, kM, 0.05, data.inputs, data.increments, compact, quick_fit()); });
+  gp::FitOptions as_given = quick_fit();
+  as_given.optimise = false;
+  const auto fitted = compact.fit(TrainingSet{data.inputs, data.increments.col(0)}, as_given).model;
+  expect_reason([&] { moment_matcher_for({fitted.get()}); });
 }
 
 }  // namespace

@@ -13,7 +13,8 @@
 ///   [gp]      backend, exact_points, inducing, frequencies, restarts, max_evaluations
 ///   [solver]  max_iterations, tolerance, gradient_tolerance, gp_algorithm ("robust_ilqg"|"ilqg")
 ///   [mpc]     enabled, horizon, first_solve_iterations, iterations_per_step
-///   [pddp]    enabled, max_iterations, own, own_initial_rollouts, own_amplitude (m)
+///   [pddp]    enabled, max_iterations, backend ("exact"|"fitc"|"ssgp"), own, own_initial_rollouts,
+///             own_amplitude (m)
 
 #include <filesystem>
 #include <optional>
@@ -72,6 +73,7 @@ struct RunConfig {
   // [pddp]
   bool pddp = true;
   int pddp_max_iterations = 40;
+  std::string pddp_backend = "exact";  ///< PDDP's GPs (sized by backend_settings): one with exact moment matching
   bool pddp_own = true;
   int pddp_own_initial_rollouts = 3;
   Vector pddp_own_amplitude;

@@ -162,6 +162,10 @@ class FitcPredictor {
   Matrix C_;                ///< M x M, symmetric
 };
 
+/// The posterior of `model` when it is a fitted FITC GP ("fitc"), else nullptr: what moment matching
+/// (moment_matching.hpp, per-output centres) reads. The pointer lives as long as `model`.
+const FitcPredictor* fitc_posterior(const FittedGp& model);
+
 /// How the pseudo-inputs are initialised.
 enum class FitcInitialisation {
   KMeans,        ///< k-means++ seeding (Arthur & Vassilvitskii 2007), then Lloyd iterations

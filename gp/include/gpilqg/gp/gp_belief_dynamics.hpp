@@ -1,9 +1,10 @@
 #pragma once
 /// @file gp_belief_dynamics.hpp
-/// PDDP's learned dynamics (Pan and Theodorou, NIPS 2014): n independent SE-ARD GPs, one per state
-/// dimension, on z = [x; u] -> dx = x' - x, learned from data only (no simulator in the mean). Under a
-/// Gaussian belief x ~ N(mu, Sigma) and a known control u, the input is z ~ N([mu; u], blkdiag(Sigma, 0)),
-/// and exact moment matching (moment_matching.hpp) gives M = E[dx], S = Cov[dx] and C = Cov[z, dx], so
+/// PDDP's learned dynamics (Pan and Theodorou, NIPS 2014): n independent GPs, one per state dimension,
+/// on z = [x; u] -> dx = x' - x, learned from data only (no simulator in the mean). Under a Gaussian
+/// belief x ~ N(mu, Sigma) and a known control u, the input is z ~ N([mu; u], blkdiag(Sigma, 0)), and
+/// exact moment matching (a MomentMatcher, moment_matcher.hpp: the SE-ARD GP of the exact and FITC
+/// backends, or SSGP's trigonometric features) gives M = E[dx], S = Cov[dx] and C = Cov[z, dx], so
 ///
 ///   mu'    = mu + M
 ///   Sigma' = Sigma + S + C_x + C_x'        (C_x = Cov[x, dx], the first n rows of C)
@@ -11,30 +12,32 @@
 /// a deterministic belief step v' = F(v, u) with analytic Jacobians by the chain rule through M, S and
 /// C (the packed-covariance convention of core/belief.hpp).
 
+#include <memory>
 #include <vector>
 
 #include "gpilqg/core/belief.hpp"
 #include "gpilqg/gp/backend.hpp"
-#include "gpilqg/gp/moment_matching.hpp"
+#include "gpilqg/gp/moment_matcher.hpp"
 
 namespace gpilqg::gp {
 
 class GpBeliefDynamics final : public BeliefStepModel {
  public:
   /// `matcher` must have n outputs (the increments of x) over D = n + m inputs. Throws
-  /// std::invalid_argument otherwise.
-  GpBeliefDynamics(int n, int m, double dt, SeArdMomentMatcher matcher);
+  /// std::invalid_argument otherwise (or when it is null).
+  GpBeliefDynamics(int n, int m, double dt, std::shared_ptr<const MomentMatcher> matcher);
 
   /// Conditions the n GPs on shared inputs (N x (n+m), rows z = [x; u]) and increments (N x n, rows
   /// x' - x), with per-output hyperparameters [log l (n+m); log sf; log sn].
   static GpBeliefDynamics condition(int n, int m, double dt, const Matrix& inputs, const Matrix& increments,
                                     const std::vector<Vector>& hyperparameters);
 
-  /// Fits the n GPs by maximum likelihood with `backend`, one output at a time, then conditions the
-  /// moment matcher on the points the fits used. Exact moment matching needs the exact SE-ARD
-  /// predictor on its training points, so the backend must be the exact one ("exact", subsampled or
-  /// not); any other backend is rejected with std::invalid_argument. The outputs share one subsample
-  /// (the same seed for every output). `summaries` receives one fit summary per output when not null.
+  /// Fits the n GPs by maximum likelihood with `backend`, one output at a time, then builds the
+  /// moment matcher of the fitted models (moment_matcher_for, fitted_moment_matcher.hpp): "exact"
+  /// (the outputs share one subsample: the same seed for every output), "fitc" (each output its own
+  /// pseudo-inputs) or "ssgp" (each output its own frequencies). Any other backend ("compact": the
+  /// Wendland kernel has no closed-form Gaussian expectation) is rejected with std::invalid_argument
+  /// before anything is fitted. `summaries` receives one fit summary per output when not null.
   static GpBeliefDynamics fit(int n, int m, double dt, const Matrix& inputs, const Matrix& increments,
                               const GpBackend& backend, const FitOptions& options = {},
                               std::vector<FitSummary>* summaries = nullptr);
@@ -45,12 +48,12 @@ class GpBeliefDynamics final : public BeliefStepModel {
   void propagate(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
                  BeliefJacobians* jacobians = nullptr) const override;
 
-  const SeArdMomentMatcher& matcher() const { return matcher_; }
+  const MomentMatcher& matcher() const { return *matcher_; }
 
  private:
   int n_, m_;
   double dt_;
-  SeArdMomentMatcher matcher_;
+  std::shared_ptr<const MomentMatcher> matcher_;  ///< immutable, shared by copies of this model
 };
 
 }  // namespace gpilqg::gp

@@ -114,6 +114,8 @@ class SsgpPredictor {
   /// The scaled frequencies S = W ./ l' (m x D).
   const Matrix& frequency_matrix() const { return S_; }
   const Vector& alpha() const { return alpha_; }
+  /// C = sn2 A^-1 (2m x 2m, symmetric): s2(x) = phi(x)' C phi(x).
+  const Matrix& variance_matrix() const { return C_; }
 
   /// Latent mean at x (D entries) and, for each non-null pointer, the variance, d mean / dx and
   /// d variance / dx (D doubles each). Scratch owned by the caller (no allocation): phi receives the
@@ -127,6 +129,10 @@ class SsgpPredictor {
   Vector alpha_;  ///< 2m
   Matrix C_;      ///< 2m x 2m, symmetric
 };
+
+/// The posterior of `model` when it is a fitted SSGP ("ssgp"), else nullptr: what moment matching
+/// (ssgp_moment_matching.hpp) reads. The pointer lives as long as `model`.
+const SsgpPredictor* ssgp_posterior(const FittedGp& model);
 
 /// Options of the SSGP backend.
 struct SsgpOptions {
