@@ -24,6 +24,9 @@
 // column d, sf = std of the output's increments, sn = 0.01 sf (bench/system_samples.hpp); FITC and SSGP
 // are conditioned at them with their pseudo-inputs / spectral points as above (GpBackend::condition).
 //
+// The *_2_threads variants lend the belief step a second thread (GpBeliefDynamics::set_threads: the
+// exact GP's output pairs are shared out); they report wall time.
+//
 // Run e.g. build/bench/gpilqg_pddp_bench --benchmark_min_time=0.2
 
 #include <cmath>
@@ -151,8 +154,10 @@ Vector typical_belief(const PddpTask& task) {
   return v;
 }
 
-void BM_BeliefStep(benchmark::State& state, const char* system, const char* backend, bool with_jacobians) {
+void BM_BeliefStep(benchmark::State& state, const char* system, const char* backend, bool with_jacobians,
+                   int threads = 1) {
   const PddpTask task = make_task(system, backend);
+  task.dynamics->set_threads(threads);
   const Vector v = typical_belief(task);
   Vector v_next(v.size());
   BeliefJacobians jacobians;
@@ -166,9 +171,10 @@ void BM_BeliefStep(benchmark::State& state, const char* system, const char* back
   state.counters["belief_dim"] = static_cast<double>(v.size());
 }
 
-void BM_PddpIteration(benchmark::State& state, const char* system, const char* backend) {
+void BM_PddpIteration(benchmark::State& state, const char* system, const char* backend, int threads = 1) {
   const int T = static_cast<int>(state.range(0));
   const PddpTask task = make_task(system, backend);
+  task.dynamics->set_threads(threads);
   const auto cost = make_cost(task, T);
   const int n = static_cast<int>(task.x0.size());
   const PddpProblem problem{task.dynamics.get(), cost.get(), task.x0, Matrix::Zero(n, n), T, {}, {}};
@@ -194,6 +200,11 @@ BENCHMARK_CAPTURE(BM_BeliefStep, quadrotor, "quadrotor", "exact", false)->Unit(b
 BENCHMARK_CAPTURE(BM_BeliefStep, quadrotor_jacobians, "quadrotor", "exact", true)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_BeliefStep, cartpole_fitc, "cartpole", "fitc", false)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_BeliefStep, cartpole_jacobians_fitc, "cartpole", "fitc", true)->Unit(benchmark::kMillisecond);
+// The same with two threads (MomentMatch::threads; wall time, the figure that counts here).
+BENCHMARK_CAPTURE(BM_BeliefStep, cartpole_2_threads, "cartpole", "exact", false, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_BeliefStep, cartpole_jacobians_2_threads, "cartpole", "exact", true, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_BeliefStep, quadrotor_2_threads, "quadrotor", "exact", false, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_BeliefStep, quadrotor_jacobians_2_threads, "quadrotor", "exact", true, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_BeliefStep, quadrotor_fitc, "quadrotor", "fitc", false)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_BeliefStep, quadrotor_jacobians_fitc, "quadrotor", "fitc", true)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_BeliefStep, cartpole_ssgp, "cartpole", "ssgp", false)->Unit(benchmark::kMillisecond);
@@ -202,6 +213,7 @@ BENCHMARK_CAPTURE(BM_BeliefStep, quadrotor_ssgp, "quadrotor", "ssgp", false)->Un
 BENCHMARK_CAPTURE(BM_BeliefStep, quadrotor_jacobians_ssgp, "quadrotor", "ssgp", true)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PddpIteration, cartpole, "cartpole", "exact")->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PddpIteration, quadrotor, "quadrotor", "exact")->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_PddpIteration, cartpole_2_threads, "cartpole", "exact", 2)->Arg(50)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_PddpIteration, cartpole_fitc, "cartpole", "fitc")->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PddpIteration, quadrotor_fitc, "quadrotor", "fitc")->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PddpIteration, cartpole_ssgp, "cartpole", "ssgp")->Arg(50)->Unit(benchmark::kMillisecond);

@@ -7,12 +7,16 @@
 #include <fmt/format.h>
 
 #include "gpilqg/control/belief_space.hpp"
-#include "gpilqg/gp/exact_gp.hpp"
 #include "gpilqg/gp/gp_belief_dynamics.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 
 namespace gpilqg {
 namespace {
+
+/// Threads for the work inside one algorithm's iteration: the residual GP's outputs are fitted
+/// concurrently, and PDDP's belief step shares its output pairs (the results do not depend on it).
+/// The machine the README's figures come from has 2 cores.
+constexpr int kThreads = 2;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -174,7 +178,7 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     const auto last = previous != nullptr ? std::dynamic_pointer_cast<const gp::ResidualModel>(previous->model) : nullptr;
     gp::ResidualModelOptions options;
     options.fit = fit_options(c, seed, name, data.size());
-    options.threads = 2;
+    options.threads = kThreads;
     auto model = std::make_shared<const gp::ResidualModel>(gp::ResidualModel::fit(
         c.models.simulator, all, backend, options, nullptr, last ? &validation : nullptr, last.get()));
     record.fit_seconds = seconds_since(start);
@@ -198,8 +202,9 @@ DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uin
     inputs << data.x, data.u;
     const Matrix increments = data.x_next - data.x;
     const auto backend = gp::make_backend(c.config.pddp_backend, c.config.backend_settings);
-    const auto dynamics = gp::GpBeliefDynamics::fit(n, m, c.config.dt, inputs, increments, *backend,
-                                                    fit_options(c, seed, name, data.size()));
+    auto dynamics = gp::GpBeliefDynamics::fit(n, m, c.config.dt, inputs, increments, *backend,
+                                              fit_options(c, seed, name, data.size()));
+    dynamics.set_threads(kThreads);
     record.fit_seconds = seconds_since(start);
 
     PddpProblem problem;

@@ -20,6 +20,11 @@ GpBeliefDynamics::GpBeliefDynamics(int n, int m, double dt, std::shared_ptr<cons
                                 std::to_string(n) + " over " + std::to_string(n + m) + " (z = [x; u] -> dx)");
 }
 
+void GpBeliefDynamics::set_threads(int threads) {
+  if (threads < 1) throw std::invalid_argument("GpBeliefDynamics::set_threads: threads is " + std::to_string(threads) + ", need >= 1");
+  threads_ = threads;
+}
+
 GpBeliefDynamics GpBeliefDynamics::condition(int n, int m, double dt, const Matrix& inputs, const Matrix& increments,
                                              const std::vector<Vector>& hyperparameters) {
   const int D = n + m;
@@ -67,6 +72,7 @@ void GpBeliefDynamics::propagate(const VectorCRef& v, const VectorCRef& u, Vecto
   thread_local Vector mu, mu_z;
   thread_local Matrix Sigma, Sigma_z, Sigma_next;
   thread_local MomentMatch mm;
+  mm.threads = threads_;
   unpack_belief(v, n, mu, Sigma);
   mu_z.resize(D);
   mu_z.head(n) = mu;

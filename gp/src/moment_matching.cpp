@@ -27,6 +27,7 @@
 #include "gpilqg/gp/moment_matching.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -165,12 +166,19 @@ void SeArdMomentMatcher::build(std::vector<Matrix> centres, std::vector<SeArdOut
     max_centres_ = std::max(max_centres_, n);
     outputs_.push_back(std::move(o));
   }
+  for (std::size_t a = 0; a < outputs_.size(); ++a)
+    for (std::size_t b = a; b < outputs_.size(); ++b) pair_order_.emplace_back(a, b);
+  const auto work = [this](const std::pair<std::size_t, std::size_t>& p) {
+    return static_cast<double>(outputs_[p.first].centres.rows()) * static_cast<double>(outputs_[p.second].centres.rows());
+  };
+  std::stable_sort(pair_order_.begin(), pair_order_.end(), [&](const auto& x, const auto& y) { return work(x) > work(y); });
+  for (const auto& p : pair_order_) pair_work_ += work(p);
 }
 
 // ------------------------------------------------------------------------------------------------
 // Propagation
 
-void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives) const {
+void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives, int workers) const {
   const Eigen::Index n = max_centres_;
   const Eigen::Index d = input_dim_;
   const Eigen::Index e = static_cast<Eigen::Index>(outputs_.size());
@@ -197,109 +205,131 @@ void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives) const {
   size_all(s.shrink, false, d, d);
   size_all_vectors(s.gradient, false, d);
   s.log_det.resize(e);
-  for (Matrix* m : {&s.rt, &s.rt_inverse, &s.xi, &s.gain, &s.pair_precision, &s.dd, &s.dd2, &s.inner})
-    m->resize(d, d);
-  s.nd.resize(n, d);
-  s.nd2.resize(n, d);
-  for (Vector* v : {&s.row_term, &s.col_term, &s.row_sums, &s.col_sums}) v->resize(n);
-  s.nn.resize(n, n);
-  for (Vector* v : {&s.sqrt_w_pair, &s.lengthscale_pair, &s.dvec, &s.dvec2}) v->resize(d);
+  s.workers.resize(static_cast<std::size_t>(std::max(workers, 1)));
+  for (MomentMatchWorkerScratch& w : s.workers) {
+    for (Matrix* m : {&w.rt, &w.rt_inverse, &w.xi, &w.gain, &w.pair_precision, &w.dd, &w.dd2, &w.inner})
+      m->resize(d, d);
+    w.nd.resize(n, d);
+    w.nd2.resize(n, d);
+    for (Vector* v : {&w.row_term, &w.col_term, &w.row_sums, &w.col_sums}) v->resize(n);
+    w.nn.resize(n, n);
+    for (Vector* v : {&w.sqrt_w_pair, &w.lengthscale_pair, &w.dvec, &w.dvec2}) v->resize(d);
+    if (derivatives) {
+      w.outer.resize(n, d * d);
+      w.third.resize(d, d * d);
+      for (Matrix* m : {&w.pair_shrink, &w.delta_a, &w.delta_b}) m->resize(d, d);
+    }
+  }
   if (derivatives) {
-    s.outer.resize(n, d * d);
-    s.third.resize(d, d * d);
     size_all_vectors(s.scaled_sum, false, d);
     size_all(s.scaled_scatter, false, d, d);
-    for (Matrix* m : {&s.pair_shrink, &s.delta_a, &s.delta_b}) m->resize(d, d);
   }
 }
 
-double SeArdMomentMatcher::factor_scaled(MomentMatchScratch& s, const Vector& sqrt_w, std::size_t a,
-                                         std::size_t b) const {
-  s.rt.noalias() = sqrt_w.asDiagonal() * s.sigma * sqrt_w.asDiagonal();
-  s.rt.diagonal().array() += 1.0;
-  s.llt.compute(s.rt);
-  const auto diagonal = s.llt.matrixLLT().diagonal();
-  if (s.llt.info() != Eigen::Success || !diagonal.allFinite() || !(diagonal.array() > 0.0).all()) {
+double SeArdMomentMatcher::factor_scaled(const Matrix& sigma, MomentMatchWorkerScratch& w, const Vector& sqrt_w,
+                                         std::size_t a, std::size_t b) const {
+  w.rt.noalias() = sqrt_w.asDiagonal() * sigma * sqrt_w.asDiagonal();
+  w.rt.diagonal().array() += 1.0;
+  w.llt.compute(w.rt);
+  const auto diagonal = w.llt.matrixLLT().diagonal();
+  if (w.llt.info() != Eigen::Success || !diagonal.allFinite() || !(diagonal.array() > 0.0).all()) {
     const std::string what = a == b ? "output " + std::to_string(a)
                                     : "outputs " + std::to_string(a) + " and " + std::to_string(b);
     throw std::invalid_argument(
         "SeArdMomentMatcher::propagate: Sigma is too far from positive semidefinite: "
         "W^1/2 Sigma W^1/2 + I is not positive definite for " + what);
   }
-  s.rt_inverse.setIdentity();
-  s.llt.solveInPlace(s.rt_inverse);
+  w.rt_inverse.setIdentity();
+  w.llt.solveInPlace(w.rt_inverse);
   return 2.0 * diagonal.array().log().sum();
+}
+
+int SeArdMomentMatcher::workers_for(int threads) const {
+  if (threads <= 1 || pair_work_ < kParallelPairWork) return 1;
+  return std::min(threads, static_cast<int>(pair_order_.size()));
 }
 
 void SeArdMomentMatcher::evaluate(const VectorCRef& mu, const MatrixCRef& sigma, MomentMatch& out,
                                   bool derivatives) const {
-  prepare(out, derivatives);
+  const int workers = workers_for(out.threads);
+  prepare(out, derivatives, workers);
   MomentMatchScratch& s = out.scratch;
   s.sigma = 0.5 * (sigma + sigma.transpose());
-  for (std::size_t a = 0; a < outputs_.size(); ++a) s.centred[a] = outputs_[a].centres.rowwise() - mu.transpose();
-  propagate_mean(out, derivatives);
-  propagate_covariance(out, derivatives);
+  const auto e = static_cast<int>(outputs_.size());
+  // The outputs, then the pairs of outputs (largest first), dealt out to the workers; every output
+  // and every pair writes its own entries of `out`, so the results do not depend on the split.
+  out.fork_join.run(workers, [&](int worker, int count) {
+    for (int a = worker; a < e; a += count)
+      propagate_mean(out, static_cast<std::size_t>(a), s.workers[static_cast<std::size_t>(worker)], mu, derivatives);
+  });
+  std::atomic<std::size_t> next_pair{0};
+  out.fork_join.run(workers, [&](int worker, int) {
+    MomentMatchWorkerScratch& w = s.workers[static_cast<std::size_t>(worker)];
+    for (std::size_t p = next_pair++; p < pair_order_.size(); p = next_pair++)
+      propagate_covariance(out, pair_order_[p].first, pair_order_[p].second, w, derivatives);
+  });
 }
 
-void SeArdMomentMatcher::propagate_mean(MomentMatch& out, bool derivatives) const {
+void SeArdMomentMatcher::propagate_mean(MomentMatch& out, std::size_t a, MomentMatchWorkerScratch& w,
+                                        const VectorCRef& mu, bool derivatives) const {
   MomentMatchScratch& s = out.scratch;
   const Eigen::Index d = input_dim_;
-  for (std::size_t a = 0; a < outputs_.size(); ++a) {
-    const OutputData& o = outputs_[a];
-    const auto ai = static_cast<Eigen::Index>(a);
-    const Matrix& v = s.centred[a];
-    auto nd = view(s.nd, v.rows(), d);
-    const double log_det = factor_scaled(s, o.sqrt_w, a, a);
-    s.log_det(ai) = log_det;
+  const OutputData& o = outputs_[a];
+  const auto ai = static_cast<Eigen::Index>(a);
+  s.centred[a] = o.centres.rowwise() - mu.transpose();
+  const Matrix& v = s.centred[a];
+  auto nd = view(w.nd, v.rows(), d);
+  const double log_det = factor_scaled(s.sigma, w, o.sqrt_w, a, a);
+  s.log_det(ai) = log_det;
 
-    Matrix& p = s.precision[a];
-    p.noalias() = o.sqrt_w.asDiagonal() * s.rt_inverse * o.sqrt_w.asDiagonal();
-    Matrix& p_lambda = s.precision_lambda[a];  // P Lambda = W^1/2 Rt^-1 Lambda^1/2
-    p_lambda.noalias() = o.sqrt_w.asDiagonal() * s.rt_inverse * o.lengthscales.asDiagonal();
+  Matrix& p = s.precision[a];
+  p.noalias() = o.sqrt_w.asDiagonal() * w.rt_inverse * o.sqrt_w.asDiagonal();
+  Matrix& p_lambda = s.precision_lambda[a];  // P Lambda = W^1/2 Rt^-1 Lambda^1/2
+  p_lambda.noalias() = o.sqrt_w.asDiagonal() * w.rt_inverse * o.lengthscales.asDiagonal();
 
-    Matrix& t = s.solved[a];
-    tiled_product(v, p, t);
-    // gamma_i = beta_i q_i, q_i = exp(log sf^2 - 1/2 log|Rt| - 1/2 nu_i' P nu_i)
-    const double log_c = o.log_signal_variance - 0.5 * log_det;
-    Vector& q = s.kernel_mean[a];
-    q = t.cwiseProduct(v).rowwise().sum();
-    q = (log_c - 0.5 * q.array()).exp().matrix();
-    Vector& gamma = s.weighted[a];
-    gamma = q.cwiseProduct(o.beta);
-    const double m = gamma.sum();
-    out.mean(ai) = m;
-    Vector& g = s.gradient[a];
-    g.noalias() = t.transpose() * gamma;
-    out.cross_covariance.col(ai).noalias() = s.sigma * g;
+  Matrix& t = s.solved[a];
+  tiled_product(v, p, t);
+  // gamma_i = beta_i q_i, q_i = exp(log sf^2 - 1/2 log|Rt| - 1/2 nu_i' P nu_i)
+  const double log_c = o.log_signal_variance - 0.5 * log_det;
+  Vector& q = s.kernel_mean[a];
+  q = t.cwiseProduct(v).rowwise().sum();
+  q = (log_c - 0.5 * q.array()).exp().matrix();
+  Vector& gamma = s.weighted[a];
+  gamma = q.cwiseProduct(o.beta);
+  const double m = gamma.sum();
+  out.mean(ai) = m;
+  Vector& g = s.gradient[a];
+  g.noalias() = t.transpose() * gamma;
+  out.cross_covariance.col(ai).noalias() = s.sigma * g;
 
-    // For the pairs: A_a = V W_a, B_a = W_a - P_a = W_a^1/2 (I - Rt_a^-1) W_a^1/2 formed without the
-    // subtraction W_a - P_a (exactly 0 at Sigma = 0), and c_ai = 1/2 nu_i' B_a nu_i.
-    Matrix& scaled = s.scaled[a];
-    scaled.noalias() = v * o.inverse_squared_lengthscales.asDiagonal();
-    s.dd = -s.rt_inverse;
-    s.dd.diagonal().array() += 1.0;
-    Matrix& shrink = s.shrink[a];
-    shrink.noalias() = o.sqrt_w.asDiagonal() * s.dd * o.sqrt_w.asDiagonal();
-    tiled_product(v, shrink, nd);
-    s.log_shift[a] = 0.5 * nd.cwiseProduct(v).rowwise().sum();
+  // For the pairs: A_a = V W_a, B_a = W_a - P_a = W_a^1/2 (I - Rt_a^-1) W_a^1/2 formed without the
+  // subtraction W_a - P_a (exactly 0 at Sigma = 0), and c_ai = 1/2 nu_i' B_a nu_i.
+  Matrix& scaled = s.scaled[a];
+  scaled.noalias() = v * o.inverse_squared_lengthscales.asDiagonal();
+  w.dd = -w.rt_inverse;
+  w.dd.diagonal().array() += 1.0;
+  Matrix& shrink = s.shrink[a];
+  shrink.noalias() = o.sqrt_w.asDiagonal() * w.dd * o.sqrt_w.asDiagonal();
+  tiled_product(v, shrink, nd);
+  s.log_shift[a] = 0.5 * nd.cwiseProduct(v).rowwise().sum();
 
-    if (!derivatives) continue;
-    // u_a = A_a' gamma_a and E_a = A_a' diag(gamma_a) A_a for the covariance derivatives.
-    s.scaled_sum[a].noalias() = scaled.transpose() * gamma;
-    nd = scaled;
-    nd.array().colwise() *= gamma.array();
-    tiled_product(scaled.transpose(), nd, s.scaled_scatter[a]);
-    Matrix& h = s.hessian[a];
-    nd = t;
-    nd.array().colwise() *= gamma.array();
-    tiled_product(t.transpose(), nd, h);
-    h -= m * p;
-    detail::write_mean_derivatives(out, ai, s.sigma, g, h);
-    cross_covariance_derivatives(out, a);
-  }
+  if (!derivatives) return;
+  // u_a = A_a' gamma_a and E_a = A_a' diag(gamma_a) A_a for the covariance derivatives.
+  s.scaled_sum[a].noalias() = scaled.transpose() * gamma;
+  nd = scaled;
+  nd.array().colwise() *= gamma.array();
+  tiled_product(scaled.transpose(), nd, s.scaled_scatter[a]);
+  Matrix& h = s.hessian[a];
+  nd = t;
+  nd.array().colwise() *= gamma.array();
+  tiled_product(t.transpose(), nd, h);
+  h -= m * p;
+  detail::write_mean_derivatives(out, ai, s.sigma, g, h);
+  cross_covariance_derivatives(out, a, w);
 }
 
-void SeArdMomentMatcher::cross_covariance_derivatives(MomentMatch& out, std::size_t a) const {
+void SeArdMomentMatcher::cross_covariance_derivatives(MomentMatch& out, std::size_t a,
+                                                       MomentMatchWorkerScratch& w) const {
   MomentMatchScratch& s = out.scratch;
   const Eigen::Index d = input_dim_;
   const auto ai = static_cast<Eigen::Index>(a);
@@ -310,9 +340,9 @@ void SeArdMomentMatcher::cross_covariance_derivatives(MomentMatch& out, std::siz
   const Vector& g = s.gradient[a];
 
   // third(k, i + D j) = sum_n gamma_n s_nk t_ni t_nj with s_n = Sigma t_n: one (D x N) (N x D^2) GEMM.
-  auto sigma_t = view(s.nd, t.rows(), d);
+  auto sigma_t = view(w.nd, t.rows(), d);
   tiled_product(t, s.sigma, sigma_t);
-  detail::weighted_third_moment(t, sigma_t, s.weighted[a], view(s.outer, t.rows(), d * d), s.third);
+  detail::weighted_third_moment(t, sigma_t, s.weighted[a], view(w.outer, t.rows(), d * d), w.third);
 
   // Symmetrised: 1/2 third_k - 1/2 C_ka P + 1/2 ((P Lambda)_:k g' + g (P Lambda)_:k').
   for (Eigen::Index k = 0; k < d; ++k) {
@@ -321,7 +351,7 @@ void SeArdMomentMatcher::cross_covariance_derivatives(MomentMatch& out, std::siz
     for (Eigen::Index j = 0; j < d; ++j)
       for (Eigen::Index i = 0; i < d; ++i)
         out.dcross_dsigma(row, i + d * j) =
-            0.5 * (s.third(k, i + d * j) - c * p(i, j) + p_lambda(i, k) * g(j) + g(i) * p_lambda(j, k));
+            0.5 * (w.third(k, i + d * j) - c * p(i, j) + p_lambda(i, k) * g(j) + g(i) * p_lambda(j, k));
   }
 }
 

@@ -90,158 +90,154 @@ constexpr double kMaxLogRatio = 700.0;
 
 }  // namespace
 
-void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, bool derivatives) const {
+void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, std::size_t a, std::size_t b,
+                                              MomentMatchWorkerScratch& w, bool derivatives) const {
   MomentMatchScratch& s = out.scratch;
   const Eigen::Index d = input_dim_;
+  const OutputData& oa = outputs_[a];
+  const OutputData& ob = outputs_[b];
+  const auto ai = static_cast<Eigen::Index>(a);
+  const auto bi = static_cast<Eigen::Index>(b);
+  const bool same = a == b;
+  const Vector& gamma_a = s.weighted[a];
+  const Vector& gamma_b = s.weighted[b];
+  // Output a's centres index the rows (N_a), output b's the columns (N_b).
+  const Matrix& v_a = s.centred[a];
+  const Matrix& v_b = s.centred[b];
+  const Eigen::Index n_a = v_a.rows();
+  const Eigen::Index n_b = v_b.rows();
+  auto nd_a = view(w.nd, n_a, d);
+  auto nd_b = view(w.nd2, n_b, d);
+  auto nn = view(w.nn, n_a, n_b);
+  auto row_term = view(w.row_term, n_a);
+  auto col_term = view(w.col_term, n_b);
+  auto row_sums = view(w.row_sums, n_a);
+  auto col_sums = view(w.col_sums, n_b);
 
-  for (std::size_t a = 0; a < outputs_.size(); ++a) {
-    for (std::size_t b = a; b < outputs_.size(); ++b) {
-      const OutputData& oa = outputs_[a];
-      const OutputData& ob = outputs_[b];
-      const auto ai = static_cast<Eigen::Index>(a);
-      const auto bi = static_cast<Eigen::Index>(b);
-      const bool same = a == b;
-      const Vector& gamma_a = s.weighted[a];
-      const Vector& gamma_b = s.weighted[b];
-      // Output a's centres index the rows (N_a), output b's the columns (N_b).
-      const Matrix& v_a = s.centred[a];
-      const Matrix& v_b = s.centred[b];
-      const Eigen::Index n_a = v_a.rows();
-      const Eigen::Index n_b = v_b.rows();
-      auto nd_a = view(s.nd, n_a, d);
-      auto nd_b = view(s.nd2, n_b, d);
-      auto nn = view(s.nn, n_a, n_b);
-      auto row_term = view(s.row_term, n_a);
-      auto col_term = view(s.col_term, n_b);
-      auto row_sums = view(s.row_sums, n_a);
-      auto col_sums = view(s.col_sums, n_b);
+  w.sqrt_w_pair = (oa.inverse_squared_lengthscales + ob.inverse_squared_lengthscales).cwiseSqrt();
+  w.lengthscale_pair = w.sqrt_w_pair.cwiseInverse();
+  const double log_det = factor_scaled(s.sigma, w, w.sqrt_w_pair, a, b);
+  w.dd = -w.rt_inverse;  // I - Rt^-1, exactly 0 at Sigma = 0
+  w.dd.diagonal().array() += 1.0;
+  w.xi.noalias() = w.lengthscale_pair.asDiagonal() * w.dd * w.lengthscale_pair.asDiagonal();
+  if (derivatives)
+    w.pair_shrink.noalias() = w.sqrt_w_pair.asDiagonal() * w.dd * w.sqrt_w_pair.asDiagonal();
 
-      s.sqrt_w_pair = (oa.inverse_squared_lengthscales + ob.inverse_squared_lengthscales).cwiseSqrt();
-      s.lengthscale_pair = s.sqrt_w_pair.cwiseInverse();
-      const double log_det = factor_scaled(s, s.sqrt_w_pair, a, b);
-      s.dd = -s.rt_inverse;  // I - Rt^-1, exactly 0 at Sigma = 0
-      s.dd.diagonal().array() += 1.0;
-      s.xi.noalias() = s.lengthscale_pair.asDiagonal() * s.dd * s.lengthscale_pair.asDiagonal();
-      if (derivatives)
-        s.pair_shrink.noalias() = s.sqrt_w_pair.asDiagonal() * s.dd * s.sqrt_w_pair.asDiagonal();
-
-      // D = log(Q / (q_a q_b')): row and column parts, then the cross term, all O(Sigma).
-      const Matrix& scaled_a = s.scaled[a];
-      const Matrix& scaled_b = s.scaled[b];
-      tiled_product(scaled_a, s.xi, nd_a);
-      row_term = 0.5 * nd_a.cwiseProduct(scaled_a).rowwise().sum() - s.log_shift[a];
-      if (same) {
-        col_term = row_term;
-      } else {
-        tiled_product(scaled_b, s.xi, nd_b);
-        col_term = 0.5 * nd_b.cwiseProduct(scaled_b).rowwise().sum() - s.log_shift[b];
-      }
-      row_term.array() += -0.5 * (log_det - s.log_det(ai) - s.log_det(bi));
-      tiled_product(nd_a, scaled_b.transpose(), nn);
-      const auto centred_exp = [&](Eigen::Index j, Eigen::Index start) {
-        const Eigen::Index len = n_a - start;
-        auto col = nn.col(j).tail(len);
-        for (Eigen::Index i = 0; i < len; ++i)
-          col(i) = std::expm1(std::min(col(i) + row_term(start + i) + col_term(j), kMaxLogRatio));
-      };
-
-      const double ma = out.mean(ai);
-      const double mb = out.mean(bi);
-      double total = 0.0;  // 1' Omega 1
-      if (same) {
-        // expm1(D) is symmetric: the lower triangle (the exponentials dominate the cost), mirrored.
-        const Eigen::Index n = n_a;
-        for (Eigen::Index j = 0; j < n; ++j) centred_exp(j, j);
-        for (Eigen::Index j = 0; j + 1 < n; ++j) nn.row(j).tail(n - j - 1) = nn.col(j).tail(n - j - 1).transpose();
-        const Vector& q = s.kernel_mean[a];
-        double centred = 0.0;      // gamma' expm1(D) gamma = beta' (Q - q q') beta
-        double kinv_centred = 0.0;  // <Kinv, Q - q q'>
-        for (Eigen::Index j = 0; j < n; ++j) {
-          const auto col = nn.col(j);
-          centred += gamma_a(j) * col.dot(gamma_a);
-          kinv_centred += q(j) * col.cwiseProduct(oa.Kinv.col(j)).dot(q);
-        }
-        row_sums.noalias() = oa.Kinv * q;
-        const double expected_variance = oa.signal_variance - q.dot(row_sums) - kinv_centred;
-        const bool clamped = !(expected_variance > 0.0);
-        const double sab = centred + (clamped ? 0.0 : expected_variance);
-        out.covariance(ai, ai) = sab;
-        if (!derivatives) continue;
-        // Omega = gamma gamma' .* expm1(D) - Kinv .* Q (the second term dropped when clamped).
-        if (clamped) {
-          for (Eigen::Index j = 0; j < n; ++j) nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_a(j);
-        } else {
-          for (Eigen::Index j = 0; j < n; ++j)
-            nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_a(j) -
-                        (nn.col(j).array() + 1.0).matrix().cwiseProduct(oa.Kinv.col(j)).cwiseProduct(q) * q(j);
-        }
-        total = nn.sum();
-      } else {
-        for (Eigen::Index j = 0; j < n_b; ++j) centred_exp(j, 0);
-        // Omega = gamma_a gamma_b' .* expm1(D) = diag(beta_a) (Q - q_a q_b') diag(beta_b).
-        for (Eigen::Index j = 0; j < n_b; ++j) nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_b(j);
-        total = nn.sum();
-        out.covariance(ai, bi) = total;
-        out.covariance(bi, ai) = total;
-        if (!derivatives) continue;
-      }
-
-      row_sums = nn.rowwise().sum();
-      col_sums = nn.colwise().sum().transpose();
-      s.gain.noalias() = s.sqrt_w_pair.asDiagonal() * s.rt_inverse * s.lengthscale_pair.asDiagonal();
-      s.pair_precision.noalias() = s.sqrt_w_pair.asDiagonal() * s.rt_inverse * s.sqrt_w_pair.asDiagonal();
-      // Delta_a = G - G_a = (P_a - P) Sigma, exactly 0 at Sigma = 0.
-      s.dd = s.precision[a] - s.pair_precision;
-      s.delta_a.noalias() = s.dd * s.sigma;
-      s.dd = s.precision[b] - s.pair_precision;
-      s.delta_b.noalias() = s.dd * s.sigma;
-      const Vector& u_a = s.scaled_sum[a];
-      const Vector& u_b = s.scaled_sum[b];
-
-      // d/dmu = G (W_a V_a' r + W_b V_b' c) + M_b Delta_a u_a + M_a Delta_b u_b
-      s.dvec.noalias() = v_a.transpose() * row_sums;
-      s.dvec2.noalias() = v_b.transpose() * col_sums;
-      s.dvec = oa.inverse_squared_lengthscales.cwiseProduct(s.dvec) +
-               ob.inverse_squared_lengthscales.cwiseProduct(s.dvec2);
-      s.dvec2.noalias() = s.gain * s.dvec;
-      s.dvec2.noalias() += mb * (s.delta_a * u_a);
-      s.dvec2.noalias() += ma * (s.delta_b * u_b);
-
-      // d/dSigma: J, then -1/2 (1'r) P + 1/2 G J G' + the rank-one correction (file comment).
-      nd_a = v_a;
-      nd_a.array().colwise() *= row_sums.array();
-      tiled_product(v_a.transpose(), nd_a, s.dd);
-      s.inner.noalias() = oa.inverse_squared_lengthscales.asDiagonal() * s.dd *
-                          oa.inverse_squared_lengthscales.asDiagonal();
-      nd_b = v_b;
-      nd_b.array().colwise() *= col_sums.array();
-      tiled_product(v_b.transpose(), nd_b, s.dd);
-      s.inner.noalias() += ob.inverse_squared_lengthscales.asDiagonal() * s.dd *
-                           ob.inverse_squared_lengthscales.asDiagonal();
-      tiled_product(nn, v_b, nd_a);  // Omega V_b (N_a x D)
-      tiled_product(v_a.transpose(), nd_a, s.dd);
-      s.dd2.noalias() = oa.inverse_squared_lengthscales.asDiagonal() * s.dd *
-                        ob.inverse_squared_lengthscales.asDiagonal();
-      s.inner += s.dd2 + s.dd2.transpose();
-      // 1/2 (u_a u_b' + u_b u_a') joins J: G J G' then carries 1/2 G (u_a u_b' + u_b u_a') G'.
-      s.inner.noalias() += u_a * u_b.transpose();
-      s.inner.noalias() += u_b * u_a.transpose();
-      s.dd2.noalias() = s.gain * s.inner;
-      s.dd.noalias() = s.dd2 * s.gain.transpose();
-      s.dd = 0.5 * s.dd - (0.5 * total) * s.pair_precision -
-             (0.5 * ma * mb) * (s.shrink[a] + s.shrink[b] - s.pair_shrink);
-      // + 1/2 M_b (Delta_a E_a G' + G_a E_a Delta_a') + 1/2 M_a (Delta_b E_b G' + G_b E_b Delta_b')
-      s.dd2.noalias() = s.delta_a * s.scaled_scatter[a];
-      s.dd.noalias() += (0.5 * mb) * (s.dd2 * s.gain.transpose());
-      s.dd2.noalias() = s.precision_lambda[a] * s.scaled_scatter[a];
-      s.dd.noalias() += (0.5 * mb) * (s.dd2 * s.delta_a.transpose());
-      s.dd2.noalias() = s.delta_b * s.scaled_scatter[b];
-      s.dd.noalias() += (0.5 * ma) * (s.dd2 * s.gain.transpose());
-      s.dd2.noalias() = s.precision_lambda[b] * s.scaled_scatter[b];
-      s.dd.noalias() += (0.5 * ma) * (s.dd2 * s.delta_b.transpose());
-      detail::write_covariance_derivatives(out, ai, bi, s.dvec2, s.dd);
-    }
+  // D = log(Q / (q_a q_b')): row and column parts, then the cross term, all O(Sigma).
+  const Matrix& scaled_a = s.scaled[a];
+  const Matrix& scaled_b = s.scaled[b];
+  tiled_product(scaled_a, w.xi, nd_a);
+  row_term = 0.5 * nd_a.cwiseProduct(scaled_a).rowwise().sum() - s.log_shift[a];
+  if (same) {
+    col_term = row_term;
+  } else {
+    tiled_product(scaled_b, w.xi, nd_b);
+    col_term = 0.5 * nd_b.cwiseProduct(scaled_b).rowwise().sum() - s.log_shift[b];
   }
+  row_term.array() += -0.5 * (log_det - s.log_det(ai) - s.log_det(bi));
+  tiled_product(nd_a, scaled_b.transpose(), nn);
+  const auto centred_exp = [&](Eigen::Index j, Eigen::Index start) {
+    const Eigen::Index len = n_a - start;
+    auto col = nn.col(j).tail(len);
+    for (Eigen::Index i = 0; i < len; ++i)
+      col(i) = std::expm1(std::min(col(i) + row_term(start + i) + col_term(j), kMaxLogRatio));
+  };
+
+  const double ma = out.mean(ai);
+  const double mb = out.mean(bi);
+  double total = 0.0;  // 1' Omega 1
+  if (same) {
+    // expm1(D) is symmetric: the lower triangle (the exponentials dominate the cost), mirrored.
+    const Eigen::Index n = n_a;
+    for (Eigen::Index j = 0; j < n; ++j) centred_exp(j, j);
+    for (Eigen::Index j = 0; j + 1 < n; ++j) nn.row(j).tail(n - j - 1) = nn.col(j).tail(n - j - 1).transpose();
+    const Vector& q = s.kernel_mean[a];
+    double centred = 0.0;      // gamma' expm1(D) gamma = beta' (Q - q q') beta
+    double kinv_centred = 0.0;  // <Kinv, Q - q q'>
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const auto col = nn.col(j);
+      centred += gamma_a(j) * col.dot(gamma_a);
+      kinv_centred += q(j) * col.cwiseProduct(oa.Kinv.col(j)).dot(q);
+    }
+    row_sums.noalias() = oa.Kinv * q;
+    const double expected_variance = oa.signal_variance - q.dot(row_sums) - kinv_centred;
+    const bool clamped = !(expected_variance > 0.0);
+    const double sab = centred + (clamped ? 0.0 : expected_variance);
+    out.covariance(ai, ai) = sab;
+    if (!derivatives) return;
+    // Omega = gamma gamma' .* expm1(D) - Kinv .* Q (the second term dropped when clamped).
+    if (clamped) {
+      for (Eigen::Index j = 0; j < n; ++j) nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_a(j);
+    } else {
+      for (Eigen::Index j = 0; j < n; ++j)
+        nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_a(j) -
+                    (nn.col(j).array() + 1.0).matrix().cwiseProduct(oa.Kinv.col(j)).cwiseProduct(q) * q(j);
+    }
+    total = nn.sum();
+  } else {
+    for (Eigen::Index j = 0; j < n_b; ++j) centred_exp(j, 0);
+    // Omega = gamma_a gamma_b' .* expm1(D) = diag(beta_a) (Q - q_a q_b') diag(beta_b).
+    for (Eigen::Index j = 0; j < n_b; ++j) nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_b(j);
+    total = nn.sum();
+    out.covariance(ai, bi) = total;
+    out.covariance(bi, ai) = total;
+    if (!derivatives) return;
+  }
+
+  row_sums = nn.rowwise().sum();
+  col_sums = nn.colwise().sum().transpose();
+  w.gain.noalias() = w.sqrt_w_pair.asDiagonal() * w.rt_inverse * w.lengthscale_pair.asDiagonal();
+  w.pair_precision.noalias() = w.sqrt_w_pair.asDiagonal() * w.rt_inverse * w.sqrt_w_pair.asDiagonal();
+  // Delta_a = G - G_a = (P_a - P) Sigma, exactly 0 at Sigma = 0.
+  w.dd = s.precision[a] - w.pair_precision;
+  w.delta_a.noalias() = w.dd * s.sigma;
+  w.dd = s.precision[b] - w.pair_precision;
+  w.delta_b.noalias() = w.dd * s.sigma;
+  const Vector& u_a = s.scaled_sum[a];
+  const Vector& u_b = s.scaled_sum[b];
+
+  // d/dmu = G (W_a V_a' r + W_b V_b' c) + M_b Delta_a u_a + M_a Delta_b u_b
+  w.dvec.noalias() = v_a.transpose() * row_sums;
+  w.dvec2.noalias() = v_b.transpose() * col_sums;
+  w.dvec = oa.inverse_squared_lengthscales.cwiseProduct(w.dvec) +
+           ob.inverse_squared_lengthscales.cwiseProduct(w.dvec2);
+  w.dvec2.noalias() = w.gain * w.dvec;
+  w.dvec2.noalias() += mb * (w.delta_a * u_a);
+  w.dvec2.noalias() += ma * (w.delta_b * u_b);
+
+  // d/dSigma: J, then -1/2 (1'r) P + 1/2 G J G' + the rank-one correction (file comment).
+  nd_a = v_a;
+  nd_a.array().colwise() *= row_sums.array();
+  tiled_product(v_a.transpose(), nd_a, w.dd);
+  w.inner.noalias() = oa.inverse_squared_lengthscales.asDiagonal() * w.dd *
+                      oa.inverse_squared_lengthscales.asDiagonal();
+  nd_b = v_b;
+  nd_b.array().colwise() *= col_sums.array();
+  tiled_product(v_b.transpose(), nd_b, w.dd);
+  w.inner.noalias() += ob.inverse_squared_lengthscales.asDiagonal() * w.dd *
+                       ob.inverse_squared_lengthscales.asDiagonal();
+  tiled_product(nn, v_b, nd_a);  // Omega V_b (N_a x D)
+  tiled_product(v_a.transpose(), nd_a, w.dd);
+  w.dd2.noalias() = oa.inverse_squared_lengthscales.asDiagonal() * w.dd *
+                    ob.inverse_squared_lengthscales.asDiagonal();
+  w.inner += w.dd2 + w.dd2.transpose();
+  // 1/2 (u_a u_b' + u_b u_a') joins J: G J G' then carries 1/2 G (u_a u_b' + u_b u_a') G'.
+  w.inner.noalias() += u_a * u_b.transpose();
+  w.inner.noalias() += u_b * u_a.transpose();
+  w.dd2.noalias() = w.gain * w.inner;
+  w.dd.noalias() = w.dd2 * w.gain.transpose();
+  w.dd = 0.5 * w.dd - (0.5 * total) * w.pair_precision -
+         (0.5 * ma * mb) * (s.shrink[a] + s.shrink[b] - w.pair_shrink);
+  // + 1/2 M_b (Delta_a E_a G' + G_a E_a Delta_a') + 1/2 M_a (Delta_b E_b G' + G_b E_b Delta_b')
+  w.dd2.noalias() = w.delta_a * s.scaled_scatter[a];
+  w.dd.noalias() += (0.5 * mb) * (w.dd2 * w.gain.transpose());
+  w.dd2.noalias() = s.precision_lambda[a] * s.scaled_scatter[a];
+  w.dd.noalias() += (0.5 * mb) * (w.dd2 * w.delta_a.transpose());
+  w.dd2.noalias() = w.delta_b * s.scaled_scatter[b];
+  w.dd.noalias() += (0.5 * ma) * (w.dd2 * w.gain.transpose());
+  w.dd2.noalias() = s.precision_lambda[b] * s.scaled_scatter[b];
+  w.dd.noalias() += (0.5 * ma) * (w.dd2 * w.delta_b.transpose());
+  detail::write_covariance_derivatives(out, ai, bi, w.dvec2, w.dd);
 }
 
 }  // namespace gpilqg::gp

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "moment_matching_checks.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/systems.hpp"
+#include "gpilqg/gp/moment_matching.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 
 // AddressSanitizer owns malloc itself; under it (GPILQG_SANITIZE) the counter is off and the tests skip.
@@ -119,6 +121,30 @@ TEST(Allocation, MomentMatchingDoesNotAllocateAfterWarmUp) {
     }
     EXPECT_EQ(g_malloc_calls.load() - before, 0) << fits.models[0]->backend_name();
   }
+}
+
+TEST(Allocation, MomentMatchingOnTwoThreadsDoesNotAllocateAfterWarmUp) {
+  SKIP_WITHOUT_COUNTER();
+  // 300 shared centres, 3 outputs: large enough that the pairs go to the helper thread (ForkJoin).
+  const Matrix inputs = Matrix::Random(300, 3) * 3.0;
+  std::vector<SeArdOutput> outputs;
+  for (int a = 0; a < 3; ++a)
+    outputs.push_back(condition_se_ard_output(inputs, inputs.col(a).array().sin().matrix(), Vector::Zero(3), 0.0,
+                                              std::log(0.1)));
+  const SeArdMomentMatcher matcher(inputs, outputs);
+  const Vector mu = Vector::Constant(3, 0.1);
+  const Matrix sigma = make_sigma(3, 0.3, 1, /*zero_index=*/2);
+  const Matrix wider = 2.0 * sigma;
+  MomentMatch m;
+  m.threads = 2;
+  matcher.propagate(mu, sigma, m, MomentDerivatives::All);  // warm-up: sizes the buffers, starts the helper
+  ASSERT_EQ(m.fork_join.helpers(), 1);
+  const long before = g_malloc_calls.load();
+  for (int i = 0; i < 5; ++i) {
+    matcher.propagate(mu, wider, m, MomentDerivatives::All);
+    matcher.propagate(mu, sigma, m, MomentDerivatives::None);
+  }
+  EXPECT_EQ(g_malloc_calls.load() - before, 0);
 }
 
 }  // namespace

@@ -389,6 +389,73 @@ TEST(MomentMatching, ReusedResultMatchesAFreshOneAndDerivativesCanBeSkipped) {
   EXPECT_EQ(reused.covariance, reused.covariance.transpose());
 }
 
+/// Every result block of two propagations, compared bit for bit.
+void expect_identical(const MomentMatch& a, const MomentMatch& b, const std::string& label) {
+  EXPECT_EQ(a.mean, b.mean) << label;
+  EXPECT_EQ(a.covariance, b.covariance) << label;
+  EXPECT_EQ(a.cross_covariance, b.cross_covariance) << label;
+  EXPECT_EQ(a.has_derivatives, b.has_derivatives) << label;
+  if (!a.has_derivatives || !b.has_derivatives) return;
+  EXPECT_EQ(a.dmean_dmu, b.dmean_dmu) << label;
+  EXPECT_EQ(a.dmean_dsigma, b.dmean_dsigma) << label;
+  EXPECT_EQ(a.dcovariance_dmu, b.dcovariance_dmu) << label;
+  EXPECT_EQ(a.dcovariance_dsigma, b.dcovariance_dsigma) << label;
+  EXPECT_EQ(a.dcross_dmu, b.dcross_dmu) << label;
+  EXPECT_EQ(a.dcross_dsigma, b.dcross_dsigma) << label;
+}
+
+TEST(MomentMatching, TwoThreadsGiveBitIdenticalResults) {
+  // Shared centres (N = 300, E = 3: 6 pairs of 300 x 300) and per-output centres of different sizes
+  // (N_a = 260, 190, 120), both above the size from which the pairs are shared out.
+  const TestGp shared = make_gp(300, 3, 3, 25, /*spread=*/3.0);
+  std::vector<Matrix> centres;
+  std::vector<SeArdOutput> outputs;
+  for (int a = 0; a < 3; ++a) {
+    const TestGp one = make_gp(260 - 70 * a, 3, 1, 40 + a, 3.0);
+    centres.push_back(one.inputs);
+    outputs.push_back(one.outputs[0]);
+  }
+  const SeArdMomentMatcher per_output(centres, outputs);
+  const SeArdMomentMatcher shared_matcher = shared.matcher();
+  Vector mu(3);
+  mu << 0.2, 0.1, -0.1;
+  for (const SeArdMomentMatcher* matcher : {&shared_matcher, &per_output}) {
+    MomentMatch one, two;
+    two.threads = 2;
+    for (const Matrix& sigma : {make_sigma(3, 0.3, 6, 2), Matrix(Matrix::Zero(3, 3)), make_sigma(3, 0.8, 7)}) {
+      for (const auto derivatives : {MomentDerivatives::All, MomentDerivatives::None}) {
+        matcher->propagate(mu, sigma, one, derivatives);
+        matcher->propagate(mu, sigma, two, derivatives);
+        expect_identical(one, two, matcher == &shared_matcher ? "shared centres" : "per-output centres");
+      }
+    }
+    EXPECT_EQ(two.fork_join.helpers(), 1) << "the second thread was used";
+    EXPECT_EQ(one.fork_join.helpers(), 0);
+  }
+  // Small problems stay on the calling thread.
+  const TestGp small = make_gp(18, 3, 3, 31);
+  MomentMatch m;
+  m.threads = 2;
+  small.matcher().propagate(mu, make_sigma(3, 0.3, 1), m, MomentDerivatives::All);
+  EXPECT_EQ(m.fork_join.helpers(), 0);
+}
+
+TEST(MomentMatching, AnErrorOnTheHelperThreadReachesTheCaller) {
+  const TestGp gp = make_gp(300, 3, 3, 25, 3.0);
+  const SeArdMomentMatcher matcher = gp.matcher();
+  MomentMatch m;
+  m.threads = 2;
+  const Vector mu = Vector::Zero(3);
+  // Outputs 1 (and the pairs) run on the helper: every Rt fails there and here alike.
+  expect_invalid([&] { matcher.propagate(mu, -100.0 * Matrix::Identity(3, 3), m, MomentDerivatives::All); },
+                 "positive semidefinite");
+  EXPECT_FALSE(m.has_derivatives);
+  MomentMatch reference;
+  matcher.propagate(mu, 0.1 * Matrix::Identity(3, 3), m, MomentDerivatives::All);
+  matcher.propagate(mu, 0.1 * Matrix::Identity(3, 3), reference, MomentDerivatives::All);
+  expect_identical(m, reference, "after the error");
+}
+
 TEST(MomentMatching, OnlyTheSymmetricPartOfSigmaIsRead) {
   const TestGp gp = make_gp(12, 3, 2, 32);
   const SeArdMomentMatcher matcher = gp.matcher();

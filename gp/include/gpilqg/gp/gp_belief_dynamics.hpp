@@ -50,9 +50,16 @@ class GpBeliefDynamics final : public BeliefStepModel {
 
   const MomentMatcher& matcher() const { return *matcher_; }
 
+  /// Threads one belief step may use (MomentMatch::threads, >= 1; default 1): the SE-ARD matcher
+  /// shares its output pairs among them. The results are the same for any value. Throws
+  /// std::invalid_argument when threads < 1.
+  void set_threads(int threads);
+  int threads() const { return threads_; }
+
  private:
   int n_, m_;
   double dt_;
+  int threads_ = 1;
   std::shared_ptr<const MomentMatcher> matcher_;  ///< immutable, shared by copies of this model
 };
 

@@ -39,14 +39,16 @@
 /// (the heat equation of the Gaussian expectation), C_:a = Sigma dM_a/dmu.
 ///
 /// Threading and allocation: a matcher is immutable after construction and may be shared between
-/// threads; each thread uses its own MomentMatch. After the first call with a given MomentMatch (and
-/// the same matcher), propagate does not allocate.
+/// threads; each thread uses its own MomentMatch, which may also lend the call helper threads
+/// (MomentMatch::threads). After the first call with a given MomentMatch (and the same matcher and
+/// thread count), propagate does not allocate.
 
 #include <string_view>
 #include <vector>
 
 #include <Eigen/Cholesky>
 
+#include "gpilqg/core/fork_join.hpp"
 #include "gpilqg/core/types.hpp"
 
 namespace gpilqg::gp {
@@ -57,9 +59,23 @@ enum class MomentDerivatives {
   All,   ///< moments and all six derivative blocks (w.r.t. mu and Sigma)
 };
 
+/// The buffers one worker of an SE-ARD propagation (moment_matching*.cpp) uses for the output or the
+/// pair of outputs it is working on; room for the largest N, used through views. Internal.
+struct MomentMatchWorkerScratch {
+  Eigen::LLT<Matrix> llt;                ///< factor of the current scaled matrix Rt (D x D)
+  Matrix rt, rt_inverse, xi, gain, pair_precision, dd, dd2, inner;  ///< D x D
+  Matrix pair_shrink, delta_a, delta_b;                            ///< D x D, derivatives only
+  Matrix nd, nd2;                                                  ///< room for N_max x D
+  Vector row_term, col_term, row_sums, col_sums;                   ///< room for N_max
+  Matrix nn;                             ///< D, expm1(D), then Omega of one pair (room for N_max x N_max)
+  Matrix outer;                          ///< t_ni t_nj (room for N_max x D*D), derivatives only
+  Matrix third;                          ///< sum_n gamma_n (Sigma t_n)_k t_ni t_nj (D x D*D), derivatives only
+  Vector sqrt_w_pair, lengthscale_pair, dvec, dvec2;               ///< D
+};
+
 /// Scratch space of one SE-ARD propagation (moment_matching.cpp), sized on first use. Internal: the
-/// contents are unspecified. Per-output entries have N_a rows (that output's centres); the pair
-/// buffers (nd, nd2, row_term, ..., nn, outer) have room for the largest N and are used through views.
+/// contents are unspecified. Per-output entries have N_a rows (that output's centres) and are written
+/// by the worker that owns the output; `workers` holds one MomentMatchWorkerScratch per worker.
 struct MomentMatchScratch {
   Matrix sigma;                          ///< sym(Sigma) (D x D)
   std::vector<Matrix> centred;           ///< V_a = X_a - 1 mu' (N_a x D) per output
@@ -76,15 +92,7 @@ struct MomentMatchScratch {
   std::vector<Vector> scaled_sum;        ///< u_a = A_a' gamma_a (D) per output, derivatives only
   std::vector<Matrix> scaled_scatter;    ///< E_a = A_a' diag(gamma_a) A_a (D x D) per output, derivatives only
   Vector log_det;                        ///< log|Rt_a| (E)
-  Eigen::LLT<Matrix> llt;                ///< factor of the current scaled matrix Rt (D x D)
-  Matrix rt, rt_inverse, xi, gain, pair_precision, dd, dd2, inner;  ///< D x D
-  Matrix pair_shrink, delta_a, delta_b;                            ///< D x D, derivatives only
-  Matrix nd, nd2;                                                  ///< room for N_max x D
-  Vector row_term, col_term, row_sums, col_sums;                   ///< room for N_max
-  Matrix nn;                             ///< D, expm1(D), then Omega of one pair (room for N_max x N_max)
-  Matrix outer;                          ///< t_ni t_nj (room for N_max x D*D), derivatives only
-  Matrix third;                          ///< sum_n gamma_n (Sigma t_n)_k t_ni t_nj (D x D*D), derivatives only
-  Vector sqrt_w_pair, lengthscale_pair, dvec, dvec2;               ///< D
+  std::vector<MomentMatchWorkerScratch> workers;  ///< one per worker thread
 };
 
 /// Scratch space of one SSGP propagation (ssgp_moment_matching.cpp), sized on first use. Internal:
@@ -125,6 +133,11 @@ struct MomentMatch {
   Matrix dcross_dsigma;          ///< D*E x D*D
   MomentMatchScratch scratch;    ///< SeArdMomentMatcher's
   SsgpMomentScratch ssgp_scratch;  ///< SsgpMomentMatcher's
+  /// Threads one propagation may use (>= 1; the caller's choice). SeArdMomentMatcher shares the
+  /// outputs, then the pairs of outputs, among them when the N x N pair matrices are large enough
+  /// to repay the hand-off (SsgpMomentMatcher ignores it); the results do not depend on it.
+  int threads = 1;
+  ForkJoin fork_join;            ///< the helper threads, started on the first call that uses them
 };
 
 /// Exact moment matching of E GP outputs under a Gaussian input (see the file comment).
