@@ -13,8 +13,8 @@
 namespace gpilqg {
 namespace {
 
-/// Threads for the work inside one algorithm's iteration: the residual GP's outputs are fitted
-/// concurrently, and PDDP's belief step shares its output pairs (the results do not depend on it).
+/// Threads for the work inside one algorithm's iteration: the GPs' outputs are fitted concurrently,
+/// and PDDP's belief step shares its output pairs (the results do not depend on it).
 /// The machine the README's figures come from has 2 cores.
 constexpr int kThreads = 2;
 
@@ -202,9 +202,8 @@ DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uin
     inputs << data.x, data.u;
     const Matrix increments = data.x_next - data.x;
     const auto backend = gp::make_backend(c.config.pddp_backend, c.config.backend_settings);
-    auto dynamics = gp::GpBeliefDynamics::fit(n, m, c.config.dt, inputs, increments, *backend,
-                                              fit_options(c, seed, name, data.size()));
-    dynamics.set_threads(kThreads);
+    const auto dynamics = gp::GpBeliefDynamics::fit(n, m, c.config.dt, inputs, increments, *backend,
+                                                    fit_options(c, seed, name, data.size()), nullptr, kThreads);
     record.fit_seconds = seconds_since(start);
 
     PddpProblem problem;

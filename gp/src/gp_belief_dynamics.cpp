@@ -6,6 +6,7 @@
 
 #include "gpilqg/gp/fitted_moment_matcher.hpp"
 #include "gpilqg/gp/moment_matching.hpp"
+#include "parallel.hpp"
 
 namespace gpilqg::gp {
 
@@ -46,19 +47,24 @@ GpBeliefDynamics GpBeliefDynamics::condition(int n, int m, double dt, const Matr
 
 GpBeliefDynamics GpBeliefDynamics::fit(int n, int m, double dt, const Matrix& inputs, const Matrix& increments,
                                        const GpBackend& backend, const FitOptions& options,
-                                       std::vector<FitSummary>* summaries) {
+                                       std::vector<FitSummary>* summaries, int threads) {
   require_moment_matching(backend.name(), "GpBeliefDynamics::fit");
+  if (threads < 1) throw std::invalid_argument("GpBeliefDynamics::fit: threads is " + std::to_string(threads) + ", need >= 1");
   if (increments.cols() != n || increments.rows() != inputs.rows())
     throw std::invalid_argument("GpBeliefDynamics::fit: increments must be N x n with N = rows of inputs");
-  std::vector<std::unique_ptr<FittedGp>> models;
-  std::vector<const FittedGp*> outputs;
-  for (int a = 0; a < n; ++a) {
+  std::vector<std::unique_ptr<FittedGp>> models(static_cast<std::size_t>(n));
+  std::vector<FitSummary> fit_summaries(static_cast<std::size_t>(n));
+  detail::run_indexed(n, threads, [&](int a) {
     FitResult fitted = backend.fit(TrainingSet{inputs, increments.col(a)}, options);
-    outputs.push_back(fitted.model.get());
-    models.push_back(std::move(fitted.model));
-    if (summaries) summaries->push_back(fitted.summary);
-  }
-  return GpBeliefDynamics(n, m, dt, moment_matcher_for(outputs));
+    models[static_cast<std::size_t>(a)] = std::move(fitted.model);
+    fit_summaries[static_cast<std::size_t>(a)] = std::move(fitted.summary);
+  });
+  std::vector<const FittedGp*> outputs;
+  for (const auto& model : models) outputs.push_back(model.get());
+  if (summaries) summaries->insert(summaries->end(), fit_summaries.begin(), fit_summaries.end());
+  GpBeliefDynamics dynamics(n, m, dt, moment_matcher_for(outputs));
+  dynamics.set_threads(threads);
+  return dynamics;
 }
 
 void GpBeliefDynamics::propagate(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,

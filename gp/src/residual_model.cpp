@@ -1,12 +1,10 @@
 #include "gpilqg/gp/residual_model.hpp"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <stdexcept>
-#include <thread>
 
+#include "parallel.hpp"
 #include "shared_prediction.hpp"
 
 namespace gpilqg::gp {
@@ -28,29 +26,6 @@ StepScratch& step_scratch(int input_dim, int outputs) {
   if (scratch.predictions.size() < static_cast<std::size_t>(outputs))
     scratch.predictions.resize(static_cast<std::size_t>(outputs));
   return scratch;
-}
-
-/// Runs task(i) for i in [0, count) on up to `threads` threads; rethrows the first exception.
-template <class Task>
-void run_parallel(int count, int threads, Task&& task) {
-  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(count));
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int i = next++; i < count; i = next++) {
-      try {
-        task(i);
-      } catch (...) {
-        errors[static_cast<std::size_t>(i)] = std::current_exception();
-      }
-    }
-  };
-  const int workers = std::max(1, std::min(threads, count));
-  std::vector<std::thread> pool;
-  for (int w = 1; w < workers; ++w) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  for (auto& e : errors)
-    if (e) std::rethrow_exception(e);
 }
 
 }  // namespace
@@ -124,7 +99,7 @@ ResidualModel ResidualModel::fit(SimulatorPtr simulator, const ResidualData& dat
     r.outputs[index] = result.summary;
     outputs[index] = std::move(result.model);
   };
-  run_parallel(n, options.threads, [&](int i) {
+  detail::run_indexed(n, options.threads, [&](int i) {
     try {
       fit_output(i);
     } catch (const std::invalid_argument& e) {

@@ -7,12 +7,14 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "gpilqg/gp/compact.hpp"
+#include "gpilqg/gp/exact_gp.hpp"
 #include "gpilqg/gp/fitc.hpp"
 #include "gpilqg/gp/fitted_moment_matcher.hpp"
 #include "gpilqg/gp/gp_belief_dynamics.hpp"
@@ -190,6 +192,34 @@ TEST(GpBeliefDynamics, SsgpServesPddp) {
   SsgpOptions options;
   options.frequencies = 15;
   expect_belief_step_is_the_prediction(SsgpBackend(options));
+}
+
+TEST(GpBeliefDynamics, FittingOnTwoThreadsGivesTheSameModel) {
+  // The outputs fitted concurrently and the belief step shared out: the same summaries and the same
+  // belief step with Jacobians, bit for bit, as one thread.
+  const PendulumData data = pendulum_data();
+  const ExactGpBackend backend;
+  std::vector<FitSummary> one_summaries, two_summaries;
+  const GpBeliefDynamics one =
+      GpBeliefDynamics::fit(kN, kM, 0.05, data.inputs, data.increments, backend, quick_fit(), &one_summaries, 1);
+  const GpBeliefDynamics two =
+      GpBeliefDynamics::fit(kN, kM, 0.05, data.inputs, data.increments, backend, quick_fit(), &two_summaries, 2);
+  EXPECT_EQ(one.threads(), 1);
+  EXPECT_EQ(two.threads(), 2);
+  ASSERT_EQ(one_summaries.size(), 2u);
+  ASSERT_EQ(two_summaries.size(), 2u);
+  for (std::size_t a = 0; a < 2; ++a) EXPECT_EQ(one_summaries[a].nlml, two_summaries[a].nlml) << "output " << a;
+  const Vector v = belief(Vector::Constant(kN, 0.3), 0.01 * Matrix::Identity(kN, kN));
+  const Vector u = Vector::Constant(kM, 0.2);
+  Vector next_one(v.size()), next_two(v.size());
+  BeliefJacobians j_one, j_two;
+  one.propagate(v, u, next_one, &j_one);
+  two.propagate(v, u, next_two, &j_two);
+  EXPECT_EQ(next_one, next_two);
+  EXPECT_EQ(j_one.dv, j_two.dv);
+  EXPECT_EQ(j_one.du, j_two.du);
+  EXPECT_THROW(GpBeliefDynamics::fit(kN, kM, 0.05, data.inputs, data.increments, backend, quick_fit(), nullptr, 0),
+               std::invalid_argument);
 }
 
 TEST(GpBeliefDynamics, TheBackendsThatServeAreExactFitcAndSsgp) {

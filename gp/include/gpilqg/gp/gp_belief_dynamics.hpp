@@ -38,9 +38,11 @@ class GpBeliefDynamics final : public BeliefStepModel {
   /// pseudo-inputs) or "ssgp" (each output its own frequencies). Any other backend ("compact": the
   /// Wendland kernel has no closed-form Gaussian expectation) is rejected with std::invalid_argument
   /// before anything is fitted. `summaries` receives one fit summary per output when not null.
+  /// `threads` (>= 1): the outputs are fitted concurrently on that many threads, and the model's
+  /// belief step gets them too (set_threads); the results do not depend on it.
   static GpBeliefDynamics fit(int n, int m, double dt, const Matrix& inputs, const Matrix& increments,
                               const GpBackend& backend, const FitOptions& options = {},
-                              std::vector<FitSummary>* summaries = nullptr);
+                              std::vector<FitSummary>* summaries = nullptr, int threads = 1);
 
   int state_dim() const override { return n_; }
   int control_dim() const override { return m_; }
