@@ -205,7 +205,8 @@ void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives, int workers
   size_all(s.shrink, false, d, d);
   size_all_vectors(s.gradient, false, d);
   s.log_det.resize(e);
-  s.workers.resize(static_cast<std::size_t>(std::max(workers, 1)));
+  // Grow only: a MomentMatch that alternates between thread counts keeps its buffers.
+  if (s.workers.size() < static_cast<std::size_t>(workers)) s.workers.resize(static_cast<std::size_t>(workers));
   for (MomentMatchWorkerScratch& w : s.workers) {
     for (Matrix* m : {&w.rt, &w.rt_inverse, &w.xi, &w.gain, &w.pair_precision, &w.dd, &w.dd2, &w.inner})
       m->resize(d, d);
