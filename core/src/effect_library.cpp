@@ -5,122 +5,11 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/system_registry.hpp"
+
 namespace gpilqg {
 
 namespace {
-
-/// Width of the tanh that smooths Coulomb friction (DESIGN.md section 5) [m/s or rad/s].
-constexpr double kCoulombWidth = 0.05;
-
-ForceEffectPtr linear_force(std::string name, EffectParameter parameter, std::string formula, int force_dim,
-                            LinearForceEffect::Basis basis) {
-  return std::make_shared<LinearForceEffect>(std::move(name), std::move(parameter), std::move(formula), force_dim,
-                                             std::move(basis));
-}
-
-/// g = -v on component `component`, v = x(velocity).
-LinearForceEffect::Basis viscous(int component, int velocity) {
-  return [=](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
-    g(component) = -x(velocity);
-    if (dg_dx != nullptr) (*dg_dx)(component, velocity) = -1.0;
-  };
-}
-
-/// g = -tanh(v / w), dg/dv = -(1 - tanh^2) / w.
-LinearForceEffect::Basis coulomb(int component, int velocity) {
-  return [=](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
-    const double t = std::tanh(x(velocity) / kCoulombWidth);
-    g(component) = -t;
-    if (dg_dx != nullptr) (*dg_dx)(component, velocity) = -(1.0 - t * t) / kCoulombWidth;
-  };
-}
-
-/// g = e_component: a constant force.
-LinearForceEffect::Basis constant(int component) {
-  return [=](const VectorCRef&, VectorRef g, Matrix*) { g(component) = 1.0; };
-}
-
-/// g_i = -|v_i| v_i for the velocities starting at `first_velocity`, dg_i/dv_i = -2 |v_i|.
-LinearForceEffect::Basis quadratic_drag(int components, int first_velocity) {
-  return [=](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
-    for (int i = 0; i < components; ++i) {
-      const double v = x(first_velocity + i);
-      g(i) = -std::abs(v) * v;
-      if (dg_dx != nullptr) (*dg_dx)(i, first_velocity + i) = -2.0 * std::abs(v);
-    }
-  };
-}
-
-LibraryEffect force_entry(ForceEffectPtr force) {
-  LibraryEffect e;
-  e.name = force->name();
-  e.kind = EffectKind::Force;
-  e.parameters = force->parameters();
-  e.formula = force->formula();
-  e.linear = force->linear_in_parameters();
-  e.force = std::move(force);
-  return e;
-}
-
-LibraryEffect gain_entry() {
-  LibraryEffect e;
-  e.name = "actuator_gain";
-  e.kind = EffectKind::ActuatorGain;
-  e.parameters = {{"k", "-", 1.0, 0.0, std::numeric_limits<double>::infinity()}};
-  e.formula = "applied input = k u";
-  e.linear = true;  // the built-in systems are control-affine
-  return e;
-}
-
-/// param:<name> for every physical parameter except gravity. Masses, lengths, inertia and rho stay
-/// positive; kv and km stay non-negative. Linear: kv, km and rho enter xdot linearly.
-void add_recalibrations(const Dynamics& system, std::vector<LibraryEffect>& out) {
-  for (const Parameter& p : system.parameters()) {
-    if (p.name == "gravity") continue;
-    LibraryEffect e;
-    e.name = "param:" + p.name;
-    e.kind = EffectKind::Recalibration;
-    e.recalibrated = p.name;
-    const bool non_negative = p.name == "kv" || p.name == "km";
-    e.parameters = {{p.name, p.unit, std::max(std::abs(p.value), 1e-3), non_negative ? 0.0 : 1e-6 * std::abs(p.value),
-                     std::numeric_limits<double>::infinity()}};
-    e.formula = "recalibrate " + p.name + " [" + p.unit + "]";
-    e.linear = p.name == "kv" || p.name == "km" || p.name == "rho";
-    out.push_back(std::move(e));
-  }
-}
-
-std::vector<LibraryEffect> cartpole_library() {
-  // Q = (Q_x, Q_theta); x = (x, x_dot, theta, theta_dot).
-  std::vector<LibraryEffect> out;
-  out.push_back(force_entry(linear_force("cart_viscous_friction", {"b", "N s/m", 1.0}, "Q_x = -b x_dot", 2, viscous(0, 1))));
-  out.push_back(force_entry(linear_force("cart_coulomb_friction", {"mu", "N", 1.0}, "Q_x = -mu tanh(x_dot / 0.05)", 2,
-                                         coulomb(0, 1))));
-  out.push_back(force_entry(linear_force("pole_viscous_damping", {"c", "N m s/rad", 0.1}, "Q_theta = -c theta_dot", 2,
-                                         viscous(1, 3))));
-  out.push_back(force_entry(linear_force("pole_coulomb_friction", {"tau", "N m", 0.1},
-                                         "Q_theta = -tau tanh(theta_dot / 0.05)", 2, coulomb(1, 3))));
-  out.push_back(force_entry(linear_force("external_force_x", {"F", "N", 1.0}, "Q_x = F", 2, constant(0))));
-  out.push_back(force_entry(linear_force("quadratic_drag", {"c_d", "N s^2/m^2", 0.1}, "Q_x = -c_d |x_dot| x_dot", 2,
-                                         quadratic_drag(1, 1))));
-  out.push_back(gain_entry());
-  add_recalibrations(*make_system("cartpole"), out);
-  return out;
-}
-
-std::vector<LibraryEffect> quadrotor_library() {
-  // Q = (F_x, F_y, F_z, tau_x, tau_y, tau_z); velocities at x(3..5).
-  std::vector<LibraryEffect> out;
-  const char* axes[] = {"x", "y", "z"};
-  for (int i = 0; i < 3; ++i)
-    out.push_back(force_entry(linear_force(std::string("external_force_") + axes[i], {"F", "N", 1.0},
-                                           std::string("F_") + axes[i] + " = F (world frame)", 6, constant(i))));
-  out.push_back(force_entry(
-      linear_force("quadratic_drag", {"c_d", "N s^2/m^2", 0.1}, "F_i = -c_d |v_i| v_i (world frame)", 6, quadratic_drag(3, 3))));
-  out.push_back(gain_entry());
-  add_recalibrations(*make_system("quadrotor"), out);
-  return out;
-}
 
 std::string joined_names(const std::vector<LibraryEffect>& library) {
   std::string out;
@@ -131,12 +20,8 @@ std::string joined_names(const std::vector<LibraryEffect>& library) {
 }  // namespace
 
 const std::vector<LibraryEffect>& effect_library(std::string_view system) {
-  static const std::vector<LibraryEffect> kCartpole = cartpole_library();
-  static const std::vector<LibraryEffect> kQuadrotor = quadrotor_library();
-  if (system == "cartpole") return kCartpole;
-  if (system == "quadrotor") return kQuadrotor;
-  make_system(system);  // throws listing the known systems
-  throw std::invalid_argument("no effect library for system '" + std::string(system) + "'");
+  // Entries live as long as the process-wide registry, so the reference stays valid.
+  return find_system(system)->effects;
 }
 
 std::string effect_names(std::string_view system) { return joined_names(effect_library(system)); }
@@ -218,8 +103,11 @@ ModelSpec ModelSpec::with(const LibraryEffect& effect, const VectorCRef& values)
 std::vector<std::string> ModelSpec::describe() const {
   std::vector<std::string> lines;
   for (const auto& [name, value] : parameters) {
-    const LibraryEffect& e = find_effect(system, "param:" + name);
-    lines.push_back(fmt::format("param:{}: {} = {:.6g} {}", name, name, value, e.parameters[0].unit));
+    const LibraryEffect* effect = nullptr;
+    for (const LibraryEffect& e : effect_library(system))
+      if (e.kind == EffectKind::Recalibration && e.recalibrated == name) effect = &e;
+    if (effect == nullptr) throw std::invalid_argument(fmt::format("system '{}' has no parameter '{}' to recalibrate", system, name));
+    lines.push_back(fmt::format("{}: {} = {:.6g} {}", effect->name, name, value, effect->parameters[0].unit));
   }
   if (actuator_gain != 1.0) lines.push_back(fmt::format("actuator_gain: k = {:.6g}", actuator_gain));
   for (const auto& [name, values] : forces) {

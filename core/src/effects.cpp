@@ -106,6 +106,11 @@ void EffectDynamics::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRe
   jacobians->fu.noalias() += s.W * s.dQ_du;
 }
 
+void EffectDynamics::generalised_force(const VectorCRef& x, const VectorCRef& u, VectorRef Q) const {
+  Q.setZero();
+  for (const AppliedEffect& e : effects_) e.effect->add_force(x, u, e.theta, Q, nullptr, nullptr);
+}
+
 void EffectDynamics::input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const {
   if (input_dependent_) {
     Dynamics::input_matrix(x, u, out);

@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "gpilqg/core/effects.hpp"
+
 namespace gpilqg {
 
 std::optional<Integrator> parse_integrator(std::string_view name) {
@@ -153,6 +155,23 @@ void IntegratedStepModel::step(const VectorCRef& x, const VectorCRef& u, VectorR
 void IntegratedStepModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
                                 bool derivatives) const {
   dynamics_->noise(x, u, out, derivatives);
+}
+
+}  // namespace gpilqg
+
+namespace gpilqg {
+
+const OwnIntegrator* own_integrator(const Dynamics& dynamics) {
+  const Dynamics* system = &dynamics;
+  if (const auto* decorated = dynamic_cast<const EffectDynamics*>(system)) system = &decorated->base();
+  return dynamic_cast<const OwnIntegrator*>(system);
+}
+
+std::shared_ptr<const StepModel> make_step_model(DynamicsPtr dynamics, Integrator integrator, double dt,
+                                                 int substeps) {
+  if (!dynamics) throw std::invalid_argument("make_step_model: dynamics is null");
+  if (const OwnIntegrator* own = own_integrator(*dynamics)) return own->own_step_model(dynamics, dt);
+  return std::make_shared<IntegratedStepModel>(std::move(dynamics), integrator, dt, substeps);
 }
 
 }  // namespace gpilqg

@@ -115,7 +115,8 @@ ProfileData read_measurement_profile(const std::filesystem::path& file, const Pr
   for (const Episode& e : set.episodes)
     if (e.length() > 1) dt = e.dt();
   if (!(dt > 0.0)) throw DataError(file, "", "no episode has two samples", "at least one step t -> t+1");
-  const IntegratedStepModel simulator(make_system(options.system, Preset::Simulator), Integrator::RK4, dt);
+  const auto simulator_model = make_step_model(make_system(options.system, Preset::Simulator), Integrator::RK4, dt);
+  const StepModel& simulator = *simulator_model;
   gp::ResidualData residual;
   try {
     residual = gp::make_residual_data(simulator, set);

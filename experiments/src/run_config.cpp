@@ -5,8 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "embedded_run_configs.hpp"
-#include "gpilqg/core/systems.hpp"
+#include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
 #include "gpilqg/gp/fitted_moment_matcher.hpp"
@@ -160,16 +159,24 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
 }  // namespace
 
 const std::string& default_run_config_text(const std::string& system) {
-  static const std::string cartpole = embedded::kRunCartpoleToml;
-  static const std::string quadrotor = embedded::kRunQuadrotorToml;
-  if (system == "cartpole") return cartpole;
-  if (system == "quadrotor") return quadrotor;
-  throw InputError(fmt::format("run: unknown system '{}'; expected \"cartpole\" or \"quadrotor\"", system));
+  try {
+    return find_system(system)->default_run_config;  // entries live as long as the registry
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("run: {}", e.what()));
+  }
 }
 
 RunConfig parse_run_config(const std::string& system, const std::string& override_text, const std::string& source) {
+  const std::string& default_text = default_run_config_text(system);
+  if (default_text.empty()) {
+    // A system without a default config (a MuJoCo model, most plugins): the file is the whole config.
+    if (override_text.empty())
+      throw InputError(fmt::format("run: system '{}' has no default config; give a complete one with --config "
+                                   "(docs/own-system.md shows one)", system));
+    return read_run_config(TomlFields::parse_text(override_text, source), source, system);
+  }
   const std::string defaults_source = fmt::format("<embedded defaults of run {}>", system);
-  const toml::table defaults = TomlFields::parse_text(default_run_config_text(system), defaults_source);
+  const toml::table defaults = TomlFields::parse_text(default_text, defaults_source);
   if (override_text.empty()) return read_run_config(defaults, defaults_source, system);
   toml::table root = TomlFields::parse_text(override_text, source);
   TomlFields::merge(root, defaults);

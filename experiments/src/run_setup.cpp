@@ -9,7 +9,7 @@ namespace gpilqg {
 
 RunModels make_run_models(const RunConfig& c) {
   const auto make = [&](Preset preset) -> std::shared_ptr<const StepModel> {
-    return std::make_shared<IntegratedStepModel>(make_system(c.system, preset, {}, c.noise), c.integrator, c.dt,
+    return make_step_model(make_system(c.system, preset, {}, c.noise), c.integrator, c.dt,
                                                  c.substeps);
   };
   return {make(Preset::RealWorld), make(Preset::Simulator)};

@@ -83,10 +83,11 @@ SolveConfig read_solve_config(const std::filesystem::path& file) {
 
 DdpResult solve_config(const SolveConfig& c) {
   auto dynamics = make_system(c.system, c.preset, {}, c.noise);
-  IntegratedStepModel model(dynamics, c.integrator, c.dt, c.substeps);
+  const auto step_model = make_step_model(dynamics, c.integrator, c.dt, c.substeps);
+  const StepModel& model = *step_model;
   const QuadraticCost cost(c.dt, c.Q.asDiagonal(), c.R.asDiagonal(), c.Qf.asDiagonal(), c.goal);
   DdpProblem problem;
-  problem.model = &model;
+  problem.model = step_model.get();
   problem.cost = &cost;
   problem.x0 = c.x0;
   problem.horizon = c.horizon;

@@ -79,7 +79,8 @@ SyntheticData simulate_measurements(const DynamicsPtr& system, const ExcitationS
   const Vector amplitude = or_default(settings.control_amplitude, m, 1.0);
   const Vector obs_std = or_default(settings.observation_std, n, 0.0);
 
-  IntegratedStepModel world(system, Integrator::RK4, settings.dt, settings.substeps);
+  const auto world_model = make_step_model(system, Integrator::RK4, settings.dt, settings.substeps);
+  const StepModel& world = *world_model;
   std::mt19937_64 rng(settings.seed);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   std::normal_distribution<double> normal(0.0, 1.0);

@@ -12,7 +12,7 @@
 namespace gpilqg::diagnosis {
 
 std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integrator integrator, double dt, int substeps) {
-  return std::make_shared<IntegratedStepModel>(model.build(), integrator, dt, substeps);
+  return gpilqg::make_step_model(model.build(), integrator, dt, substeps);
 }
 
 namespace {

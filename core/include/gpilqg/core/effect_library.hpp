@@ -46,11 +46,13 @@ struct LibraryEffect {
   bool linear = false;                     ///< xdot is linear in the parameters
   ForceEffectPtr force;                    ///< kind == Force only
   std::string recalibrated;                ///< kind == Recalibration: the parameter's name, e.g. "pole_length"
+                                           ///< (for MuJoCo's actuator_gain:<a>, the parameter "<a>.gain")
 };
 
-/// Every effect of the library that applies to the built-in system `system` ("cartpole",
-/// "quadrotor"), in a fixed order: forces, actuator_gain, then param:<name> in the system's parameter
-/// order. Throws std::invalid_argument listing the systems for an unknown name.
+/// Every effect of the library that applies to `system` (a registered name or a MuJoCo model file,
+/// system_registry.hpp), in the entry's fixed order; for the built-in systems: forces, actuator_gain,
+/// then param:<name> in the system's parameter order. Throws std::invalid_argument listing the systems
+/// for an unknown name.
 const std::vector<LibraryEffect>& effect_library(std::string_view system);
 
 /// The library entry called `name`. Throws std::invalid_argument naming `name` and listing every

@@ -116,6 +116,10 @@ class EffectDynamics final : public Dynamics {
   /// db_j/dx = k db_j^base/dx and db_j/du = k^2 db_j^base/du_a; otherwise central differences.
   void input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const override;
 
+  /// Q(x, u) = sum_e Q_e(x, u; theta_e) (k_Q entries, the base system's generalised forces); `u` is
+  /// the commanded input. Used by systems that integrate the forces themselves (OwnIntegrator).
+  void generalised_force(const VectorCRef& x, const VectorCRef& u, VectorRef Q) const;
+
   const Dynamics& base() const { return *base_; }
   double actuator_gain() const { return gain_; }
   const std::vector<AppliedEffect>& effects() const { return effects_; }

@@ -11,6 +11,7 @@
 /// their Jacobians (A = A_s ... A_1, B accumulated), used for finely integrated "real-world" rollouts.
 /// Noise is Euler-Maruyama over the whole step: F is evaluated at (x, u).
 
+#include <memory>
 #include <optional>
 #include <string_view>
 
@@ -54,5 +55,15 @@ class IntegratedStepModel final : public StepModel {
   double dt_;
   int substeps_;
 };
+
+/// The discrete-time simulator of `dynamics` at step dt. A system with its own integrator
+/// (OwnIntegrator, e.g. a MuJoCo model), bare or decorated by EffectDynamics, gives its own step model
+/// and `integrator` and `substeps` are not used; every other system gives
+/// IntegratedStepModel(dynamics, integrator, dt, substeps). Throws std::invalid_argument like either.
+std::shared_ptr<const StepModel> make_step_model(DynamicsPtr dynamics, Integrator integrator, double dt,
+                                                 int substeps = 1);
+
+/// The OwnIntegrator behind `dynamics` (itself or the base an EffectDynamics decorates), or null.
+const OwnIntegrator* own_integrator(const Dynamics& dynamics);
 
 }  // namespace gpilqg

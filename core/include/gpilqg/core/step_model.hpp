@@ -11,6 +11,8 @@
 /// F and G are the continuous-time amplifications; the caller multiplies by sqrt(dt) (paper, appendix).
 /// iLQR uses the mean only, iLQG adds F, Robust-iLQG adds F and G.
 
+#include <memory>
+
 #include "gpilqg/core/dynamics.hpp"
 #include "gpilqg/core/noise.hpp"
 #include "gpilqg/core/types.hpp"
@@ -51,6 +53,19 @@ class StepModel {
 
   /// Convenience: returns phi(x, u).
   Vector next(const VectorCRef& x, const VectorCRef& u) const;
+};
+
+/// A system whose simulator is its own discrete-time integrator rather than one of integrator.hpp's:
+/// a MuJoCo model steps with its own integrator and timestep (DESIGN.md section 10).
+/// make_step_model (integrator.hpp) asks for it.
+class OwnIntegrator {
+ public:
+  virtual ~OwnIntegrator() = default;
+  /// The step model of `decorated` at step dt: `decorated` is this system, or a Dynamics decorating
+  /// it (EffectDynamics) whose gain and forces the step must include. Throws std::invalid_argument
+  /// when dt does not suit the system (for MuJoCo: not a whole multiple of the timestep).
+  virtual std::shared_ptr<const StepModel> own_step_model(std::shared_ptr<const Dynamics> decorated,
+                                                          double dt) const = 0;
 };
 
 }  // namespace gpilqg

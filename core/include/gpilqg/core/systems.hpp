@@ -1,7 +1,8 @@
 #pragma once
 /// @file systems.hpp
-/// The registry of built-in systems by their fixed names (DESIGN.md section 3) and the paper's two
-/// parameter sets: "sim" (the simulator the controller believes) and "real" (the world it acts in).
+/// Systems by name (DESIGN.md sections 3 and 10), through the registry of system_registry.hpp, and the
+/// paper's two parameter sets: "sim" (the simulator the controller believes) and "real" (the world it
+/// acts in). A name is a registered system ("cartpole", "quadrotor", a plugin's) or a MuJoCo model file.
 
 #include <map>
 #include <optional>
@@ -19,18 +20,18 @@ enum class Preset { Simulator, RealWorld };
 std::optional<Preset> parse_preset(std::string_view name);
 std::string_view to_string(Preset preset);
 
-/// The names of all built-in systems: "cartpole", "quadrotor".
-const std::vector<std::string>& system_names();
+/// The registered names: "cartpole", "quadrotor", then those of loaded plugins.
+std::vector<std::string> system_names();
 
 /// Builds a system with a preset's parameters, then applies `overrides` by parameter name
-/// (e.g. {"pole_length", 1.3}) and attaches the noise model F(x, u). Throws std::invalid_argument
-/// listing the valid choices when the system name or a parameter name is unknown, or when a value
-/// or a noise size is invalid.
+/// (e.g. {"pole_length", 1.3}, or {"arm.mass", 1.2} for a MuJoCo model) and attaches the noise model
+/// F(x, u). Throws std::invalid_argument listing the valid choices when the system name or a parameter
+/// name is unknown, or when a value, a model file or a noise size is invalid.
 DynamicsPtr make_system(std::string_view name, Preset preset = Preset::Simulator,
                         const std::map<std::string, double>& overrides = {},
                         const ActuatorNoise& noise = {});
 
-/// The signature (name, states, controls) of a built-in system; throws like make_system.
+/// The signature (name, states, controls) of a system; throws like make_system.
 SystemSignature system_signature(std::string_view name);
 
 }  // namespace gpilqg

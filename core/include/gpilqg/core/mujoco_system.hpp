@@ -1,0 +1,102 @@
+#pragma once
+/// @file mujoco_system.hpp
+/// A MuJoCo model (MJCF, or URDF as MuJoCo loads it) as a gpilqg system (DESIGN.md section 10).
+///
+/// States: the joint positions in model order, named by joint name, then their velocities named
+/// `<joint>_dot`. Controls: the actuators in model order, named by actuator name. Hinge and slide
+/// joints only (then nq = nv and x = [qpos; qvel]); actuators without activation states (na = 0).
+///
+/// Continuous time (Dynamics): xdot = [qvel; qacc(qpos, qvel, k .* u)] from mj_forward, with the
+/// generalised-force map W = [0; M(q)^-1] (nv forces, one per degree of freedom), so the
+/// physical-effects library applies to every model. Jacobians of f are central differences.
+///
+/// Discrete time (OwnIntegrator): the simulator is the model's own integrator and timestep. A step
+/// of length dt = s * timestep is s calls of mj_step; A and B come from MuJoCo's finite differences
+/// (mjd_transitionFD, centred) chained over the s sub-steps:
+///
+///   A = A_s ... A_1,   B = sum_i A_s ... A_{i+1} B_i diag(k),
+///
+/// where k are the actuator gains ("<actuator>.gain", the applied control is k u). Force effects
+/// (EffectDynamics) enter inside every sub-step as passive forces, through MuJoCo's passive-force
+/// callback, so mj_step and mjd_transitionFD both see them, with their dependence on the state.
+///
+/// Parameters by name, each a field of the model (DESIGN.md section 10):
+///   "<body>.mass" (kg; the body's inertia scales with it), "<joint>.damping", "<joint>.armature",
+///   "<joint>.frictionloss", "<joint>.stiffness" (the model's units), "<actuator>.gear" (-),
+///   "<actuator>.gain" (-, 1 in the file: the applied control is gain * u).
+///
+/// Thread safety: a MujocoSystem is immutable. Every evaluation borrows an mjData from a pool owned by
+/// the shared model (each call sets the whole state first, so results do not depend on which mjData it
+/// gets), so any number of threads can step one model.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gpilqg/core/dynamics.hpp"
+#include "gpilqg/core/generalised_forces.hpp"
+#include "gpilqg/core/step_model.hpp"
+#include "gpilqg/core/system_registry.hpp"
+
+namespace gpilqg {
+
+class MujocoModel;  // the loaded mjModel with its names and mjData pool (mujoco_model.hpp, internal)
+
+class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public OwnIntegrator {
+ public:
+  /// Loads `path` and applies `overrides` by parameter name. Throws std::invalid_argument with the
+  /// file (and MuJoCo's line) for a model MuJoCo rejects, naming the joint for a free or ball joint,
+  /// the index for an unnamed joint or actuator, and listing the valid names for an unknown parameter.
+  static std::shared_ptr<MujocoSystem> load(const std::string& path, const std::map<std::string, double>& overrides = {});
+
+  /// The same model with other parameter values (overrides apply on top of this system's values).
+  std::shared_ptr<MujocoSystem> with_parameters(const std::map<std::string, double>& overrides) const;
+
+  const std::string& name() const override;
+  const std::vector<Quantity>& states() const override;
+  const std::vector<Quantity>& controls() const override;
+  std::vector<Parameter> parameters() const override;
+
+  void evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot,
+                DynamicsJacobians* jacobians = nullptr) const override;
+
+  const std::vector<Quantity>& generalised_forces() const override;
+  /// W = [0; M(q)^-1] (n x nv); dW/dx_j by central differences over q_j (zero for velocities).
+  void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const override;
+
+  /// The model's integrator and timestep with `decorated`'s effects (this system, or an EffectDynamics
+  /// over it). Throws std::invalid_argument when dt is not a whole multiple of the timestep.
+  std::shared_ptr<const StepModel> own_step_model(DynamicsPtr decorated, double dt) const override;
+
+  /// The model's timestep [s].
+  double timestep() const;
+  /// The file the model was loaded from.
+  const std::string& path() const;
+  /// Body, joint and actuator names, in model order (bodies without the world body).
+  std::vector<std::string> body_names() const;
+  std::vector<std::string> joint_names() const;
+  std::vector<std::string> actuator_names() const;
+  /// Degree of freedom of a joint, or -1 for an unknown name.
+  int joint_dof(const std::string& joint) const;
+
+  /// The loaded model (internal: mujoco_model.hpp).
+  const std::shared_ptr<const MujocoModel>& model() const { return model_; }
+
+  explicit MujocoSystem(std::shared_ptr<const MujocoModel> model);
+
+ private:
+  std::shared_ptr<const MujocoModel> model_;
+};
+
+/// The registry entry of a model file (system_registry.hpp calls this for names ending in .xml or
+/// .urdf): builder (both presets are the file's values; `overrides` set fields), the generic effect
+/// library of DESIGN.md section 10, no default run config. Throws like MujocoSystem::load.
+SystemEntry mujoco_system_entry(const std::string& path);
+
+/// The generic effects of a system with a generalised-force map whose generalised forces are one per
+/// degree of freedom named after its joints (MuJoCo models): joint_viscous_damping:<joint>,
+/// joint_coulomb_friction:<joint>, actuator_gain:<actuator>, external_force_{x,y,z}:<body>, then
+/// param:<field> for every parameter except the gains.
+std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system);
+
+}  // namespace gpilqg

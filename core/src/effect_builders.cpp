@@ -1,0 +1,84 @@
+#include "gpilqg/core/effect_builders.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace gpilqg::effect_bases {
+
+LinearForceEffect::Basis viscous(int component, int velocity) {
+  return [=](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
+    g(component) = -x(velocity);
+    if (dg_dx != nullptr) (*dg_dx)(component, velocity) = -1.0;
+  };
+}
+
+LinearForceEffect::Basis coulomb(int component, int velocity) {
+  // g = -tanh(v / w), dg/dv = -(1 - tanh^2) / w.
+  return [=](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
+    const double t = std::tanh(x(velocity) / kCoulombWidth);
+    g(component) = -t;
+    if (dg_dx != nullptr) (*dg_dx)(component, velocity) = -(1.0 - t * t) / kCoulombWidth;
+  };
+}
+
+LinearForceEffect::Basis constant(int component) {
+  return [=](const VectorCRef&, VectorRef g, Matrix*) { g(component) = 1.0; };
+}
+
+LinearForceEffect::Basis quadratic_drag(int components, int first_velocity) {
+  // g_i = -|v_i| v_i, dg_i/dv_i = -2 |v_i|.
+  return [=](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
+    for (int i = 0; i < components; ++i) {
+      const double v = x(first_velocity + i);
+      g(i) = -std::abs(v) * v;
+      if (dg_dx != nullptr) (*dg_dx)(i, first_velocity + i) = -2.0 * std::abs(v);
+    }
+  };
+}
+
+}  // namespace gpilqg::effect_bases
+
+namespace gpilqg {
+
+LibraryEffect force_entry(ForceEffectPtr force) {
+  LibraryEffect e;
+  e.name = force->name();
+  e.kind = EffectKind::Force;
+  e.parameters = force->parameters();
+  e.formula = force->formula();
+  e.linear = force->linear_in_parameters();
+  e.force = std::move(force);
+  return e;
+}
+
+LibraryEffect linear_force_entry(std::string name, EffectParameter parameter, std::string formula, int force_dim,
+                                 LinearForceEffect::Basis basis) {
+  return force_entry(std::make_shared<LinearForceEffect>(std::move(name), std::move(parameter), std::move(formula),
+                                                         force_dim, std::move(basis)));
+}
+
+LibraryEffect actuator_gain_entry() {
+  LibraryEffect e;
+  e.name = "actuator_gain";
+  e.kind = EffectKind::ActuatorGain;
+  e.parameters = {{"k", "-", 1.0, 0.0, std::numeric_limits<double>::infinity()}};
+  e.formula = "applied input = k u";
+  e.linear = true;  // the built-in systems are control-affine
+  return e;
+}
+
+LibraryEffect recalibration_entry(std::string effect_name, const Parameter& parameter, bool non_negative, bool linear) {
+  LibraryEffect e;
+  e.name = std::move(effect_name);
+  e.kind = EffectKind::Recalibration;
+  e.recalibrated = parameter.name;
+  const double magnitude = std::abs(parameter.value);
+  e.parameters = {{parameter.name, parameter.unit, std::max(magnitude, 1e-3), non_negative ? 0.0 : 1e-6 * magnitude,
+                   std::numeric_limits<double>::infinity()}};
+  e.formula = "recalibrate " + parameter.name + " [" + parameter.unit + "]";
+  e.linear = linear;
+  return e;
+}
+
+}  // namespace gpilqg

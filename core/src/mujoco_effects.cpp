@@ -1,0 +1,146 @@
+/// The generic effect library of MuJoCo models (DESIGN.md section 10) and their registry entries.
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "gpilqg/core/effect_builders.hpp"
+#include "gpilqg/core/finite_difference.hpp"
+#include "gpilqg/core/mujoco_system.hpp"
+#include "mujoco_model.hpp"
+
+namespace gpilqg {
+namespace {
+
+/// external_force_<axis>:<body>: a constant world-frame force F e_axis at the body's centre of mass,
+///
+///   Q(q) = F J_com(q)' e_axis     (nv generalised forces; J_com the 3 x nv Jacobian of the centre),
+///
+/// linear in F; dQ/dq by central differences of J_com.
+class BodyForceEffect final : public ForceEffect {
+ public:
+  BodyForceEffect(std::shared_ptr<const MujocoModel> model, int body, int axis, std::string name, std::string formula)
+      : model_(std::move(model)), body_(body), axis_(axis), name_(std::move(name)), formula_(std::move(formula)),
+        parameters_{{"F", "N", 1.0}} {}
+
+  const std::string& name() const override { return name_; }
+  const std::vector<EffectParameter>& parameters() const override { return parameters_; }
+  const std::string& formula() const override { return formula_; }
+  bool linear_in_parameters() const override { return true; }
+
+  void add_force(const VectorCRef& x, const VectorCRef&, const VectorCRef& theta, VectorRef Q, Matrix* dQ_dx,
+                 Matrix*) const override {
+    const int nv = model_->nq();
+    Q.noalias() += theta(0) * basis(x);
+    if (dQ_dx == nullptr) return;
+    for (int j = 0; j < nv; ++j) {
+      const double h = kCentralDifferenceStep * std::max(1.0, std::abs(x(j)));
+      Vector plus = x, minus = x;
+      plus(j) += h;
+      minus(j) -= h;
+      dQ_dx->col(j).noalias() += theta(0) * (basis(plus) - basis(minus)) / (2.0 * h);
+    }
+  }
+
+ private:
+  /// J_com(q)' e_axis.
+  Vector basis(const VectorCRef& x) const {
+    const mjModel* m = model_->m();
+    auto d = model_->borrow(x, Vector::Zero(m->nu));
+    mj_kinematics(m, d.get());
+    mj_comPos(m, d.get());
+    std::vector<mjtNum> jacp(static_cast<std::size_t>(3 * m->nv));
+    mj_jacBodyCom(m, d.get(), jacp.data(), nullptr, body_);
+    Vector g(m->nv);
+    for (int i = 0; i < m->nv; ++i) g(i) = jacp[static_cast<std::size_t>(axis_ * m->nv + i)];
+    return g;
+  }
+
+  std::shared_ptr<const MujocoModel> model_;
+  int body_;
+  int axis_;
+  std::string name_;
+  std::string formula_;
+  std::vector<EffectParameter> parameters_;
+};
+
+/// The typical size of a field that may be zero in the file: sets the finite-difference step and
+/// the search box of its recalibration.
+double typical_scale(const std::string& field, double value) {
+  double floor = 1e-3;
+  if (field.ends_with(".damping") || field.ends_with(".frictionloss")) floor = 0.1;
+  else if (field.ends_with(".stiffness")) floor = 1.0;
+  else if (field.ends_with(".armature")) floor = 0.01;
+  return std::max(std::abs(value), floor);
+}
+
+}  // namespace
+
+std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
+  using namespace effect_bases;
+  const auto& model = system.model();
+  const mjModel* m = model->m();
+  const int nv = m->nv;
+  std::vector<LibraryEffect> out;
+  for (const std::string& joint : system.joint_names()) {
+    const int dof = system.joint_dof(joint);
+    const bool slide = m->jnt_type[mj_name2id(m, mjOBJ_JOINT, joint.c_str())] == mjJNT_SLIDE;
+    out.push_back(linear_force_entry("joint_viscous_damping:" + joint, {"b", slide ? "N s/m" : "N m s/rad", 0.1},
+                                     fmt::format("Q_{0} = -b {0}_dot", joint), nv, viscous(dof, nv + dof)));
+    out.push_back(linear_force_entry("joint_coulomb_friction:" + joint, {"tau", slide ? "N" : "N m", 0.1},
+                                     fmt::format("Q_{0} = -tau tanh({0}_dot / 0.05)", joint), nv, coulomb(dof, nv + dof)));
+  }
+  for (const std::string& actuator : system.actuator_names()) {
+    LibraryEffect gain = recalibration_entry("actuator_gain:" + actuator, {actuator + ".gain", "-", 1.0}, true, true);
+    gain.parameters[0].name = "k";
+    gain.formula = fmt::format("actuator {} applies k u", actuator);
+    out.push_back(std::move(gain));
+  }
+  const char* axes[] = {"x", "y", "z"};
+  const auto bodies = system.body_names();
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    if (bodies[b].empty()) continue;
+    for (int axis = 0; axis < 3; ++axis) {
+      const std::string name = fmt::format("external_force_{}:{}", axes[axis], bodies[b]);
+      out.push_back(force_entry(std::make_shared<BodyForceEffect>(
+          model, static_cast<int>(b) + 1, axis, name,
+          fmt::format("constant world-frame force F e_{} at the centre of mass of {}", axes[axis], bodies[b]))));
+    }
+  }
+  for (const Parameter& p : system.parameters()) {
+    if (p.name.ends_with(".gain")) continue;  // actuator_gain:<actuator> above
+    const bool non_negative = !p.name.ends_with(".mass");
+    LibraryEffect e = recalibration_entry("param:" + p.name, p, non_negative, false);
+    e.parameters[0].scale = typical_scale(p.name, p.value);
+    if (p.name.ends_with(".gear")) e.parameters[0].lower = -std::numeric_limits<double>::infinity();
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+SystemEntry mujoco_system_entry(const std::string& path) {
+  const std::shared_ptr<const MujocoSystem> file = MujocoSystem::load(path);
+  SystemEntry entry;
+  entry.name = path;
+  entry.description = fmt::format("MuJoCo model '{}' ({}): {} joints, {} actuators, timestep {} s", file->name(), path,
+                                  file->joint_names().size(), file->actuator_names().size(), file->timestep());
+  entry.origin = path;
+  entry.build = [file](Preset, const std::map<std::string, double>& overrides, const ActuatorNoise& noise) -> DynamicsPtr {
+    // A model file has one parameter set, the file's: both presets build it, and the "real world"
+    // differs by overrides or by another file (DESIGN.md section 10).
+    auto system = overrides.empty() ? std::make_shared<MujocoSystem>(file->model()) : file->with_parameters(overrides);
+    system->set_noise_model(noise);
+    return system;
+  };
+  entry.effects = mujoco_effect_library(*file);
+  for (const std::string& joint : file->joint_names())
+    entry.same_physics.push_back({"param:" + joint + ".damping", "joint_viscous_damping:" + joint});
+  for (const std::string& actuator : file->actuator_names())
+    entry.same_physics.push_back({"param:" + actuator + ".gear", "actuator_gain:" + actuator});
+  return entry;
+}
+
+}  // namespace gpilqg

@@ -1,0 +1,225 @@
+#include "mujoco_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace gpilqg {
+namespace {
+
+/// MuJoCo prints warnings on stdout by default, which would corrupt `--json` output: route them to
+/// stderr, once per process.
+void route_warnings_to_stderr() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    mju_user_warning = [](const char* message) { std::fprintf(stderr, "warning: MuJoCo: %s\n", message); };
+  });
+}
+
+std::string object_name(const mjModel* m, mjtObj type, int id) {
+  const char* name = mj_id2name(m, type, id);
+  return name == nullptr ? std::string() : std::string(name);
+}
+
+/// MuJoCo's multi-line message on one line: "XML Error: ...; Element 'geom', line 5".
+std::string one_line(const std::string& text) {
+  std::string out;
+  bool pending_break = false;
+  for (const char c : text) {
+    if (c == '\n' || c == '\r') {
+      pending_break = !out.empty();
+      continue;
+    }
+    if (pending_break) out += "; ";
+    pending_break = false;
+    out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+MujocoModel::Lease::~Lease() {
+  if (d_ == nullptr) return;
+  std::lock_guard lock(owner_->pool_mutex_);
+  owner_->pool_.push_back(d_);
+}
+
+MujocoModel::MujocoModel(mjModel* m, std::string path) : m_(m), path_(std::move(path)) {}
+
+MujocoModel::~MujocoModel() {
+  for (mjData* d : pool_) mj_deleteData(d);
+  mj_deleteModel(m_);
+}
+
+std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
+  route_warnings_to_stderr();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw std::invalid_argument(fmt::format("{}: no such model file; expected a MuJoCo model (MJCF .xml or URDF)", path));
+  char error[1024] = "";
+  mjModel* m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
+  if (m == nullptr)
+    throw std::invalid_argument(fmt::format("{}: MuJoCo cannot load the model: {}", path, one_line(error)));
+  // One extra userdata slot per mjData holds the passive-force context of the step (mujoco_system.cpp).
+  m->nuserdata += 1;
+  std::shared_ptr<MujocoModel> model(new MujocoModel(m, path));
+  for (int j = 0; j < m->njnt; ++j) {
+    const std::string name = object_name(m, mjOBJ_JOINT, j);
+    const int type = m->jnt_type[j];
+    if (type == mjJNT_FREE || type == mjJNT_BALL)
+      throw std::invalid_argument(fmt::format(
+          "{}: joint {} ('{}') is a {} joint; gpilqg supports hinge and slide joints only (DESIGN.md section 10)", path,
+          j, name.empty() ? "unnamed" : name, type == mjJNT_FREE ? "free" : "ball"));
+    if (name.empty())
+      throw std::invalid_argument(fmt::format(
+          "{}: joint {} has no name; every joint needs one (it names the states in data files)", path, j));
+  }
+  for (int a = 0; a < m->nu; ++a)
+    if (object_name(m, mjOBJ_ACTUATOR, a).empty())
+      throw std::invalid_argument(fmt::format(
+          "{}: actuator {} has no name; every actuator needs one (it names the controls in data files)", path, a));
+  if (m->na > 0)
+    throw std::invalid_argument(fmt::format(
+        "{}: the model has {} actuator activation state(s); gpilqg supports actuators without activation dynamics",
+        path, m->na));
+  if (m->njnt == 0) throw std::invalid_argument(fmt::format("{}: the model has no joints; expected hinge or slide joints", path));
+  if (m->nu == 0) throw std::invalid_argument(fmt::format("{}: the model has no actuators; expected at least one", path));
+  model->read_names();
+  return model;
+}
+
+void MujocoModel::read_names() {
+  name_ = std::string(m_->names);  // the model's name (<mujoco model="...">) comes first in names
+  if (name_.empty() || name_ == "MuJoCo Model") name_ = std::filesystem::path(path_).stem().string();
+  states_.clear();
+  controls_.clear();
+  forces_.clear();
+  for (int j = 0; j < m_->njnt; ++j) {
+    const bool slide = m_->jnt_type[j] == mjJNT_SLIDE;
+    const std::string name = object_name(m_, mjOBJ_JOINT, j);
+    states_.push_back({name, slide ? "m" : "rad"});
+    forces_.push_back({"Q_" + name, slide ? "N" : "N m"});
+  }
+  for (int j = 0; j < m_->njnt; ++j)
+    states_.push_back({object_name(m_, mjOBJ_JOINT, j) + "_dot", m_->jnt_type[j] == mjJNT_SLIDE ? "m/s" : "rad/s"});
+  for (int a = 0; a < m_->nu; ++a) controls_.push_back({object_name(m_, mjOBJ_ACTUATOR, a), "-"});
+  if (gains_.size() != m_->nu) gains_ = Vector::Ones(m_->nu);
+}
+
+std::vector<std::string> MujocoModel::body_names() const {
+  std::vector<std::string> out;
+  for (int b = 1; b < m_->nbody; ++b) out.push_back(object_name(m_, mjOBJ_BODY, b));
+  return out;
+}
+
+std::vector<std::string> MujocoModel::joint_names() const {
+  std::vector<std::string> out;
+  for (int j = 0; j < m_->njnt; ++j) out.push_back(object_name(m_, mjOBJ_JOINT, j));
+  return out;
+}
+
+std::vector<std::string> MujocoModel::actuator_names() const {
+  std::vector<std::string> out;
+  for (int a = 0; a < m_->nu; ++a) out.push_back(object_name(m_, mjOBJ_ACTUATOR, a));
+  return out;
+}
+
+std::vector<MujocoModel::Field> MujocoModel::fields() const {
+  std::vector<Field> out;
+  constexpr double kZero = 0.0;
+  for (int b = 1; b < m_->nbody; ++b) {
+    const std::string name = object_name(m_, mjOBJ_BODY, b);
+    if (!name.empty()) out.push_back({name + ".mass", "kg", &m_->body_mass[b], kZero, true});
+  }
+  for (int j = 0; j < m_->njnt; ++j) {
+    const std::string name = object_name(m_, mjOBJ_JOINT, j);
+    const int dof = m_->jnt_dofadr[j];
+    const bool slide = m_->jnt_type[j] == mjJNT_SLIDE;
+    out.push_back({name + ".damping", slide ? "N s/m" : "N m s/rad", &m_->dof_damping[dof], kZero, false});
+    out.push_back({name + ".armature", slide ? "kg" : "kg m^2", &m_->dof_armature[dof], kZero, false});
+    out.push_back({name + ".frictionloss", slide ? "N" : "N m", &m_->dof_frictionloss[dof], kZero, false});
+    out.push_back({name + ".stiffness", slide ? "N/m" : "N m/rad", &m_->jnt_stiffness[j], kZero, false});
+  }
+  for (int a = 0; a < m_->nu; ++a) {
+    const std::string name = object_name(m_, mjOBJ_ACTUATOR, a);
+    out.push_back({name + ".gear", "-", &m_->actuator_gear[6 * a], -std::numeric_limits<double>::infinity(), false});
+    out.push_back({name + ".gain", "-", const_cast<double*>(&gains_(a)), kZero, false});
+  }
+  return out;
+}
+
+std::vector<Parameter> MujocoModel::parameters() const {
+  std::vector<Parameter> out;
+  for (const Field& f : fields()) out.push_back({f.name, f.unit, *f.value});
+  return out;
+}
+
+std::shared_ptr<const MujocoModel> MujocoModel::with_parameters(const std::map<std::string, double>& overrides) const {
+  mjModel* copy = mj_copyModel(nullptr, m_);
+  if (copy == nullptr) throw std::runtime_error(fmt::format("{}: MuJoCo could not copy the model", path_));
+  std::shared_ptr<MujocoModel> out(new MujocoModel(copy, path_));
+  out->gains_ = gains_;
+  out->read_names();
+  const std::vector<Field> fields = out->fields();
+  for (const auto& [key, value] : overrides) {
+    const auto it = std::find_if(fields.begin(), fields.end(), [&](const Field& f) { return f.name == key; });
+    if (it == fields.end()) {
+      std::string known;
+      for (const Field& f : fields) known += (known.empty() ? "" : ", ") + f.name;
+      throw std::invalid_argument(
+          fmt::format("unknown parameter '{}' for MuJoCo model {}; expected one of: {}", key, path_, known));
+    }
+    if (!std::isfinite(value) || value < it->lower || (it->positive && value <= it->lower))
+      throw std::invalid_argument(fmt::format("parameter '{}' of {} = {}; expected a finite value {} {}", key, path_,
+                                              value, it->positive ? ">" : ">=", it->lower));
+    if (key.ends_with(".mass")) {
+      // The body's rotational inertia scales with its mass (a uniformly denser body).
+      const auto body = static_cast<int>(it->value - copy->body_mass);
+      const double ratio = value / *it->value;
+      for (int k = 0; k < 3; ++k) copy->body_inertia[3 * body + k] *= ratio;
+    }
+    *it->value = value;
+  }
+  if (!overrides.empty()) {
+    // Derived constants (subtree masses, the constraint solver's inverse weights) follow the new fields.
+    mjData* d = mj_makeData(copy);
+    mj_setConst(copy, d);
+    mj_deleteData(d);
+  }
+  return out;
+}
+
+MujocoModel::Lease MujocoModel::borrow(const VectorCRef& x, const VectorCRef& u) const {
+  mjData* d = nullptr;
+  {
+    std::lock_guard lock(pool_mutex_);
+    if (!pool_.empty()) {
+      d = pool_.back();
+      pool_.pop_back();
+    }
+  }
+  if (d == nullptr) d = mj_makeData(m_);
+  if (d == nullptr) throw std::runtime_error(fmt::format("{}: MuJoCo could not allocate its data", path_));
+  Lease lease(*this, d);
+  const int nv = m_->nv;
+  d->time = 0.0;
+  for (int i = 0; i < nv; ++i) {
+    d->qpos[i] = x(i);
+    d->qvel[i] = x(nv + i);
+    d->qacc_warmstart[i] = 0.0;
+    d->qfrc_applied[i] = 0.0;
+  }
+  for (int b = 0; b < 6 * m_->nbody; ++b) d->xfrc_applied[b] = 0.0;
+  for (int a = 0; a < m_->nu; ++a) d->ctrl[a] = gains_(a) * u(a);
+  d->userdata[context_slot()] = 0.0;
+  for (int w = 0; w < mjNWARNING; ++w) d->warning[w].number = 0;
+  return lease;
+}
+
+}  // namespace gpilqg

@@ -1,0 +1,94 @@
+#pragma once
+/// The loaded mjModel behind a MujocoSystem: validated once, immutable afterwards, with its names,
+/// its parameter fields and a pool of mjData that evaluations borrow (mujoco_system.hpp).
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <mujoco/mujoco.h>
+
+#include "gpilqg/core/quantity.hpp"
+#include "gpilqg/core/types.hpp"
+
+namespace gpilqg {
+
+class MujocoModel {
+ public:
+  /// Loads and validates the file (see MujocoSystem::load for the errors).
+  static std::shared_ptr<const MujocoModel> load(const std::string& path);
+
+  /// A copy with parameter fields set by name; throws std::invalid_argument listing the names for
+  /// an unknown one and for a value outside the field's range.
+  std::shared_ptr<const MujocoModel> with_parameters(const std::map<std::string, double>& overrides) const;
+
+  ~MujocoModel();
+  MujocoModel(const MujocoModel&) = delete;
+  MujocoModel& operator=(const MujocoModel&) = delete;
+
+  const mjModel* m() const { return m_; }
+  const std::string& path() const { return path_; }
+  const std::string& name() const { return name_; }
+  int nq() const { return m_->nq; }
+  int nu() const { return m_->nu; }
+
+  const std::vector<Quantity>& states() const { return states_; }
+  const std::vector<Quantity>& controls() const { return controls_; }
+  const std::vector<Quantity>& forces() const { return forces_; }
+  std::vector<Parameter> parameters() const;
+  /// The actuator gains k (nu): the applied control is k .* u.
+  const Vector& gains() const { return gains_; }
+
+  std::vector<std::string> body_names() const;    ///< without the world body
+  std::vector<std::string> joint_names() const;
+  std::vector<std::string> actuator_names() const;
+
+  /// An mjData borrowed from the pool, returned when the lease ends.
+  class Lease {
+   public:
+    Lease(const MujocoModel& owner, mjData* d) : owner_(&owner), d_(d) {}
+    Lease(Lease&& other) noexcept : owner_(other.owner_), d_(other.d_) { other.d_ = nullptr; }
+    Lease(const Lease&) = delete;
+    Lease& operator=(const Lease&) = delete;
+    Lease& operator=(Lease&&) = delete;
+    ~Lease();
+    mjData* operator->() const { return d_; }
+    mjData* get() const { return d_; }
+
+   private:
+    const MujocoModel* owner_;
+    mjData* d_;
+  };
+  /// Borrows an mjData with the state (qpos, qvel) = x, ctrl = k .* u, no applied forces, zero time
+  /// and warm start, and no passive-force context.
+  Lease borrow(const VectorCRef& x, const VectorCRef& u) const;
+
+  /// The index of the userdata slot that holds the passive-force context (mujoco_system.cpp).
+  int context_slot() const { return m_->nuserdata - 1; }
+
+ private:
+  explicit MujocoModel(mjModel* m, std::string path);
+  void read_names();
+
+  struct Field {
+    std::string name;
+    std::string unit;
+    double* value;   ///< in m_
+    double lower;    ///< physical range
+    bool positive;   ///< strictly above lower
+  };
+  /// The named parameter fields, pointing into m_ (which only with_parameters' fresh copy writes).
+  std::vector<Field> fields() const;
+
+  mjModel* m_;
+  std::string path_;
+  std::string name_;
+  std::vector<Quantity> states_, controls_, forces_;
+  Vector gains_;
+  mutable std::mutex pool_mutex_;
+  mutable std::vector<mjData*> pool_;
+};
+
+}  // namespace gpilqg

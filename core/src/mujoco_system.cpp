@@ -1,0 +1,225 @@
+#include "gpilqg/core/mujoco_system.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+#include "gpilqg/core/effects.hpp"
+#include "gpilqg/core/finite_difference.hpp"
+#include "mujoco_model.hpp"
+
+namespace gpilqg {
+namespace {
+
+using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// What the passive-force callback needs during one step: the decorated system's forces.
+struct PassiveContext {
+  const EffectDynamics* effects;
+  const Vector* gains;  ///< k: the commanded input is ctrl ./ k
+};
+
+/// MuJoCo's passive-force callback (mjcb_passive, process-wide): adds the generalised forces of the
+/// step's effects, Q(x, u), to qfrc_passive. The context pointer sits in the mjData's last userdata
+/// slot; mjData without one (no effects) are left alone. Evaluated inside every mj_step and every
+/// perturbed step of mjd_transitionFD, so A and B include dQ/dx.
+void add_effect_forces(const mjModel* m, mjData* d) {
+  const double slot = d->userdata[m->nuserdata - 1];
+  PassiveContext* context = nullptr;
+  std::memcpy(&context, &slot, sizeof context);
+  if (context == nullptr) return;
+  const int nv = m->nv;
+  Vector x(2 * nv), u(m->nu), Q = Vector::Zero(nv);
+  for (int i = 0; i < nv; ++i) {
+    x(i) = d->qpos[i];
+    x(nv + i) = d->qvel[i];
+  }
+  for (int a = 0; a < m->nu; ++a) {
+    const double k = (*context->gains)(a);
+    u(a) = k != 0.0 ? d->ctrl[a] / k : 0.0;
+  }
+  context->effects->generalised_force(x, u, Q);
+  for (int i = 0; i < nv; ++i) d->qfrc_passive[i] += Q(i);
+}
+
+void install_passive_callback() {
+  static std::once_flag once;
+  std::call_once(once, [] { mjcb_passive = add_effect_forces; });
+}
+
+/// The model's own integrator and timestep as a StepModel: dt / timestep calls of mj_step.
+class MujocoStepModel final : public StepModel {
+ public:
+  MujocoStepModel(std::shared_ptr<const MujocoModel> model, DynamicsPtr decorated, double dt)
+      : model_(std::move(model)), decorated_(std::move(decorated)), dt_(dt) {
+    const double timestep = model_->m()->opt.timestep;
+    if (!std::isfinite(dt) || dt <= 0.0)
+      throw std::invalid_argument(fmt::format("step length dt = {}; expected a finite value > 0", dt));
+    const double ratio = dt / timestep;
+    substeps_ = static_cast<int>(std::lround(ratio));
+    if (substeps_ < 1 || std::abs(ratio - substeps_) > 1e-6 * ratio)
+      throw std::invalid_argument(fmt::format(
+          "dt = {} s is not a whole multiple of the MuJoCo model's timestep {} s ({}); use a multiple such as {} s",
+          dt, timestep, model_->path(), std::max(1L, std::lround(ratio)) * timestep));
+    const auto* effects = dynamic_cast<const EffectDynamics*>(decorated_.get());
+    gains_ = model_->gains();
+    if (effects != nullptr) {
+      gains_ *= effects->actuator_gain();
+      if (!effects->effects().empty()) {
+        for (const AppliedEffect& e : effects->effects())
+          if (e.effect->depends_on_input())
+            throw std::invalid_argument(fmt::format(
+                "effect '{}' depends on the input; MuJoCo models take effects of the state only", e.effect->name()));
+        effects_ = effects;
+        install_passive_callback();
+      }
+    }
+  }
+
+  int state_dim() const override { return 2 * model_->nq(); }
+  int control_dim() const override { return model_->nu(); }
+  double dt() const override { return dt_; }
+
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians) const override {
+    const mjModel* m = model_->m();
+    const int nv = m->nv, n = 2 * nv, nu = m->nu;
+    auto d = model_->borrow(x, u);
+    for (int a = 0; a < nu; ++a) d->ctrl[a] = gains_(a) * u(a);
+    PassiveContext context{effects_, &gains_};
+    if (effects_ != nullptr) {
+      const PassiveContext* pointer = &context;
+      std::memcpy(&d->userdata[model_->context_slot()], &pointer, sizeof pointer);
+    }
+    if (jacobians != nullptr) {
+      jacobians->resize(n, nu);
+      jacobians->A.setIdentity();
+      jacobians->B.setZero();
+    }
+    RowMajorMatrix A_sub(n, n), B_sub(n, nu);
+    for (int s = 0; s < substeps_; ++s) {
+      if (jacobians != nullptr) {
+        // Centred differences with MuJoCo's own step; the state of d is restored afterwards.
+        mjd_transitionFD(m, d.get(), 1e-6, 1, A_sub.data(), B_sub.data(), nullptr, nullptr);
+        jacobians->B = A_sub * jacobians->B + B_sub * gains_.asDiagonal();
+        jacobians->A = A_sub * jacobians->A;
+      }
+      mj_step(m, d.get());
+    }
+    const bool unstable = d->warning[mjWARN_BADQACC].number > 0 || d->warning[mjWARN_BADQPOS].number > 0 ||
+                          d->warning[mjWARN_BADQVEL].number > 0;
+    for (int i = 0; i < nv; ++i) {
+      x_next(i) = d->qpos[i];
+      x_next(nv + i) = d->qvel[i];
+    }
+    // MuJoCo resets an unstable simulation to its initial state; report the divergence instead, as
+    // the integrators do, so that rollouts record it as a status.
+    if (unstable) x_next.setConstant(std::numeric_limits<double>::quiet_NaN());
+  }
+
+  int noise_dim() const override { return decorated_->noise_dim(); }
+  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const override {
+    decorated_->noise(x, u, out, derivatives);
+  }
+
+ private:
+  std::shared_ptr<const MujocoModel> model_;
+  DynamicsPtr decorated_;
+  const EffectDynamics* effects_ = nullptr;
+  Vector gains_;
+  double dt_;
+  int substeps_ = 1;
+};
+
+}  // namespace
+
+MujocoSystem::MujocoSystem(std::shared_ptr<const MujocoModel> model) : model_(std::move(model)) {
+  if (!model_) throw std::invalid_argument("MujocoSystem: null model");
+}
+
+std::shared_ptr<MujocoSystem> MujocoSystem::load(const std::string& path, const std::map<std::string, double>& overrides) {
+  auto model = MujocoModel::load(path);
+  if (!overrides.empty()) model = model->with_parameters(overrides);
+  return std::make_shared<MujocoSystem>(std::move(model));
+}
+
+std::shared_ptr<MujocoSystem> MujocoSystem::with_parameters(const std::map<std::string, double>& overrides) const {
+  return std::make_shared<MujocoSystem>(model_->with_parameters(overrides));
+}
+
+const std::string& MujocoSystem::name() const { return model_->name(); }
+const std::vector<Quantity>& MujocoSystem::states() const { return model_->states(); }
+const std::vector<Quantity>& MujocoSystem::controls() const { return model_->controls(); }
+std::vector<Parameter> MujocoSystem::parameters() const { return model_->parameters(); }
+const std::vector<Quantity>& MujocoSystem::generalised_forces() const { return model_->forces(); }
+double MujocoSystem::timestep() const { return model_->m()->opt.timestep; }
+const std::string& MujocoSystem::path() const { return model_->path(); }
+std::vector<std::string> MujocoSystem::body_names() const { return model_->body_names(); }
+std::vector<std::string> MujocoSystem::joint_names() const { return model_->joint_names(); }
+std::vector<std::string> MujocoSystem::actuator_names() const { return model_->actuator_names(); }
+
+int MujocoSystem::joint_dof(const std::string& joint) const {
+  const int id = mj_name2id(model_->m(), mjOBJ_JOINT, joint.c_str());
+  return id < 0 ? -1 : model_->m()->jnt_dofadr[id];
+}
+
+void MujocoSystem::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot,
+                            DynamicsJacobians* jacobians) const {
+  const mjModel* m = model_->m();
+  const int nv = m->nv;
+  {
+    auto d = model_->borrow(x, u);
+    mj_forward(m, d.get());
+    for (int i = 0; i < nv; ++i) {
+      xdot(i) = d->qvel[i];
+      xdot(nv + i) = d->qacc[i];
+    }
+  }
+  if (jacobians == nullptr) return;
+  const Vector x0 = x, u0 = u;
+  const auto f = [&](const Vector& xs, const Vector& us, Vector& out) {
+    auto d = model_->borrow(xs, us);
+    mj_forward(m, d.get());
+    for (int i = 0; i < nv; ++i) {
+      out(i) = d->qvel[i];
+      out(nv + i) = d->qacc[i];
+    }
+  };
+  const int n = 2 * nv;
+  jacobians->fx = central_difference_jacobian([&](const Vector& xs, Vector& out) { f(xs, u0, out); }, x0, n);
+  jacobians->fu = central_difference_jacobian([&](const Vector& us, Vector& out) { f(x0, us, out); }, u0, n);
+}
+
+void MujocoSystem::generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const {
+  const mjModel* m = model_->m();
+  const int nv = m->nv, n = 2 * nv;
+  const Vector u0 = Vector::Zero(m->nu);
+  const auto inverse_mass = [&](const Vector& xs) {
+    auto d = model_->borrow(xs, u0);
+    mj_forward(m, d.get());
+    RowMajorMatrix M(nv, nv);
+    mj_fullM(m, M.data(), d->qM);
+    return Matrix(M.llt().solve(Matrix::Identity(nv, nv)));
+  };
+  W.setZero(n, nv);
+  W.bottomRows(nv) = inverse_mass(x);
+  if (d_dx == nullptr) return;
+  d_dx->assign(static_cast<std::size_t>(n), Matrix::Zero(n, nv));
+  for (int j = 0; j < nv; ++j) {  // M depends on q only
+    const double h = kCentralDifferenceStep * std::max(1.0, std::abs(x(j)));
+    Vector plus = x, minus = x;
+    plus(j) += h;
+    minus(j) -= h;
+    (*d_dx)[static_cast<std::size_t>(j)].bottomRows(nv) = (inverse_mass(plus) - inverse_mass(minus)) / (2.0 * h);
+  }
+}
+
+std::shared_ptr<const StepModel> MujocoSystem::own_step_model(DynamicsPtr decorated, double dt) const {
+  return std::make_shared<MujocoStepModel>(model_, std::move(decorated), dt);
+}
+
+}  // namespace gpilqg

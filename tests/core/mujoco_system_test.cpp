@@ -1,0 +1,255 @@
+// MuJoCo models as systems (mujoco_system.hpp): names, the model's own integrator, Jacobians from
+// mjd_transitionFD against central differences of mj_step, effects inside the step against a
+// hand-written mj_step loop, parameter overrides, thread safety and the errors of DESIGN.md section 10.
+
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/mujoco_system.hpp"
+#include "gpilqg/core/system_registry.hpp"
+#include "test_support.hpp"
+
+namespace gpilqg {
+namespace {
+
+std::string arm_path() { return (test::source_dir() / "data" / "two_link_arm.xml").string(); }
+
+/// A hand-written rollout of the file with MuJoCo's C API: `substeps` calls of mj_step from x under
+/// ctrl = u, with qfrc_applied = force(qpos, qvel) set before each call.
+Vector reference_step(const Vector& x, const Vector& u, int substeps,
+                      const std::function<Vector(const Vector&)>& force = nullptr) {
+  char error[512] = "";
+  mjModel* m = mj_loadXML(arm_path().c_str(), nullptr, error, sizeof error);
+  EXPECT_NE(m, nullptr) << error;
+  mjData* d = mj_makeData(m);
+  for (int i = 0; i < m->nv; ++i) {
+    d->qpos[i] = x(i);
+    d->qvel[i] = x(m->nv + i);
+  }
+  for (int a = 0; a < m->nu; ++a) d->ctrl[a] = u(a);
+  for (int s = 0; s < substeps; ++s) {
+    if (force) {
+      Vector state(2 * m->nv);
+      for (int i = 0; i < m->nv; ++i) {
+        state(i) = d->qpos[i];
+        state(m->nv + i) = d->qvel[i];
+      }
+      const Vector Q = force(state);
+      for (int i = 0; i < m->nv; ++i) d->qfrc_applied[i] = Q(i);
+    }
+    mj_step(m, d);
+  }
+  Vector out(2 * m->nv);
+  for (int i = 0; i < m->nv; ++i) {
+    out(i) = d->qpos[i];
+    out(m->nv + i) = d->qvel[i];
+  }
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  return out;
+}
+
+TEST(MujocoSystem, NamesStatesAndControlsFollowTheModel) {
+  const auto arm = MujocoSystem::load(arm_path());
+  EXPECT_EQ(arm->name(), "two_link_arm");
+  EXPECT_EQ(names_of(arm->states()), (std::vector<std::string>{"shoulder", "elbow", "shoulder_dot", "elbow_dot"}));
+  EXPECT_EQ(names_of(arm->controls()), (std::vector<std::string>{"shoulder_motor", "elbow_motor"}));
+  EXPECT_EQ(arm->states()[0].unit, "rad");
+  EXPECT_EQ(arm->states()[2].unit, "rad/s");
+  EXPECT_DOUBLE_EQ(arm->timestep(), 0.01);
+  EXPECT_EQ(system_signature(arm_path()).name, "two_link_arm");
+}
+
+TEST(MujocoSystem, StepIsTheModelsOwnIntegratorOverWholeTimesteps) {
+  const auto arm = MujocoSystem::load(arm_path());
+  const auto model = make_step_model(arm, Integrator::RK4, 0.05);  // RK4 is not used: the model's Euler is
+  const Vector x = (Vector(4) << 0.4, -0.3, 0.7, -1.1).finished();
+  const Vector u = (Vector(2) << 0.8, -0.5).finished();
+  EXPECT_MATRIX_NEAR(model->next(x, u), reference_step(x, u, 5), 0.0);
+}
+
+TEST(MujocoSystem, TransitionJacobiansMatchCentralDifferencesOfMjStep) {
+  const auto arm = MujocoSystem::load(arm_path());
+  for (const double dt : {0.01, 0.05}) {
+    const auto model = make_step_model(arm, Integrator::Euler, dt);
+    const Vector x = (Vector(4) << 0.9, 1.2, -0.4, 2.0).finished();
+    const Vector u = (Vector(2) << 1.5, -0.7).finished();
+    StepJacobians J;
+    Vector next(4);
+    model->step(x, u, next, &J);
+    const int substeps = static_cast<int>(std::lround(dt / 0.01));
+    const Matrix A = test::numeric_jacobian([&](const Vector& xs) { return reference_step(xs, u, substeps); }, x, 1e-6);
+    const Matrix B = test::numeric_jacobian([&](const Vector& us) { return reference_step(x, us, substeps); }, u, 1e-6);
+    EXPECT_TRUE(test::matrices_near(J.A, A, 1e-6, 1e-6)) << "dt = " << dt;
+    EXPECT_TRUE(test::matrices_near(J.B, B, 1e-6, 1e-6)) << "dt = " << dt;
+  }
+}
+
+TEST(MujocoSystem, ForceEffectsEnterEverySubstepWithTheirStateDerivatives) {
+  // Coulomb friction on the elbow and a constant horizontal force at the forearm's centre of mass.
+  ModelSpec spec;
+  spec.system = arm_path();
+  spec = spec.with(find_effect(arm_path(), "joint_coulomb_friction:elbow"), Vector::Constant(1, 0.3));
+  spec = spec.with(find_effect(arm_path(), "external_force_x:forearm"), Vector::Constant(1, 2.0));
+  const auto model = make_step_model(spec.build(), Integrator::Euler, 0.03);
+  const Vector x = (Vector(4) << 0.3, 0.5, -0.2, 0.04).finished();
+  const Vector u = (Vector(2) << 0.2, 0.1).finished();
+
+  // The reference applies the same forces through qfrc_applied: -tau tanh(qdot / 0.05) on the elbow,
+  // and J_com' F e_x with the forearm's centre at (l1 sin q1 + c2 sin(q1 + q2), ...) along x.
+  const auto forces = [](const Vector& s) {
+    Vector Q = Vector::Zero(2);
+    Q(1) = -0.3 * std::tanh(s(3) / 0.05);
+    // The forearm's centre hangs at x = -(l1 sin q1 + c2 sin(q1 + q2)) (hinges about +y, the chain
+    // along -z at q = 0; data/two_link_arm.xml), so J_com' e_x = dx/dq.
+    const double F = 2.0, l1 = 0.5, c2 = 0.2;
+    Q(0) = F * -(l1 * std::cos(s(0)) + c2 * std::cos(s(0) + s(1)));
+    Q(1) += F * -(c2 * std::cos(s(0) + s(1)));
+    return Q;
+  };
+  StepJacobians J;
+  Vector next(4);
+  model->step(x, u, next, &J);
+  EXPECT_TRUE(test::matrices_near(next, reference_step(x, u, 3, forces), 1e-12, 1e-10));
+  const Matrix A = test::numeric_jacobian([&](const Vector& xs) { return reference_step(xs, u, 3, forces); }, x, 1e-6);
+  EXPECT_TRUE(test::matrices_near(J.A, A, 1e-5, 1e-5));
+}
+
+TEST(MujocoSystem, ParameterOverridesChangeTheModelsFields) {
+  const auto arm = MujocoSystem::load(arm_path());
+  auto find = [](const std::vector<Parameter>& ps, const std::string& name) {
+    for (const auto& p : ps)
+      if (p.name == name) return p.value;
+    ADD_FAILURE() << "no parameter " << name;
+    return 0.0;
+  };
+  EXPECT_DOUBLE_EQ(find(arm->parameters(), "forearm.mass"), 0.6);
+  EXPECT_DOUBLE_EQ(find(arm->parameters(), "elbow.damping"), 0.05);
+  const auto heavier = arm->with_parameters({{"forearm.mass", 0.9}, {"elbow_motor.gear", 2.0}});
+  EXPECT_DOUBLE_EQ(find(heavier->parameters(), "forearm.mass"), 0.9);
+  EXPECT_DOUBLE_EQ(find(heavier->parameters(), "elbow_motor.gear"), 2.0);
+  EXPECT_DOUBLE_EQ(find(arm->parameters(), "forearm.mass"), 0.6);  // the original is unchanged
+  // Doubling the gear doubles the torque: the elbow's acceleration response to its motor doubles.
+  const Vector x = Vector::Zero(4);
+  const Vector u = (Vector(2) << 0.0, 1.0).finished();
+  const auto geared = arm->with_parameters({{"elbow_motor.gear", 2.0}});
+  const Vector a1 = arm->f(x, u) - arm->f(x, Vector::Zero(2));
+  const Vector a2 = geared->f(x, u) - geared->f(x, Vector::Zero(2));
+  EXPECT_TRUE(test::matrices_near(a2, 2.0 * a1, 1e-12, 1e-9));
+  EXPECT_THROW(arm->with_parameters({{"forearm.weight", 1.0}}), std::invalid_argument);
+  EXPECT_THROW(arm->with_parameters({{"forearm.mass", -1.0}}), std::invalid_argument);
+}
+
+TEST(MujocoSystem, GeneralisedForceMapIsTheInverseMassMatrix) {
+  // xdot gains W Q: compare f with qfrc_applied = Q (by an effect) against f + W Q.
+  const auto arm = MujocoSystem::load(arm_path());
+  const Vector x = (Vector(4) << 0.7, -0.4, 0.3, 0.1).finished();
+  const Vector u = Vector::Zero(2);
+  Matrix W;
+  std::vector<Matrix> dW;
+  arm->generalised_force_map(x, W, &dW);
+  const Vector Q = (Vector(2) << 0.3, -0.2).finished();
+  // W Q against the change of qacc when a torque Q is commanded through the unit-gear motors.
+  const Vector by_motors = arm->f(x, Q) - arm->f(x, u);
+  EXPECT_TRUE(test::matrices_near(W * Q, by_motors, 1e-10, 1e-8));
+  const Matrix dW0 = test::numeric_jacobian(
+      [&](const Vector& xs) {
+        Matrix Ws;
+        arm->generalised_force_map(xs, Ws, nullptr);
+        return Vector(Eigen::Map<const Vector>(Ws.data(), Ws.size()));
+      },
+      x, 1e-5);
+  EXPECT_TRUE(test::matrices_near(Eigen::Map<const Vector>(dW[0].data(), dW[0].size()), dW0.col(0), 1e-6, 1e-5));
+}
+
+TEST(MujocoSystem, SeveralThreadsStepOneModel) {
+  const auto model = make_step_model(MujocoSystem::load(arm_path()), Integrator::Euler, 0.05);
+  const Vector u = (Vector(2) << 0.3, -0.2).finished();
+  std::vector<Vector> serial(16), parallel(16);
+  for (int i = 0; i < 16; ++i) serial[i] = model->next(Vector::Constant(4, 0.05 * i), u);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (int i = t; i < 16; i += 4) {
+        StepJacobians J;
+        Vector next(4);
+        model->step(Vector::Constant(4, 0.05 * i), u, next, &J);
+        parallel[i] = next;
+      }
+    });
+  for (auto& th : threads) th.join();
+  for (int i = 0; i < 16; ++i) EXPECT_MATRIX_NEAR(parallel[i], serial[i], 0.0);
+}
+
+TEST(MujocoSystem, TheLibraryHasTheGenericEffectsWithAliases) {
+  const auto& library = effect_library(arm_path());
+  std::vector<std::string> names;
+  for (const auto& e : library) names.push_back(e.name);
+  for (const char* expected :
+       {"joint_viscous_damping:shoulder", "joint_coulomb_friction:elbow", "actuator_gain:elbow_motor",
+        "external_force_x:forearm", "external_force_z:upper_arm", "param:forearm.mass", "param:elbow.damping",
+        "param:elbow.armature", "param:elbow.frictionloss", "param:shoulder.stiffness", "param:shoulder_motor.gear"})
+    EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
+  const auto entry = find_system(arm_path());
+  bool damping_alias = false;
+  for (const auto& group : entry->same_physics)
+    damping_alias = damping_alias || (group == std::vector<std::string>{"param:elbow.damping", "joint_viscous_damping:elbow"});
+  EXPECT_TRUE(damping_alias);
+}
+
+/// Writes `text` to a file in a fresh folder and returns its path.
+std::string write_model(const std::string& label, const std::string& text) {
+  const auto path = test::temporary_dir(label) / "model.xml";
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+std::string load_error(const std::string& path) {
+  try {
+    MujocoSystem::load(path);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MujocoSystem, BadModelsAreRefusedWithWhatIsWrong) {
+  const std::string body_open = "<mujoco><worldbody><body name=\"b\">";
+  const std::string body_close = "<geom size=\"0.1\" mass=\"1\"/></body></worldbody>";
+  EXPECT_NE(load_error(write_model("mj_free", body_open + "<joint name=\"j\" type=\"free\"/>" + body_close +
+                                                  "<actuator><motor name=\"m\" joint=\"j\"/></actuator></mujoco>"))
+                .find("joint 0 ('j') is a free joint"),
+            std::string::npos);
+  EXPECT_NE(load_error(write_model("mj_ball", body_open + "<joint name=\"ball\" type=\"ball\"/>" + body_close +
+                                                  "<actuator><motor name=\"m\" joint=\"ball\" gear=\"1 0 0\"/></actuator></mujoco>"))
+                .find("'ball') is a ball joint"),
+            std::string::npos);
+  EXPECT_NE(load_error(write_model("mj_unnamed_joint", body_open + "<joint type=\"hinge\"/>" + body_close + "</mujoco>"))
+                .find("joint 0 has no name"),
+            std::string::npos);
+  EXPECT_NE(load_error(write_model("mj_unnamed_actuator", body_open + "<joint name=\"j\" type=\"hinge\"/>" + body_close +
+                                                              "<actuator><motor joint=\"j\"/></actuator></mujoco>"))
+                .find("actuator 0 has no name"),
+            std::string::npos);
+  const std::string parse = load_error(write_model("mj_parse", "<mujoco>\n<worldbody>\n<body>\n<geom size=\"1\" bad=\"2\"/>\n"
+                                                               "</body></worldbody></mujoco>\n"));
+  EXPECT_NE(parse.find("model.xml: MuJoCo cannot load the model"), std::string::npos) << parse;
+  EXPECT_NE(parse.find("line 4"), std::string::npos) << parse;
+  EXPECT_NE(load_error("/nonexistent/model.xml").find("no such model file"), std::string::npos);
+  const auto arm = MujocoSystem::load(arm_path());
+  try {
+    make_step_model(arm, Integrator::Euler, 0.025);
+    ADD_FAILURE() << "dt = 0.025 with a 0.01 s timestep was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("not a whole multiple of the MuJoCo model's timestep 0.01"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace gpilqg
