@@ -162,6 +162,19 @@ std::vector<std::string> MujocoSystem::body_names() const { return model_->body_
 std::vector<std::string> MujocoSystem::joint_names() const { return model_->joint_names(); }
 std::vector<std::string> MujocoSystem::actuator_names() const { return model_->actuator_names(); }
 
+std::pair<Vector, Vector> MujocoSystem::control_limits() const {
+  const mjModel* m = model_->m();
+  const double inf = std::numeric_limits<double>::infinity();
+  Vector lower = Vector::Constant(m->nu, -inf), upper = Vector::Constant(m->nu, inf);
+  for (int a = 0; a < m->nu; ++a) {
+    const double k = model_->gains()(a);
+    if (!m->actuator_ctrllimited[a] || k <= 0.0) continue;
+    lower(a) = m->actuator_ctrlrange[2 * a] / k;
+    upper(a) = m->actuator_ctrlrange[2 * a + 1] / k;
+  }
+  return {lower, upper};
+}
+
 int MujocoSystem::joint_dof(const std::string& joint) const {
   const int id = mj_name2id(model_->m(), mjOBJ_JOINT, joint.c_str());
   return id < 0 ? -1 : model_->m()->jnt_dofadr[id];

@@ -21,4 +21,15 @@ DynamicsPtr make_system(std::string_view name, Preset preset, const std::map<std
 
 SystemSignature system_signature(std::string_view name) { return make_system(name)->signature(); }
 
+std::string signature_mismatch(const SystemSignature& a, const SystemSignature& b) {
+  const auto list = [](const std::vector<Quantity>& q) {
+    std::string out;
+    for (const auto& name : names_of(q)) out += (out.empty() ? "" : ", ") + name;
+    return out;
+  };
+  if (names_of(a.states) == names_of(b.states) && names_of(a.controls) == names_of(b.controls)) return "";
+  return "'" + b.name + "' has states [" + list(b.states) + "] and controls [" + list(b.controls) + "], but '" + a.name +
+         "' has states [" + list(a.states) + "] and controls [" + list(a.controls) + "]";
+}
+
 }  // namespace gpilqg

@@ -53,6 +53,15 @@ std::vector<RunTask> read_tasks(const TomlFields& f, const toml::table& root, in
   return out;
 }
 
+/// The same registered name, or two paths of the same model file.
+bool same_system(const std::string& a, const std::string& b) {
+  if (a == b) return true;
+  if (!is_model_file_name(a) || !is_model_file_name(b)) return false;
+  std::error_code ea, eb;
+  const auto ca = std::filesystem::weakly_canonical(a, ea), cb = std::filesystem::weakly_canonical(b, eb);
+  return !ea && !eb && ca == cb;
+}
+
 bool boolean(const TomlFields& f, const toml::table& root, const std::string& path) {
   const toml::node* node = root.at_path(path).node();
   if (node == nullptr) f.fail(path, "missing; expected true or false");
@@ -76,16 +85,19 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
   const TomlFields f(root, source);
   f.only_keys("", {"system", "noise", "control", "tasks", "loop", "gp", "solver", "mpc", "pddp"});
   RunConfig c;
-  c.system = f.string("system.name");
-  if (c.system != system) f.fail("system.name", fmt::format("is '{}' but the command runs '{}'", c.system, system));
+  c.system = f.system_name("system.name");
+  if (!same_system(c.system, system))
+    f.fail("system.name", fmt::format("is '{}' but the command runs '{}'", c.system, system));
   const SystemSignature signature = f.system("system.name");
   const int n = static_cast<int>(signature.states.size());
   const int m = static_cast<int>(signature.controls.size());
 
   c.dt = f.number("system.dt");
   if (c.dt <= 0.0) f.fail("system.dt", "must be > 0");
-  c.integrator = f.integrator("system.integrator");
-  c.substeps = positive_integer(f, "system.substeps", 1);
+  if (!f.own_integrator(c.system, "system.integrator", "system.substeps")) {
+    c.integrator = f.integrator("system.integrator");
+    c.substeps = positive_integer(f, "system.substeps", 1);
+  }
 
   c.noise.multiplicative_std = non_negative(f, "noise.actuator_multiplicative", m, Vector());
   c.noise.additive_std = non_negative(f, "noise.actuator_additive", m, Vector());

@@ -29,7 +29,7 @@ SolveConfig read_solve_config(const std::filesystem::path& file) {
                          "max_seconds"});
 
   SolveConfig c;
-  c.system = f.string("system.name");
+  c.system = f.system_name("system.name");
   const SystemSignature signature = f.system("system.name");
   const int n = static_cast<int>(signature.states.size());
   const int m = static_cast<int>(signature.controls.size());
@@ -37,10 +37,12 @@ SolveConfig read_solve_config(const std::filesystem::path& file) {
   const std::string preset = f.string("system.preset", "sim");
   if (auto p = parse_preset(preset)) c.preset = *p;
   else f.fail("system.preset", fmt::format("'{}'; expected \"sim\" or \"real\"", preset));
-  c.integrator = f.integrator("system.integrator", "euler");
+  if (!f.own_integrator(c.system, "system.integrator", "system.substeps")) {
+    c.integrator = f.integrator("system.integrator", "euler");
+    c.substeps = f.integer_in("system.substeps", 1, kMaxSubsteps, 1);
+  }
   c.dt = f.number("system.dt");
   if (c.dt <= 0.0) f.fail("system.dt", "must be > 0");
-  c.substeps = f.integer_in("system.substeps", 1, kMaxSubsteps, 1);
 
   c.noise.additive_std = f.vector("noise.actuator_additive", m, Vector());
   c.noise.multiplicative_std = f.vector("noise.actuator_multiplicative", m, Vector());

@@ -6,7 +6,9 @@
 #include <string>
 
 #include "gpilqg/control/rollout.hpp"
+#include "gpilqg/core/effects.hpp"
 #include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/mujoco_system.hpp"
 
 namespace gpilqg {
 
@@ -19,6 +21,12 @@ void check_size(const Vector& v, int expected, const char* field) {
                                 std::to_string(expected) + " (or none)");
   if (!v.allFinite())
     throw std::invalid_argument(std::string("excitation field '") + field + "' has non-finite entries");
+}
+
+/// The system an EffectDynamics decorates, or the system itself.
+const Dynamics* bare_system(const Dynamics& system) {
+  if (const auto* decorated = dynamic_cast<const EffectDynamics*>(&system)) return &decorated->base();
+  return &system;
 }
 
 Vector or_default(const Vector& v, int size, double fill) {
@@ -58,6 +66,21 @@ ExcitationSettings default_excitation(const Dynamics& system) {
     s.nominal_control = Vector::Constant(m, hover);
     s.control_amplitude = Vector::Constant(m, 0.1 * hover);
     s.steps = 100;
+    s.observation_std = Vector::Constant(n, 1e-3);
+  } else if (const auto* mujoco = dynamic_cast<const MujocoSystem*>(bare_system(system))) {
+    // A MuJoCo model: from rest at the model's zero configuration, the excitation spans the
+    // actuators' control ranges (+-1 where unlimited), sampled at the whole timestep nearest 0.02 s.
+    const auto [lower, upper] = mujoco->control_limits();
+    s.nominal_state = Vector::Zero(n);
+    s.initial_spread = Vector::Constant(n, 0.1);
+    s.nominal_control = Vector::Zero(m);
+    s.control_amplitude = Vector::Ones(m);
+    for (int j = 0; j < m; ++j)
+      if (std::isfinite(lower(j)) && std::isfinite(upper(j))) {
+        s.nominal_control(j) = 0.5 * (lower(j) + upper(j));
+        s.control_amplitude(j) = 0.5 * (upper(j) - lower(j));
+      }
+    s.dt = mujoco->timestep() * std::max(1.0, std::round(0.02 / mujoco->timestep()));
     s.observation_std = Vector::Constant(n, 1e-3);
   } else {
     s.nominal_state = Vector::Zero(n);

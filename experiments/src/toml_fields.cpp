@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 
@@ -60,8 +62,39 @@ void merge_level(toml::table& overrides, const toml::table& base, const std::str
 
 void TomlFields::merge(toml::table& overrides, const toml::table& base) { merge_level(overrides, base, ""); }
 
+std::string toml_key(const std::string& key) {
+  const bool bare = !key.empty() && key.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") ==
+                                        std::string::npos;
+  if (bare) return key;
+  std::string out = "\"";
+  for (const char c : key) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
 const toml::node* TomlFields::find(const std::string& path) const {
-  return root_.at_path(path).node();
+  if (path.find('"') == std::string::npos) return root_.at_path(path).node();
+  // A path with quoted keys (toml_key), e.g. parameters."elbow.damping": walk it segment by segment.
+  const toml::node* node = &root_;
+  std::size_t i = 0;
+  while (i < path.size() && node != nullptr) {
+    std::string key;
+    if (path[i] == '"') {
+      for (++i; i < path.size() && path[i] != '"'; ++i) {
+        if (path[i] == '\\' && i + 1 < path.size()) ++i;
+        key += path[i];
+      }
+      ++i;  // the closing quote
+    } else {
+      while (i < path.size() && path[i] != '.') key += path[i++];
+    }
+    const toml::table* table = node->as_table();
+    node = table == nullptr ? nullptr : table->get(key);
+    if (i < path.size() && path[i] == '.') ++i;
+  }
+  return node;
 }
 
 bool TomlFields::has(const std::string& path) const { return find(path) != nullptr; }
@@ -159,13 +192,38 @@ Vector TomlFields::vector(const std::string& path, int size, std::optional<Vecto
   return v;
 }
 
+std::string TomlFields::system_name(const std::string& path) const {
+  std::string name = string(path);
+  if (is_model_file_name(name) && std::filesystem::path(name).is_relative()) {
+    const toml::node* node = find(path);
+    const std::filesystem::path config(source_of(node));
+    name = (config.parent_path() / name).lexically_normal().string();
+  }
+  try {
+    (void)find_system(name);
+  } catch (const std::invalid_argument& e) {
+    fail(path, e.what());
+  }
+  return name;
+}
+
 SystemSignature TomlFields::system(const std::string& path) const {
-  const std::string name = string(path);
+  const std::string name = system_name(path);
   try {
     return system_signature(name);
   } catch (const std::invalid_argument& e) {
     fail(path, e.what());
   }
+}
+
+bool TomlFields::own_integrator(const std::string& system_name, const std::string& integrator_path,
+                                const std::string& substeps_path) const {
+  if (gpilqg::own_integrator(*make_system(system_name)) == nullptr) return false;
+  for (const std::string& field : {integrator_path, substeps_path})
+    if (has(field))
+      fail(field, "not used: the system's own integrator and timestep are its simulator (a MuJoCo model's "
+                  "<option integrator=... timestep=...>); remove this field");
+  return true;
 }
 
 Integrator TomlFields::integrator(const std::string& path, std::optional<std::string> fallback) const {

@@ -23,6 +23,7 @@ struct SimulateOptions {
   std::string system;
   std::string preset = "real";
   std::string out;
+  std::string world_file;
   std::vector<std::string> parameters;
   std::vector<std::string> effects;
   int episodes = -1;
@@ -66,12 +67,18 @@ int run_simulate(const SimulateOptions& o) {
   // The world: the preset with overridden parameters and hidden effects of the library.
   ModelSpec world;
   world.system = o.system;
+  if (!o.world_file.empty()) {
+    // Another model file with the same joints and actuators is the world; the data are the system's.
+    const std::string mismatch = signature_mismatch(signature, system_signature(o.world_file));
+    if (!mismatch.empty()) throw InputError("--world " + o.world_file + ": " + mismatch);
+    world.system = o.world_file;
+  }
   world.preset = *preset;
   world.parameters = parse_parameters(o.parameters);
   for (const std::string& text : o.effects) {
-    const diagnosis::EffectRequest request = diagnosis::parse_add_option(text, o.system, "--effect");
+    const diagnosis::EffectRequest request = diagnosis::parse_add_option(text, world.system, "--effect");
     if (!request.values) throw InputError("--effect '" + text + "': expected EFFECT=VALUE, e.g. cart_coulomb_friction=1");
-    world = world.with(find_effect(o.system, request.effect), *request.values);
+    world = world.with(find_effect(world.system, request.effect), *request.values);
   }
   const auto system = world.build(noise);
 
@@ -82,7 +89,8 @@ int run_simulate(const SimulateOptions& o) {
   if (o.observation_noise >= 0.0) settings.observation_std = Vector::Constant(n, o.observation_noise);
   settings.seed = o.seed;
 
-  const SyntheticData data = simulate_measurements(system, settings);
+  SyntheticData data = simulate_measurements(system, settings);
+  data.set.system = signature;
   write_measurements(o.out, data.set);
   std::cout << fmt::format("wrote {}: {} {} preset, {} episodes, {} samples, dt = {} s, seed {}\n", o.out,
                            o.system, o.preset, data.set.episodes.size(), data.set.sample_count(),
@@ -99,7 +107,10 @@ void add_simulate_command(CLI::App& app, CommandAction& action) {
   auto options = std::make_shared<SimulateOptions>();
   auto* cmd = app.add_subcommand(
       "simulate", "Write synthetic measurements: a system preset under random excitation, with noise");
-  cmd->add_option("--system", options->system, "System name (cartpole, quadrotor)")->required();
+  cmd->add_option("--system", options->system,
+                  "System: cartpole, quadrotor, a MuJoCo model file (.xml) or a plugin's system")->required();
+  cmd->add_option("--world", options->world_file,
+                  "A second MuJoCo model file with the same joints and actuators to simulate instead of --system");
   cmd->add_option("--preset", options->preset, "Parameter set: sim or real")->capture_default_str();
   cmd->add_option("--param", options->parameters, "Override a physical parameter, NAME=VALUE (repeatable)");
   cmd->add_option("--effect", options->effects,

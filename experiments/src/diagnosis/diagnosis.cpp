@@ -107,8 +107,9 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   if (set.episodes.empty()) throw std::invalid_argument("the data has no episodes");
   DiagnosisReport R;
   R.system = o.model.system;
-  if (set.system.name != R.system)
-    throw std::invalid_argument("the data are of system '" + set.system.name + "'; the model is '" + R.system + "'");
+  // A model file's data carry the model's name (<mujoco model="...">), not the file's path.
+  if (const std::string model_name = system_signature(R.system).name; set.system.name != model_name)
+    throw std::invalid_argument("the data are of system '" + set.system.name + "'; the model is '" + model_name + "'");
   R.model_before = o.model;
   R.state_names = names_of(set.system.states);
   R.control_names = names_of(set.system.controls);

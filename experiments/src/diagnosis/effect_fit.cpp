@@ -9,6 +9,8 @@
 #include <Eigen/Dense>
 #include <nlopt.hpp>
 
+#include "gpilqg/core/system_registry.hpp"
+
 namespace gpilqg::diagnosis {
 
 std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integrator integrator, double dt, int substeps) {
@@ -284,7 +286,20 @@ EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, co
   return fit;
 }
 
+namespace {
+
+/// True when the system's entry declares `a` and `b` the same physics (system_registry.hpp).
+bool same_physics(const SystemEntry& entry, const std::string& a, const std::string& b) {
+  for (const auto& group : entry.same_physics)
+    if (std::find(group.begin(), group.end(), a) != group.end() && std::find(group.begin(), group.end(), b) != group.end())
+      return true;
+  return false;
+}
+
+}  // namespace
+
 std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold) {
+  const SystemEntryPtr system = find_system(context.model.system);
   std::vector<EffectFit> fits;
   for (const LibraryEffect& effect : effect_library(context.model.system)) fits.push_back(fit_effect(effect, context));
   std::stable_sort(fits.begin(), fits.end(),
@@ -296,7 +311,11 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_t
     used[i] = true;
     RankedEffect entry{fits[i], {}};
     for (std::size_t j = i + 1; j < fits.size(); ++j) {
-      if (used[j] || regressor_correlation(fits[i].regressor, fits[j].regressor) < alias_threshold) continue;
+      if (used[j]) continue;
+      // Aliases: nearly collinear regressors on these data, or the same physics by declaration.
+      if (regressor_correlation(fits[i].regressor, fits[j].regressor) < alias_threshold &&
+          !same_physics(*system, fits[i].effect, fits[j].effect))
+        continue;
       used[j] = true;
       entry.aliases.push_back(fits[j]);
     }

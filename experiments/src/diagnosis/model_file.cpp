@@ -39,9 +39,12 @@ ModelSpec read_model_file(const std::filesystem::path& file, const std::string& 
   fields.require_section("model");
   fields.only_keys("model", {"system", "preset"});
   ModelSpec model;
-  model.system = fields.string("model.system");
-  if (model.system != system)
-    fields.fail("model.system", fmt::format("is '{}' but --system is '{}'; expected the same system", model.system, system));
+  // The file names the system by its signature name ("cartpole", a MuJoCo model's name), so it stays
+  // valid when the model file is given by another path.
+  const std::string named = fields.string("model.system");
+  if (named != system && named != system_signature(system).name)
+    fields.fail("model.system", fmt::format("is '{}' but --system is '{}'; expected the same system", named, system));
+  model.system = system;
   const std::string preset = fields.string("model.preset", std::string("sim"));
   const auto parsed = parse_preset(preset);
   if (!parsed) fields.fail("model.preset", fmt::format("'{}'; expected \"sim\" or \"real\"", preset));
@@ -50,16 +53,16 @@ ModelSpec read_model_file(const std::filesystem::path& file, const std::string& 
   if (const toml::table* parameters = root["parameters"].as_table()) {
     for (const auto& [key, node] : *parameters) {
       const std::string name(key.str());
-      const std::string path = "parameters." + name;
+      const std::string path = "parameters." + toml_key(name);
       const LibraryEffect* effect = nullptr;
-      try {
-        effect = &find_effect(system, "param:" + name);
-      } catch (const std::invalid_argument&) {
-        std::string valid;
-        for (const auto& e : effect_library(system))
-          if (e.kind == EffectKind::Recalibration) valid += (valid.empty() ? "" : ", ") + e.recalibrated;
-        fields.fail(path, fmt::format("unknown parameter '{}' of system '{}'; expected one of: {}", name, system, valid));
+      std::string valid;
+      for (const auto& e : effect_library(system)) {
+        if (e.kind != EffectKind::Recalibration) continue;
+        if (e.recalibrated == name) effect = &e;
+        valid += (valid.empty() ? "" : ", ") + e.recalibrated;
       }
+      if (effect == nullptr)
+        fields.fail(path, fmt::format("unknown parameter '{}' of system '{}'; expected one of: {}", name, system, valid));
       const Vector value = Vector::Constant(1, fields.number(path));
       check_values(model, *effect, value, [&](const std::string& why) { fields.fail(path, why); });
       model = model.with(*effect, value);
@@ -71,7 +74,7 @@ ModelSpec read_model_file(const std::filesystem::path& file, const std::string& 
   if (const toml::table* effects = root["effects"].as_table()) {
     for (const auto& [key, node] : *effects) {
       const std::string name(key.str());
-      const std::string path = "effects." + name;
+      const std::string path = "effects." + toml_key(name);
       const LibraryEffect* effect = nullptr;
       try {
         effect = &find_effect(system, name);
@@ -102,10 +105,11 @@ ModelSpec read_model_file(const std::filesystem::path& file, const std::string& 
 std::string model_file_text(const ModelSpec& model, const std::vector<std::string>& comment) {
   std::string out;
   for (const auto& line : comment) out += "# " + line + "\n";
-  out += fmt::format("[model]\nsystem = \"{}\"\npreset = \"{}\"\n", model.system, to_string(model.preset));
+  out += fmt::format("[model]\nsystem = \"{}\"\npreset = \"{}\"\n", system_signature(model.system).name,
+                     to_string(model.preset));
   if (!model.parameters.empty()) {
     out += "\n[parameters]\n";
-    for (const auto& [name, value] : model.parameters) out += fmt::format("{} = {}\n", name, value);
+    for (const auto& [name, value] : model.parameters) out += fmt::format("{} = {}\n", toml_key(name), value);
   }
   if (model.actuator_gain != 1.0 || !model.forces.empty()) {
     out += "\n[effects]\n";
@@ -115,7 +119,7 @@ std::string model_file_text(const ModelSpec& model, const std::vector<std::strin
       std::string table;
       for (std::size_t i = 0; i < effect.parameters.size(); ++i)
         table += fmt::format("{}{} = {}", i == 0 ? "" : ", ", effect.parameters[i].name, values(static_cast<Eigen::Index>(i)));
-      out += fmt::format("{} = {{ {} }}   # {}\n", name, table, effect.formula);
+      out += fmt::format("{} = {{ {} }}   # {}\n", toml_key(name), table, effect.formula);
     }
   }
   return out;

@@ -76,6 +76,9 @@ class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public
   std::vector<std::string> body_names() const;
   std::vector<std::string> joint_names() const;
   std::vector<std::string> actuator_names() const;
+  /// The actuators' control ranges [lower, upper] in units of u (ctrlrange over the gain; infinite
+  /// for actuators without ctrllimited).
+  std::pair<Vector, Vector> control_limits() const;
   /// Degree of freedom of a joint, or -1 for an unknown name.
   int joint_dof(const std::string& joint) const;
 

@@ -34,4 +34,8 @@ DynamicsPtr make_system(std::string_view name, Preset preset = Preset::Simulator
 /// The signature (name, states, controls) of a system; throws like make_system.
 SystemSignature system_signature(std::string_view name);
 
+/// Empty when `b` has the same states and controls (names, in order) as `a`; otherwise a message
+/// listing both sets, e.g. for a "real world" model file that must match the simulator's.
+std::string signature_mismatch(const SystemSignature& a, const SystemSignature& b);
+
 }  // namespace gpilqg

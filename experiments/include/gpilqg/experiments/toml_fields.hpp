@@ -17,6 +17,10 @@
 
 namespace gpilqg {
 
+/// `key` as a TOML key: bare when it is made of letters, digits, '_' and '-', else quoted (names
+/// such as "elbow.damping" or "joint_viscous_damping:elbow"). TomlFields paths accept quoted keys.
+std::string toml_key(const std::string& key);
+
 class TomlFields {
  public:
   /// Parses `file`; a syntax error becomes an InputError "<file>:line N: <what>".
@@ -45,10 +49,19 @@ class TomlFields {
   /// An array of numbers; `size` >= 0 requires that many entries.
   Vector vector(const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) const;
   bool has(const std::string& path) const;
-  /// A built-in system's name (DESIGN.md section 3) and its signature; unknown names fail listing the systems.
+  /// A system's name (DESIGN.md sections 3 and 10) as the registry resolves it: a MuJoCo model file
+  /// given by a relative path is relative to the config file's folder. Fails naming the field for an
+  /// unknown system or a model file that cannot be loaded.
+  std::string system_name(const std::string& path) const;
+  /// The signature of system_name(path); fails like it.
   SystemSignature system(const std::string& path) const;
   /// "euler" or "rk4".
   Integrator integrator(const std::string& path, std::optional<std::string> fallback = std::nullopt) const;
+  /// For a system with its own integrator (a MuJoCo model, whose integrator and timestep are the
+  /// simulator) fails when `integrator_path` or `substeps_path` is given, and returns true; false
+  /// for every other system.
+  bool own_integrator(const std::string& system_name, const std::string& integrator_path,
+                      const std::string& substeps_path) const;
 
   /// "<file>:line N: field 'a.b': <problem>" (line when the node is known).
   [[noreturn]] void fail(const std::string& path, const std::string& problem) const;
