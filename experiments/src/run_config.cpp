@@ -81,9 +81,33 @@ Vector non_negative(const TomlFields& f, const std::string& path, int size, std:
   return v;
 }
 
+/// [world]: `model`, another model file with the same states and controls (relative to the config's
+/// folder), and `parameters`, overrides by parameter name; both optional. Every override is checked by
+/// building the world once.
+void read_world(const TomlFields& f, const toml::table& root, RunConfig& c, const SystemSignature& signature) {
+  if (!f.has("world")) return;
+  f.only_keys("world", {"model", "parameters"});
+  if (f.has("world.model")) {
+    c.world_model = f.system_name("world.model");
+    const std::string mismatch = signature_mismatch(signature, system_signature(c.world_model));
+    if (!mismatch.empty()) f.fail("world.model", mismatch);
+  }
+  if (const toml::node* node = root.at_path("world.parameters").node()) {
+    const toml::table* table = node->as_table();
+    if (table == nullptr) f.fail("world.parameters", "is not a table; expected name = value entries");
+    for (const auto& [key, value] : *table)
+      c.world_parameters[std::string(key.str())] = f.number("world.parameters." + toml_key(std::string(key.str())));
+  }
+  try {
+    (void)make_system(c.world_model.empty() ? c.system : c.world_model, Preset::RealWorld, c.world_parameters);
+  } catch (const std::invalid_argument& e) {
+    f.fail("world.parameters", e.what());
+  }
+}
+
 RunConfig read_run_config(const toml::table& root, const std::string& source, const std::string& system) {
   const TomlFields f(root, source);
-  f.only_keys("", {"system", "noise", "control", "tasks", "loop", "gp", "solver", "mpc", "pddp"});
+  f.only_keys("", {"system", "world", "noise", "control", "tasks", "loop", "gp", "solver", "mpc", "pddp"});
   RunConfig c;
   c.system = f.system_name("system.name");
   if (!same_system(c.system, system))
@@ -98,6 +122,8 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
     c.integrator = f.integrator("system.integrator");
     c.substeps = positive_integer(f, "system.substeps", 1);
   }
+
+  read_world(f, root, c, signature);
 
   c.noise.multiplicative_std = non_negative(f, "noise.actuator_multiplicative", m, Vector());
   c.noise.additive_std = non_negative(f, "noise.actuator_additive", m, Vector());

@@ -9,6 +9,10 @@ namespace gpilqg {
 
 RunModels make_run_models(const RunConfig& c) {
   const auto make = [&](Preset preset) -> std::shared_ptr<const StepModel> {
+    if (preset == Preset::RealWorld)  // the world: another model file and parameter overrides when configured
+      return make_step_model(make_system(c.world_model.empty() ? c.system : c.world_model, preset, c.world_parameters,
+                                         c.noise),
+                             c.integrator, c.dt, c.substeps);
     return make_step_model(make_system(c.system, preset, {}, c.noise), c.integrator, c.dt,
                                                  c.substeps);
   };

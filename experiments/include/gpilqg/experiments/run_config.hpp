@@ -5,7 +5,10 @@
 /// no file; `--config FILE` overrides fields: tables merge key by key, arrays (including [[tasks]])
 /// are replaced whole, and a key the defaults do not have is an error naming the file and line.
 ///
-///   [system]  name, dt, integrator ("euler"|"rk4"), substeps      (world, true model and simulator)
+///   [system]  name, dt, integrator ("euler"|"rk4"), substeps      (world, true model and simulator;
+///             a MuJoCo model has neither integrator nor substeps: its own are the simulator)
+///   [world]   model (a second model file), parameters (name = value): the real world, for systems
+///             without a default config (MuJoCo models, plugins); the built-ins' is their "real" preset
 ///   [noise]   actuator_multiplicative (m), actuator_additive (m), observation (n)
 ///   [control] u_init (m), u_min, u_max (m, optional)
 ///   [[tasks]] name, x0, goal, horizon, Q, R, Qf, track_line, transfer
@@ -17,6 +20,7 @@
 ///             own_amplitude (m)
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,6 +48,9 @@ struct RunConfig {
   double dt = 0.05;
   Integrator integrator = Integrator::RK4;
   int substeps = 10;
+  // [world]
+  std::string world_model;                         ///< another model file with the same joints and actuators
+  std::map<std::string, double> world_parameters;  ///< parameter overrides of the world
   // [noise]
   ActuatorNoise noise;     ///< the world's process noise, known to every model (the paper's F)
   Vector observation_std;  ///< n entries
