@@ -136,6 +136,7 @@ SystemEntry mujoco_system_entry(const std::string& path) {
     return system;
   };
   entry.effects = mujoco_effect_library(*file);
+  complete_system_entry(entry);
   for (const std::string& joint : file->joint_names())
     entry.same_physics.push_back({"param:" + joint + ".damping", "joint_viscous_damping:" + joint});
   for (const std::string& actuator : file->actuator_names())

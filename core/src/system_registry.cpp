@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "builtin_systems.hpp"
+#include "gpilqg/core/generalised_forces.hpp"
 #include "gpilqg/core/mujoco_system.hpp"
 
 namespace gpilqg {
@@ -17,9 +18,21 @@ bool is_model_file_name(std::string_view name) {
   const auto ends_with = [&](std::string_view suffix) {
     if (name.size() < suffix.size()) return false;
     return std::equal(suffix.rbegin(), suffix.rend(), name.rbegin(),
-                      [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; });
+                      [](char s, char n) { return std::tolower(static_cast<unsigned char>(n)) == s; });
   };
   return ends_with(".xml") || ends_with(".urdf");
+}
+
+void complete_system_entry(SystemEntry& entry) {
+  DynamicsPtr probe;
+  try {
+    probe = entry.build(Preset::Simulator, {}, {});
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(fmt::format("system '{}' ({}) cannot be built: {}", entry.name, entry.origin, e.what()));
+  }
+  if (!probe) throw std::invalid_argument(fmt::format("system '{}' ({}): its builder returned nothing", entry.name, entry.origin));
+  if (entry.parameters.empty()) entry.parameters = probe->parameters();
+  entry.generalised_forces = dynamic_cast<const GeneralisedForceInput*>(probe.get()) != nullptr;
 }
 
 struct SystemRegistry::State {
@@ -45,6 +58,7 @@ void SystemRegistry::add(SystemEntry entry) {
     throw std::invalid_argument(fmt::format(
         "system registry: '{}' ends like a model file (.xml, .urdf); choose a name without that suffix", entry.name));
   if (!entry.build) throw std::invalid_argument(fmt::format("system registry: system '{}' has no builder", entry.name));
+  complete_system_entry(entry);
   std::lock_guard lock(state_->mutex);
   for (const auto& e : state_->entries)
     if (e->name == entry.name)

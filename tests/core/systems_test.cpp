@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "gpilqg/core/cartpole.hpp"
+#include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
 
 namespace gpilqg {
@@ -15,7 +17,10 @@ double parameter(const Dynamics& d, const std::string& name) {
 }
 
 TEST(Systems, RegistryHoldsTheFixedNames) {
-  EXPECT_EQ(system_names(), (std::vector<std::string>{"cartpole", "quadrotor"}));
+  const auto names = system_names();  // built-ins first; a test below registers one more
+  ASSERT_GE(names.size(), 2u);
+  EXPECT_EQ(names[0], "cartpole");
+  EXPECT_EQ(names[1], "quadrotor");
   for (const auto& name : system_names()) EXPECT_EQ(make_system(name)->name(), name);
   const auto quad = system_signature("quadrotor");
   EXPECT_EQ(names_of(quad.states), (std::vector<std::string>{"px", "py", "pz", "vx", "vy", "vz", "rx",
@@ -64,6 +69,68 @@ TEST(Systems, UnknownNamesListTheValidChoices) {
     EXPECT_NE(std::string(e.what()).find("mass, kv, km, inertia, rho"), std::string::npos) << e.what();
   }
   EXPECT_THROW(make_system("cartpole", Preset::Simulator, {{"pole_mass", -1.0}}), std::invalid_argument);
+}
+
+TEST(SystemRegistry, EntriesDescribeTheirSystems) {
+  const auto cartpole = find_system("cartpole");
+  EXPECT_EQ(cartpole->presets, (std::vector<std::string>{"sim", "real"}));
+  std::vector<std::string> parameters;
+  for (const auto& p : cartpole->parameters) parameters.push_back(p.name);
+  EXPECT_EQ(parameters, (std::vector<std::string>{"cart_mass", "pole_mass", "pole_length", "gravity"}));
+  EXPECT_TRUE(cartpole->generalised_forces);
+  EXPECT_FALSE(cartpole->effects.empty());
+  EXPECT_NE(cartpole->default_run_config.find("[[tasks]]"), std::string::npos);
+  EXPECT_TRUE(find_system("quadrotor")->generalised_forces);
+}
+
+TEST(SystemRegistry, AnEntryAddedAtRunTimeWorksEverywhereByName) {
+  SystemEntry entry;
+  entry.name = "long_pole_cartpole";
+  entry.origin = "systems_test";
+  entry.build = [](Preset, const std::map<std::string, double>&, const ActuatorNoise& noise) -> DynamicsPtr {
+    CartPoleParameters p;
+    p.pole_length = 2.0;
+    auto system = std::make_shared<CartPole>(p);
+    system->set_noise_model(noise);
+    return system;
+  };
+  SystemRegistry::instance().add(entry);
+  EXPECT_EQ(make_system("long_pole_cartpole")->parameters()[2].value, 2.0);
+  EXPECT_EQ(find_system("long_pole_cartpole")->parameters[2].value, 2.0);  // filled at registration
+  // A second registration of the name is refused, naming both origins.
+  entry.origin = "another plugin";
+  try {
+    SystemRegistry::instance().add(entry);
+    FAIL() << "a duplicate name was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("by systems_test and by another plugin"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SystemRegistry, BadEntriesAreRefusedAtRegistration) {
+  SystemEntry broken;
+  broken.name = "broken_system";
+  broken.origin = "systems_test";
+  broken.build = [](Preset, const std::map<std::string, double>&, const ActuatorNoise&) -> DynamicsPtr {
+    throw std::runtime_error("no such hardware");
+  };
+  try {
+    SystemRegistry::instance().add(broken);
+    FAIL() << "a builder that throws was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("system 'broken_system' (systems_test) cannot be built: no such hardware"),
+              std::string::npos)
+        << e.what();
+  }
+  SystemEntry file_like = broken;
+  file_like.name = "robot.xml";
+  EXPECT_THROW(SystemRegistry::instance().add(file_like), std::invalid_argument);
+  SystemEntry no_builder;
+  no_builder.name = "nothing";
+  EXPECT_THROW(SystemRegistry::instance().add(no_builder), std::invalid_argument);
+  EXPECT_TRUE(is_model_file_name("arm.XML"));
+  EXPECT_TRUE(is_model_file_name("dir/robot.urdf"));
+  EXPECT_FALSE(is_model_file_name("cartpole"));
 }
 
 }  // namespace

@@ -12,6 +12,10 @@ namespace gpilqg::cli {
 
 using CommandAction = std::function<int()>;
 
+/// The help text of every --system option (DESIGN.md sections 8 and 10).
+inline constexpr const char* kSystemHelp =
+    "System: cartpole, quadrotor, a MuJoCo model file (.xml or .urdf) or a system registered by a --plugin";
+
 /// `gpilqg data info FILE --system NAME [--json]`
 void add_data_command(CLI::App& app, CommandAction& action);
 
@@ -24,7 +28,7 @@ void add_simulate_command(CLI::App& app, CommandAction& action);
 /// `gpilqg diagnose --system NAME --data FILE [--model F.toml] [--add EFFECT[=VALUE]]... [...]`
 void add_diagnose_command(CLI::App& app, CommandAction& action);
 
-/// `gpilqg run cartpole|quadrotor [--config F] [--seeds N] [--iterations K] [--backends LIST] [--out F.h5] [--plots DIR]`
+/// `gpilqg run SYSTEM [--config F] [--seeds N] [--iterations K] [--backends LIST] [--out F.h5] [--plots DIR]`
 void add_run_command(CLI::App& app, CommandAction& action);
 
 /// `gpilqg profile DATA --backends LIST [--sizes LIST] [--json] [--out F.h5] [--plots DIR]`

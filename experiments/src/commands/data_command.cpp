@@ -35,12 +35,6 @@ int run_data_info(const DataInfoOptions& options) {
   return kExitSuccess;
 }
 
-std::string system_choices() {
-  std::string choices;
-  for (const std::string& name : system_names()) choices += (choices.empty() ? "" : ", ") + name;
-  return choices;
-}
-
 }  // namespace
 
 void add_data_command(CLI::App& app, CommandAction& action) {
@@ -53,7 +47,7 @@ void add_data_command(CLI::App& app, CommandAction& action) {
       "with the file and line or dataset at fault");
   auto options = std::make_shared<DataInfoOptions>();
   info->add_option("FILE", options->file, "Measurement file: .csv, or .h5 / .hdf5")->required();
-  info->add_option("--system", options->system, "System the data belongs to: " + system_choices())->required();
+  info->add_option("--system", options->system, kSystemHelp)->required();
   info->add_flag("--json", options->json, "Print one JSON document on stdout instead of the table");
   info->callback([options, &action] { action = [options] { return run_data_info(*options); }; });
 }

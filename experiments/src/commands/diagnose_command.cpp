@@ -150,7 +150,7 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   auto* cmd = app.add_subcommand("diagnose",
                                  "Compare a model with measurements, see where it fails, learn which physical effect is "
                                  "missing, add it and watch the error fall");
-  cmd->add_option("--system", o->system, "System name (cartpole, quadrotor)")->required();
+  cmd->add_option("--system", o->system, kSystemHelp)->required();
   cmd->add_option("--data", o->data, "Measurement file (.csv, .h5)")->required();
   cmd->add_option("--model", o->model, "Model file (TOML): preset, recalibrated parameters, effects");
   cmd->add_option("--preset", o->preset, "Preset without --model: sim or real")->capture_default_str();

@@ -149,10 +149,10 @@ void add_profile_command(CLI::App& app, CommandAction& action) {
                   "compact: each support radius may grow by this / --compact-neighbours during the fit")
       ->capture_default_str();
   cmd->add_option("--threads", o->settings.threads, "Threads inside one fit")->capture_default_str();
-  cmd->add_option("--system", o->data.system, "Measurement sets: the system (cartpole, quadrotor)");
+  cmd->add_option("--system", o->data.system, std::string("Measurement sets: the system. ") + kSystemHelp);
   cmd->add_option("--output", o->data.output, "Measurement sets: the state whose target is learned (default: the first)");
   cmd->add_option("--target", o->target,
-                  "Measurement sets: 'residual' (x' - simulator step, RK4 'sim' preset) or 'increment' (x' - x)")
+                  "Measurement sets: 'residual' (x' - simulator step, the 'sim' preset, RK4 or the model's own integrator) or 'increment' (x' - x)")
       ->capture_default_str();
   cmd->add_option("--test-every", o->data.test_every, "Measurement sets: every k-th sample is held out for testing")
       ->capture_default_str();

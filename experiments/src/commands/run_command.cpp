@@ -111,7 +111,7 @@ void add_run_command(CLI::App& app, CommandAction& action) {
   auto args = std::make_shared<RunArguments>();
   auto* cmd = app.add_subcommand("run", "Run the paper's experiment for a system: ilqg_real, ilqg_sim, gp_ilqg and pddp "
                                         "side by side over seeds; results in HDF5, figures as PNG");
-  cmd->add_option("SYSTEM", args->system, "cartpole, quadrotor, a MuJoCo model file (.xml) or a plugin's system")
+  cmd->add_option("SYSTEM", args->system, kSystemHelp)
       ->required();
   cmd->add_option("--config", args->config, "TOML file overriding the embedded defaults (experiments/configs/run_SYSTEM.toml)");
   cmd->add_option("--seeds", args->seeds, "number of seeds (default 1)");

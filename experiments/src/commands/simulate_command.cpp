@@ -108,7 +108,7 @@ void add_simulate_command(CLI::App& app, CommandAction& action) {
   auto* cmd = app.add_subcommand(
       "simulate", "Write synthetic measurements: a system preset under random excitation, with noise");
   cmd->add_option("--system", options->system,
-                  "System: cartpole, quadrotor, a MuJoCo model file (.xml) or a plugin's system")->required();
+                  kSystemHelp)->required();
   cmd->add_option("--world", options->world_file,
                   "A second MuJoCo model file with the same joints and actuators to simulate instead of --system");
   cmd->add_option("--preset", options->preset, "Parameter set: sim or real")->capture_default_str();

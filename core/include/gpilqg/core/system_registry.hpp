@@ -35,6 +35,15 @@ struct SystemEntry {
   std::string name;         ///< the registry name, e.g. "cartpole", or a MuJoCo model's path
   std::string description;  ///< one line for listings, e.g. "cart-pole, point mass on a massless pole"
   SystemBuilder build;      ///< required
+  /// The parameter sets build() takes, by name: "sim" (the simulator) and "real" (the world). A model
+  /// file has one set, its own, under both names.
+  std::vector<std::string> presets = {"sim", "real"};
+  /// The named physical parameters with their "sim" values (what `--param` and `param:<name>` accept).
+  /// Filled from build() at registration when empty.
+  std::vector<Parameter> parameters;
+  /// True when the system has a generalised-force map (GeneralisedForceInput), so force effects apply.
+  /// Set from build() at registration.
+  bool generalised_forces = false;
   /// The effect library in its fixed order (effect_library.hpp); empty when the system has no
   /// generalised-force map and no gain or parameters to recalibrate. Built once, at registration.
   std::vector<LibraryEffect> effects;
@@ -50,6 +59,11 @@ struct SystemEntry {
 };
 
 using SystemEntryPtr = std::shared_ptr<const SystemEntry>;
+
+/// Checks that `entry` builds (its "sim" preset, no overrides, no noise) and fills `parameters` (when
+/// empty) and `generalised_forces` from the built system. Throws std::invalid_argument naming the
+/// system when the builder fails or returns nothing.
+void complete_system_entry(SystemEntry& entry);
 
 /// True when `name` designates a model file rather than a registered name: it ends in ".xml" or
 /// ".urdf" (any case). Such names are resolved by loading the file (mujoco_system.hpp).
