@@ -5,16 +5,37 @@
 
 namespace gpilqg {
 
+namespace {
+
+struct BeliefSpaceWorkspace final : StepWorkspace {
+  std::unique_ptr<BeliefWorkspace> belief;
+  BeliefJacobians jacobians;
+};
+
+}  // namespace
+
+std::unique_ptr<StepWorkspace> BeliefSpaceModel::make_workspace() const {
+  auto ws = std::make_unique<BeliefSpaceWorkspace>();
+  ws->belief = belief_.make_workspace();
+  return ws;
+}
+
 void BeliefSpaceModel::step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
                             StepJacobians* jacobians) const {
+  const auto workspace = make_workspace();
+  step(v, u, v_next, jacobians, *workspace);
+}
+
+void BeliefSpaceModel::step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next, StepJacobians* jacobians,
+                            StepWorkspace& workspace) const {
+  auto& ws = workspace_as<BeliefSpaceWorkspace>(workspace);
   if (!jacobians) {
-    belief_.propagate(v, u, v_next);
+    belief_.propagate(v, u, v_next, nullptr, *ws.belief);
     return;
   }
-  thread_local BeliefJacobians bj;
-  belief_.propagate(v, u, v_next, &bj);
-  jacobians->A = bj.dv;
-  jacobians->B = bj.du;
+  belief_.propagate(v, u, v_next, &ws.jacobians, *ws.belief);
+  jacobians->A = ws.jacobians.dv;
+  jacobians->B = ws.jacobians.du;
 }
 
 BeliefCost::BeliefCost(const Cost& cost) : cost_(cost), n_(cost.state_dim()) {}

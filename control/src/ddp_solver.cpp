@@ -99,7 +99,8 @@ namespace {
 class Engine {
  public:
   Engine(const DdpProblem& problem, const DdpOptions& options, DdpWorkspace& ws)
-      : pb_(problem), opt_(options), ws_(ws), model_(*problem.model), cost_(*problem.cost) {}
+      : pb_(problem), opt_(options), ws_(ws), model_(*problem.model), cost_(*problem.cost),
+        model_ws_(problem.model->make_workspace()) {}
 
   DdpResult run(const Matrix& initial_controls);
 
@@ -124,6 +125,7 @@ class Engine {
   DdpWorkspace& ws_;
   const StepModel& model_;
   const Cost& cost_;
+  std::unique_ptr<StepWorkspace> model_ws_;  ///< the model's scratch for this solve (model/data split)
 
   double lambda_ = 0.0;
   double dlambda_ = 1.0;
@@ -153,17 +155,17 @@ double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
     merit += cost_.stage(t, x_out.col(t), u_out.col(t));
     if (uses_noise()) {
       const auto& S_next = ws_.S[static_cast<std::size_t>(t + 1)];
-      model_.noise(x_out.col(t), u_out.col(t), ws_.candidate_columns, false);
+      model_.noise(x_out.col(t), u_out.col(t), ws_.candidate_columns, false, *model_ws_);
       ws_.candidate_columns.columns *= sqrt_dt;
       merit += trace_term(ws_.candidate_columns, S_next, ws_.Sc);
       if (uses_uncertainty()) {
-        model_.uncertainty(x_out.col(t), u_out.col(t), ws_.candidate_columns, false);
+        model_.uncertainty(x_out.col(t), u_out.col(t), ws_.candidate_columns, false, *model_ws_);
         ws_.candidate_columns.columns *= sqrt_dt;
         merit += trace_term(ws_.candidate_columns, S_next, ws_.Sc);
       }
     }
     const bool control_finite = u_out.col(t).allFinite();
-    if (control_finite) model_.step(x_out.col(t), u_out.col(t), x_out.col(t + 1));
+    if (control_finite) model_.step(x_out.col(t), u_out.col(t), x_out.col(t + 1), nullptr, *model_ws_);
     if (!control_finite || check_divergence(x_out.col(t + 1)) != RolloutStatus::Completed) {
       // Diverged (rollout.hpp's test, shared with every rollout): keep the candidate free of NaN and
       // inf (the last state within the bound repeated, the nominal controls after it) and reject it.
@@ -183,14 +185,14 @@ void Engine::differentiate() {
   const auto& u = ws_.policy.u_bar;
   for (int t = 0; t < T; ++t) {
     const auto ts = static_cast<std::size_t>(t);
-    model_.step(x.col(t), u.col(t), ws_.x_new.col(t + 1), &ws_.jac[ts]);
+    model_.step(x.col(t), u.col(t), ws_.x_new.col(t + 1), &ws_.jac[ts], *model_ws_);
     cost_.stage(t, x.col(t), u.col(t), &ws_.cost[ts]);
     if (uses_noise()) {
-      model_.noise(x.col(t), u.col(t), ws_.noise[ts], true);
+      model_.noise(x.col(t), u.col(t), ws_.noise[ts], true, *model_ws_);
       scale_columns(ws_.noise[ts], sqrt_dt);
     }
     if (uses_uncertainty()) {
-      model_.uncertainty(x.col(t), u.col(t), ws_.uncertainty[ts], true);
+      model_.uncertainty(x.col(t), u.col(t), ws_.uncertainty[ts], true, *model_ws_);
       scale_columns(ws_.uncertainty[ts], sqrt_dt);
     }
   }

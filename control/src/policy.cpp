@@ -8,11 +8,11 @@
 namespace gpilqg {
 
 void AffinePolicy::control(int t, const VectorCRef& x, VectorRef u, double alpha) const {
-  thread_local Vector dx;  // no allocation per call once sized
-  dx = x - x_bar.col(t);
+  // u = u_bar + alpha k + K (x - x_bar), column by column: no temporary, nothing allocated.
   u = u_bar.col(t);
   u.noalias() += alpha * k.col(t);
-  u.noalias() += K[static_cast<std::size_t>(t)] * dx;
+  const Matrix& gain = K[static_cast<std::size_t>(t)];
+  for (Eigen::Index j = 0; j < gain.cols(); ++j) u.noalias() += (x(j) - x_bar(j, t)) * gain.col(j);
   if (u_min.size()) u = u.cwiseMax(u_min);
   if (u_max.size()) u = u.cwiseMin(u_max);
 }

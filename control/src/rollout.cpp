@@ -23,8 +23,8 @@ RolloutStatus check_divergence(const VectorCRef& x, double max_magnitude) {
 }
 
 bool sample_step(const StepModel& model, const VectorCRef& x, const VectorCRef& u, RolloutNoise noise,
-                 DiffusionColumns& scratch, std::mt19937_64* rng, VectorRef x_next) {
-  model.step(x, u, x_next);
+                 DiffusionColumns& scratch, std::mt19937_64* rng, VectorRef x_next, StepWorkspace& workspace) {
+  model.step(x, u, x_next, nullptr, workspace);
   if (noise != RolloutNoise::None) {
     if (rng == nullptr) throw std::invalid_argument("sample_step: a random generator is needed to sample noise");
     std::normal_distribution<double> normal(0.0, 1.0);
@@ -33,11 +33,11 @@ bool sample_step(const StepModel& model, const VectorCRef& x, const VectorCRef& 
       for (int i = 0; i < scratch.count(); ++i) x_next += (sqrt_dt * normal(*rng)) * scratch.columns.col(i);
     };
     if (noise != RolloutNoise::UncertaintyOnly) {
-      model.noise(x, u, scratch, false);
+      model.noise(x, u, scratch, false, workspace);
       add_columns();
     }
     if (noise == RolloutNoise::ProcessAndUncertainty || noise == RolloutNoise::UncertaintyOnly) {
-      model.uncertainty(x, u, scratch, false);
+      model.uncertainty(x, u, scratch, false, workspace);
       add_columns();
     }
   }
@@ -73,6 +73,7 @@ RolloutResult closed_loop_rollout(const StepModel& world, const VectorCRef& x0, 
   result.trajectory = Trajectory(n, m, steps);
   result.trajectory.x.col(0) = x0;
   DiffusionColumns scratch;
+  const auto workspace = world.make_workspace();
   Vector observed(n), next(n);
   for (int t = 0; t < steps; ++t) {
     const auto x = result.trajectory.x.col(t);
@@ -82,7 +83,7 @@ RolloutResult closed_loop_rollout(const StepModel& world, const VectorCRef& x0, 
     controller(t, observed, u);
     RolloutStatus status = u.allFinite() ? RolloutStatus::Completed : RolloutStatus::NonFiniteControl;
     if (status == RolloutStatus::Completed) {
-      sample_step(world, x, u, noise, scratch, rng, next);
+      sample_step(world, x, u, noise, scratch, rng, next, *workspace);
       status = check_divergence(next, max_state_magnitude);
     }
     if (status != RolloutStatus::Completed) {

@@ -89,20 +89,37 @@ Eigen::Ref<const Vector> QuadraticCost::control_reference(int t) const {
   return u_ref_.col(std::min<Eigen::Index>(t, u_ref_.cols() - 1));
 }
 
+namespace {
+
+/// 0.5 e'We with e = a - b, and W e into `gradient` when not null; entry by entry, so that nothing is
+/// allocated (the cost is evaluated T times per pass).
+double half_quadratic_form(const Matrix& W, const VectorCRef& a, const VectorCRef& b, Vector* gradient) {
+  double value = 0.0;
+  if (gradient != nullptr) gradient->setZero(a.size());
+  for (Eigen::Index j = 0; j < W.cols(); ++j) {
+    const double ej = a(j) - b(j);
+    if (ej == 0.0) continue;
+    for (Eigen::Index i = 0; i < W.rows(); ++i) {
+      const double wij_ej = W(i, j) * ej;
+      value += (a(i) - b(i)) * wij_ej;
+      if (gradient != nullptr) (*gradient)(i) += wij_ej;
+    }
+  }
+  return 0.5 * value;
+}
+
+}  // namespace
+
 double QuadraticCost::stage(int t, const VectorCRef& x, const VectorCRef& u,
                             CostDerivatives* derivatives) const {
-  // Per-thread scratch: the cost is evaluated T times per pass and must not allocate.
-  thread_local Vector e, d, Qe, Rd;
-  e = x - state_reference(t);
-  d = u - control_reference(t);
-  Qe.noalias() = Q_ * e;
-  Rd.noalias() = R_ * d;
-  const double value = dt_ * 0.5 * (e.dot(Qe) + d.dot(Rd));
+  const double value =
+      dt_ * (half_quadratic_form(Q_, x, state_reference(t), derivatives ? &derivatives->lx : nullptr) +
+             half_quadratic_form(R_, u, control_reference(t), derivatives ? &derivatives->lu : nullptr));
   if (derivatives) {
     derivatives->resize(state_dim(), control_dim());
     derivatives->value = value;
-    derivatives->lx = dt_ * Qe;
-    derivatives->lu = dt_ * Rd;
+    derivatives->lx *= dt_;
+    derivatives->lu *= dt_;
     derivatives->lxx = dt_ * Q_;
     derivatives->luu = dt_ * R_;
     derivatives->lux.setZero();
@@ -115,14 +132,10 @@ double QuadraticCost::terminal(const VectorCRef& x, CostDerivatives* derivatives
 }
 
 double QuadraticCost::terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives) const {
-  thread_local Vector e, Qe;
-  e = x - state_reference(t);
-  Qe.noalias() = Qf_ * e;
-  const double value = 0.5 * e.dot(Qe);
+  const double value = half_quadratic_form(Qf_, x, state_reference(t), derivatives ? &derivatives->lx : nullptr);
   if (derivatives) {
     derivatives->resize(state_dim(), 0);
     derivatives->value = value;
-    derivatives->lx = Qe;
     derivatives->lxx = Qf_;
   }
   return value;

@@ -20,6 +20,17 @@ void InputMatrix::resize(int n, int m) {
     if (d.rows() != n || d.cols() != m) d.resize(n, m);
 }
 
+std::unique_ptr<DynamicsWorkspace> Dynamics::make_workspace() const { return std::make_unique<DynamicsWorkspace>(); }
+
+void Dynamics::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot, DynamicsJacobians* jacobians,
+                        DynamicsWorkspace&) const {
+  evaluate(x, u, xdot, jacobians);
+}
+
+void Dynamics::input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out, DynamicsWorkspace&) const {
+  input_matrix(x, u, out);
+}
+
 Vector Dynamics::f(const VectorCRef& x, const VectorCRef& u) const {
   Vector xdot(state_dim());
   evaluate(x, u, xdot);
@@ -27,6 +38,15 @@ Vector Dynamics::f(const VectorCRef& x, const VectorCRef& u) const {
 }
 
 void Dynamics::input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const {
+  input_matrix_by_differences(x, u, out, nullptr);
+}
+
+void Dynamics::input_matrix_by_differences(const VectorCRef& x, const VectorCRef& u, InputMatrix& out,
+                                           DynamicsWorkspace* workspace) const {
+  const auto f = [&](const VectorCRef& xs, const VectorCRef& us, VectorRef xdot, DynamicsJacobians* jac) {
+    if (workspace != nullptr) evaluate(xs, us, xdot, jac, *workspace);
+    else evaluate(xs, us, xdot, jac);
+  };
   // b = f_u from the (possibly analytic) Jacobian; its derivatives by central differences of f_u,
   // step h_k = 1e-6 max(1, |z_k|) (fu is itself a derivative, so the error is O(h^2) + O(eps/h)).
   const int n = state_dim();
@@ -35,12 +55,12 @@ void Dynamics::input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatri
   DynamicsJacobians jac;
   jac.resize(n, m);
   Vector xdot(n);
-  evaluate(x, u, xdot, &jac);
+  f(x, u, xdot, &jac);
   out.b = jac.fu;
 
   Vector xp = x, up = u;
   DynamicsJacobians plus, minus;
-  auto perturbed_fu = [&](DynamicsJacobians& into) { evaluate(xp, up, xdot, &into); };
+  auto perturbed_fu = [&](DynamicsJacobians& into) { f(xp, up, xdot, &into); };
   for (int k = 0; k < n + m; ++k) {
     const bool is_state = k < n;
     double& entry = is_state ? xp(k) : up(k - n);
@@ -66,8 +86,13 @@ void Dynamics::set_noise_model(ActuatorNoise noise) {
   noise_ = std::move(noise);
 }
 
-void Dynamics::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
-                     bool derivatives) const {
+void Dynamics::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const {
+  const auto workspace = make_workspace();
+  noise(x, u, out, derivatives, *workspace);
+}
+
+void Dynamics::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+                     DynamicsWorkspace& workspace) const {
   // Columns in the order of ActuatorNoise: additive actuator, multiplicative actuator, state.
   //   additive:        c = sa_j b_j            dc/dx = sa_j db_j/dx        dc/du = sa_j db_j/du
   //   multiplicative:  c = sm_j u_j b_j        dc/dx = sm_j u_j db_j/dx    dc/du = sm_j (u_j db_j/du + b_j e_j')
@@ -81,8 +106,8 @@ void Dynamics::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns&
   if (p == 0) return;
 
   const bool needs_b = noise_.additive_std.size() > 0 || noise_.multiplicative_std.size() > 0;
-  thread_local InputMatrix b;
-  if (needs_b) input_matrix(x, u, b);
+  InputMatrix& b = workspace.input;
+  if (needs_b) input_matrix(x, u, b, workspace);
 
   int c = 0;
   for (Eigen::Index j = 0; j < noise_.additive_std.size(); ++j) {

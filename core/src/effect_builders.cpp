@@ -7,32 +7,32 @@
 namespace gpilqg::effect_bases {
 
 LinearForceEffect::Basis viscous(int component, int velocity) {
-  return [=](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
-    g(component) = -x(velocity);
-    if (dg_dx != nullptr) (*dg_dx)(component, velocity) = -1.0;
+  return [=](const VectorCRef& x, double theta, VectorRef Q, Matrix* dQ_dx) {
+    Q(component) -= theta * x(velocity);
+    if (dQ_dx != nullptr) (*dQ_dx)(component, velocity) -= theta;
   };
 }
 
 LinearForceEffect::Basis coulomb(int component, int velocity) {
   // g = -tanh(v / w), dg/dv = -(1 - tanh^2) / w.
-  return [=](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
+  return [=](const VectorCRef& x, double theta, VectorRef Q, Matrix* dQ_dx) {
     const double t = std::tanh(x(velocity) / kCoulombWidth);
-    g(component) = -t;
-    if (dg_dx != nullptr) (*dg_dx)(component, velocity) = -(1.0 - t * t) / kCoulombWidth;
+    Q(component) -= theta * t;
+    if (dQ_dx != nullptr) (*dQ_dx)(component, velocity) -= theta * (1.0 - t * t) / kCoulombWidth;
   };
 }
 
 LinearForceEffect::Basis constant(int component) {
-  return [=](const VectorCRef&, VectorRef g, Matrix*) { g(component) = 1.0; };
+  return [=](const VectorCRef&, double theta, VectorRef Q, Matrix*) { Q(component) += theta; };
 }
 
 LinearForceEffect::Basis quadratic_drag(int components, int first_velocity) {
   // g_i = -|v_i| v_i, dg_i/dv_i = -2 |v_i|.
-  return [=](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
+  return [=](const VectorCRef& x, double theta, VectorRef Q, Matrix* dQ_dx) {
     for (int i = 0; i < components; ++i) {
       const double v = x(first_velocity + i);
-      g(i) = -std::abs(v) * v;
-      if (dg_dx != nullptr) (*dg_dx)(i, first_velocity + i) = -2.0 * std::abs(v);
+      Q(i) -= theta * std::abs(v) * v;
+      if (dQ_dx != nullptr) (*dQ_dx)(i, first_velocity + i) -= theta * 2.0 * std::abs(v);
     }
   };
 }

@@ -7,21 +7,15 @@ namespace gpilqg {
 
 namespace {
 
-/// Per-thread scratch space for EffectDynamics::evaluate, so that a shared const model does not
-/// allocate per call once warmed up.
-struct EffectScratch {
+/// EffectDynamics' workspace: the base system's, and the buffers of the forces, so that a caller
+/// that keeps it does not allocate per evaluation once warmed up.
+struct EffectWorkspace final : DynamicsWorkspace {
+  std::unique_ptr<DynamicsWorkspace> base;
   Vector u_applied;
   Vector Q;
   Matrix dQ_dx, dQ_du, W;
   std::vector<Matrix> dW;
-  Vector g;
-  Matrix dg_dx;
 };
-
-EffectScratch& effect_scratch() {
-  thread_local EffectScratch scratch;
-  return scratch;
-}
 
 }  // namespace
 
@@ -39,12 +33,10 @@ LinearForceEffect::LinearForceEffect(std::string name, EffectParameter parameter
 void LinearForceEffect::add_force(const VectorCRef& x, const VectorCRef&, const VectorCRef& theta, VectorRef Q,
                                   Matrix* dQ_dx, Matrix*) const {
   // Q += theta g(x);  dQ/dx += theta dg/dx;  dQ/du = 0.
-  EffectScratch& s = effect_scratch();
-  s.g.setZero(force_dim_);
-  if (dQ_dx != nullptr) s.dg_dx.setZero(force_dim_, x.size());
-  basis_(x, s.g, dQ_dx != nullptr ? &s.dg_dx : nullptr);
-  Q.noalias() += theta(0) * s.g;
-  if (dQ_dx != nullptr) dQ_dx->noalias() += theta(0) * s.dg_dx;
+  if (Q.size() != force_dim_)
+    throw std::invalid_argument("LinearForceEffect '" + name_ + "': Q has " + std::to_string(Q.size()) +
+                                " entries; expected " + std::to_string(force_dim_));
+  basis_(x, theta(0), Q, dQ_dx);
 }
 
 EffectDynamics::EffectDynamics(DynamicsPtr base, double actuator_gain, std::vector<AppliedEffect> effects)
@@ -80,11 +72,23 @@ std::vector<Parameter> EffectDynamics::parameters() const {
   return out;
 }
 
+std::unique_ptr<DynamicsWorkspace> EffectDynamics::make_workspace() const {
+  auto workspace = std::make_unique<EffectWorkspace>();
+  workspace->base = base_->make_workspace();
+  return workspace;
+}
+
 void EffectDynamics::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot,
                               DynamicsJacobians* jacobians) const {
-  EffectScratch& s = effect_scratch();
+  const auto workspace = make_workspace();
+  evaluate(x, u, xdot, jacobians, *workspace);
+}
+
+void EffectDynamics::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot, DynamicsJacobians* jacobians,
+                              DynamicsWorkspace& workspace) const {
+  auto& s = workspace_as<EffectWorkspace>(workspace);
   s.u_applied = gain_ * u;
-  base_->evaluate(x, s.u_applied, xdot, jacobians);
+  base_->evaluate(x, s.u_applied, xdot, jacobians, *s.base);
   if (jacobians != nullptr) jacobians->fu *= gain_;
   if (effects_.empty()) return;
 
@@ -97,8 +101,8 @@ void EffectDynamics::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRe
   }
   for (const AppliedEffect& e : effects_)
     e.effect->add_force(x, u, e.theta, s.Q, jacobians != nullptr ? &s.dQ_dx : nullptr,
-                        jacobians != nullptr ? &s.dQ_du : nullptr);
-  forces_->generalised_force_map(x, s.W, jacobians != nullptr ? &s.dW : nullptr);
+                        jacobians != nullptr ? &s.dQ_du : nullptr, *s.base);
+  forces_->generalised_force_map(x, s.W, jacobians != nullptr ? &s.dW : nullptr, *s.base);
   xdot.noalias() += s.W * s.Q;
   if (jacobians == nullptr) return;
   jacobians->fx.noalias() += s.W * s.dQ_dx;
@@ -106,18 +110,27 @@ void EffectDynamics::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRe
   jacobians->fu.noalias() += s.W * s.dQ_du;
 }
 
-void EffectDynamics::generalised_force(const VectorCRef& x, const VectorCRef& u, VectorRef Q) const {
+void EffectDynamics::generalised_force(const VectorCRef& x, const VectorCRef& u, VectorRef Q,
+                                       DynamicsWorkspace& workspace) const {
+  auto& s = workspace_as<EffectWorkspace>(workspace);
   Q.setZero();
-  for (const AppliedEffect& e : effects_) e.effect->add_force(x, u, e.theta, Q, nullptr, nullptr);
+  for (const AppliedEffect& e : effects_) e.effect->add_force(x, u, e.theta, Q, nullptr, nullptr, *s.base);
 }
 
 void EffectDynamics::input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const {
+  const auto workspace = make_workspace();
+  input_matrix(x, u, out, *workspace);
+}
+
+void EffectDynamics::input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out,
+                                  DynamicsWorkspace& workspace) const {
   if (input_dependent_) {
     Dynamics::input_matrix(x, u, out);
     return;
   }
-  const Vector u_applied = gain_ * u;
-  base_->input_matrix(x, u_applied, out);
+  auto& s = workspace_as<EffectWorkspace>(workspace);
+  s.u_applied = gain_ * u;
+  base_->input_matrix(x, s.u_applied, out, *s.base);
   out.b *= gain_;
   for (auto& d : out.d_dx) d *= gain_;
   for (auto& d : out.d_du) d *= gain_ * gain_;

@@ -29,10 +29,12 @@ IntegratedStepModel::IntegratedStepModel(DynamicsPtr dynamics, Integrator integr
     throw std::invalid_argument("substeps = " + std::to_string(substeps) + "; expected >= 1");
 }
 
-namespace {
-
-/// Scratch for one step, kept per thread so a shared const model never allocates after warm-up.
-struct StepWorkspace {
+/// The caller's scratch for steps of one IntegratedStepModel: the RK4 stages and their Jacobians, the
+/// sub-step accumulation, and the dynamics' own workspace.
+struct IntegratedStepModel::Workspace final : StepWorkspace {
+  std::unique_ptr<DynamicsWorkspace> dynamics;
+  Vector state;
+  StepJacobians total, sub_step;
   Vector k1, k2, k3, k4, stage;
   DynamicsJacobians j1, j2, j3, j4;
   // Derivatives of the stages k_i with respect to the sub-step's initial state and control.
@@ -53,24 +55,23 @@ struct StepWorkspace {
   }
 };
 
-StepWorkspace& workspace(int n, int m) {
-  thread_local StepWorkspace ws;
-  ws.resize(n, m);
+std::unique_ptr<StepWorkspace> IntegratedStepModel::make_workspace() const {
+  auto ws = std::make_unique<Workspace>();
+  ws->dynamics = dynamics_->make_workspace();
+  ws->resize(state_dim(), control_dim());
   return ws;
 }
 
-}  // namespace
-
-void IntegratedStepModel::substep(Vector& x, const VectorCRef& u, double h,
-                                  StepJacobians* jac) const {
-  const int n = state_dim();
-  const int m = control_dim();
-  StepWorkspace& ws = workspace(n, m);
-  const Dynamics& f = *dynamics_;
+void IntegratedStepModel::substep(Vector& x, const VectorCRef& u, double h, StepJacobians* jac,
+                                  Workspace& ws) const {
+  DynamicsWorkspace& dw = *ws.dynamics;
+  const auto f_evaluate = [&](const VectorCRef& at, VectorRef xdot, DynamicsJacobians* j) {
+    dynamics_->evaluate(at, u, xdot, j, dw);
+  };
 
   if (integrator_ == Integrator::Euler) {
     // x' = x + h f(x, u);  A = I + h f_x;  B = h f_u
-    f.evaluate(x, u, ws.k1, jac ? &ws.j1 : nullptr);
+    f_evaluate(x, ws.k1, jac ? &ws.j1 : nullptr);
     if (jac) {
       jac->A.noalias() = h * ws.j1.fx;
       jac->A.diagonal().array() += 1.0;
@@ -85,13 +86,13 @@ void IntegratedStepModel::substep(Vector& x, const VectorCRef& u, double h,
   DynamicsJacobians* j2 = jac ? &ws.j2 : nullptr;
   DynamicsJacobians* j3 = jac ? &ws.j3 : nullptr;
   DynamicsJacobians* j4 = jac ? &ws.j4 : nullptr;
-  f.evaluate(x, u, ws.k1, j1);
+  f_evaluate(x, ws.k1, j1);
   ws.stage = x + 0.5 * h * ws.k1;
-  f.evaluate(ws.stage, u, ws.k2, j2);
+  f_evaluate(ws.stage, ws.k2, j2);
   ws.stage = x + 0.5 * h * ws.k2;
-  f.evaluate(ws.stage, u, ws.k3, j3);
+  f_evaluate(ws.stage, ws.k3, j3);
   ws.stage = x + h * ws.k3;
-  f.evaluate(ws.stage, u, ws.k4, j4);
+  f_evaluate(ws.stage, ws.k4, j4);
 
   if (jac) {
     // Chain rule through the stages: stage_i = x + c_i h k_{i-1}, so
@@ -119,16 +120,24 @@ void IntegratedStepModel::substep(Vector& x, const VectorCRef& u, double h,
 
 void IntegratedStepModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
                                StepJacobians* jacobians) const {
+  const auto workspace = make_workspace();
+  step(x, u, x_next, jacobians, *workspace);
+}
+
+void IntegratedStepModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
+                               StepWorkspace& workspace) const {
   const int n = state_dim();
   const int m = control_dim();
   const double h = dt_ / substeps_;
   if (jacobians) jacobians->resize(n, m);
 
-  thread_local Vector state;
-  thread_local StepJacobians total, sub;
+  Workspace& ws = workspace_as<Workspace>(workspace);
+  Vector& state = ws.state;
+  StepJacobians& total = ws.total;
+  StepJacobians& sub = ws.sub_step;
   state = x;
   if (substeps_ == 1) {
-    substep(state, u, h, jacobians);
+    substep(state, u, h, jacobians, ws);
     x_next = state;
     return;
   }
@@ -140,7 +149,7 @@ void IntegratedStepModel::step(const VectorCRef& x, const VectorCRef& u, VectorR
     total.B.setZero();
   }
   for (int s = 0; s < substeps_; ++s) {
-    substep(state, u, h, jacobians ? &sub : nullptr);
+    substep(state, u, h, jacobians ? &sub : nullptr, ws);
     if (jacobians) {
       jacobians->A.noalias() = sub.A * total.A;
       jacobians->B.noalias() = sub.A * total.B;
@@ -155,6 +164,11 @@ void IntegratedStepModel::step(const VectorCRef& x, const VectorCRef& u, VectorR
 void IntegratedStepModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
                                 bool derivatives) const {
   dynamics_->noise(x, u, out, derivatives);
+}
+
+void IntegratedStepModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+                                StepWorkspace& workspace) const {
+  dynamics_->noise(x, u, out, derivatives, *workspace_as<Workspace>(workspace).dynamics);
 }
 
 }  // namespace gpilqg

@@ -31,29 +31,38 @@ class BodyForceEffect final : public ForceEffect {
   const std::string& formula() const override { return formula_; }
   bool linear_in_parameters() const override { return true; }
 
-  void add_force(const VectorCRef& x, const VectorCRef&, const VectorCRef& theta, VectorRef Q, Matrix* dQ_dx,
-                 Matrix*) const override {
+  void add_force(const VectorCRef& x, const VectorCRef& u, const VectorCRef& theta, VectorRef Q, Matrix* dQ_dx,
+                 Matrix* dQ_du) const override {
+    MujocoWorkspace workspace;
+    workspace.data = model_->make_data();
+    add_force(x, u, theta, Q, dQ_dx, dQ_du, workspace);
+  }
+
+  /// `workspace` is the MuJoCo system's: its mjData holds the kinematics.
+  void add_force(const VectorCRef& x, const VectorCRef&, const VectorCRef& theta, VectorRef Q, Matrix* dQ_dx, Matrix*,
+                 DynamicsWorkspace& workspace) const override {
+    mjData* d = workspace_as<MujocoWorkspace>(workspace).data.get();
     const int nv = model_->nq();
-    Q.noalias() += theta(0) * basis(x);
+    Q.noalias() += theta(0) * basis(x, d);
     if (dQ_dx == nullptr) return;
     for (int j = 0; j < nv; ++j) {
       const double h = kCentralDifferenceStep * std::max(1.0, std::abs(x(j)));
       Vector plus = x, minus = x;
       plus(j) += h;
       minus(j) -= h;
-      dQ_dx->col(j).noalias() += theta(0) * (basis(plus) - basis(minus)) / (2.0 * h);
+      dQ_dx->col(j).noalias() += theta(0) * (basis(plus, d) - basis(minus, d)) / (2.0 * h);
     }
   }
 
  private:
-  /// J_com(q)' e_axis.
-  Vector basis(const VectorCRef& x) const {
+  /// J_com(q)' e_axis, with the kinematics computed in d.
+  Vector basis(const VectorCRef& x, mjData* d) const {
     const mjModel* m = model_->m();
-    auto d = model_->borrow(x, Vector::Zero(m->nu));
-    mj_kinematics(m, d.get());
-    mj_comPos(m, d.get());
+    model_->prepare(d, x, Vector::Zero(m->nu));
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
     std::vector<mjtNum> jacp(static_cast<std::size_t>(3 * m->nv));
-    mj_jacBodyCom(m, d.get(), jacp.data(), nullptr, body_);
+    mj_jacBodyCom(m, d, jacp.data(), nullptr, body_);
     Vector g(m->nv);
     for (int i = 0; i < m->nv; ++i) g(i) = jacp[static_cast<std::size_t>(axis_ * m->nv + i)];
     return g;

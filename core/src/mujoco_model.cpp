@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -44,18 +45,9 @@ std::string one_line(const std::string& text) {
 
 }  // namespace
 
-MujocoModel::Lease::~Lease() {
-  if (d_ == nullptr) return;
-  std::lock_guard lock(owner_->pool_mutex_);
-  owner_->pool_.push_back(d_);
-}
-
 MujocoModel::MujocoModel(mjModel* m, std::string path) : m_(m), path_(std::move(path)) {}
 
-MujocoModel::~MujocoModel() {
-  for (mjData* d : pool_) mj_deleteData(d);
-  mj_deleteModel(m_);
-}
+MujocoModel::~MujocoModel() { mj_deleteModel(m_); }
 
 std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
   route_warnings_to_stderr();
@@ -195,18 +187,13 @@ std::shared_ptr<const MujocoModel> MujocoModel::with_parameters(const std::map<s
   return out;
 }
 
-MujocoModel::Lease MujocoModel::borrow(const VectorCRef& x, const VectorCRef& u) const {
-  mjData* d = nullptr;
-  {
-    std::lock_guard lock(pool_mutex_);
-    if (!pool_.empty()) {
-      d = pool_.back();
-      pool_.pop_back();
-    }
-  }
-  if (d == nullptr) d = mj_makeData(m_);
-  if (d == nullptr) throw std::runtime_error(fmt::format("{}: MuJoCo could not allocate its data", path_));
-  Lease lease(*this, d);
+MujocoModel::DataPtr MujocoModel::make_data() const {
+  DataPtr d(mj_makeData(m_));
+  if (!d) throw std::runtime_error(fmt::format("{}: MuJoCo could not allocate its data", path_));
+  return d;
+}
+
+void MujocoModel::prepare(mjData* d, const VectorCRef& x, const VectorCRef& u) const {
   const int nv = m_->nv;
   d->time = 0.0;
   for (int i = 0; i < nv; ++i) {
@@ -219,7 +206,6 @@ MujocoModel::Lease MujocoModel::borrow(const VectorCRef& x, const VectorCRef& u)
   for (int a = 0; a < m_->nu; ++a) d->ctrl[a] = gains_(a) * u(a);
   d->userdata[context_slot()] = 0.0;
   for (int w = 0; w < mjNWARNING; ++w) d->warning[w].number = 0;
-  return lease;
 }
 
 }  // namespace gpilqg

@@ -1,15 +1,15 @@
 #pragma once
-/// The loaded mjModel behind a MujocoSystem: validated once, immutable afterwards, with its names,
-/// its parameter fields and a pool of mjData that evaluations borrow (mujoco_system.hpp).
+/// The loaded mjModel behind a MujocoSystem: validated once, immutable afterwards, with its names and
+/// its parameter fields; and the workspace that holds a caller's mjData (mujoco_system.hpp).
 
 #include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include <mujoco/mujoco.h>
 
+#include "gpilqg/core/dynamics.hpp"
 #include "gpilqg/core/quantity.hpp"
 #include "gpilqg/core/types.hpp"
 
@@ -45,25 +45,15 @@ class MujocoModel {
   std::vector<std::string> joint_names() const;
   std::vector<std::string> actuator_names() const;
 
-  /// An mjData borrowed from the pool, returned when the lease ends.
-  class Lease {
-   public:
-    Lease(const MujocoModel& owner, mjData* d) : owner_(&owner), d_(d) {}
-    Lease(Lease&& other) noexcept : owner_(other.owner_), d_(other.d_) { other.d_ = nullptr; }
-    Lease(const Lease&) = delete;
-    Lease& operator=(const Lease&) = delete;
-    Lease& operator=(Lease&&) = delete;
-    ~Lease();
-    mjData* operator->() const { return d_; }
-    mjData* get() const { return d_; }
-
-   private:
-    const MujocoModel* owner_;
-    mjData* d_;
+  struct DataDeleter {
+    void operator()(mjData* d) const { mj_deleteData(d); }
   };
-  /// Borrows an mjData with the state (qpos, qvel) = x, ctrl = k .* u, no applied forces, zero time
-  /// and warm start, and no passive-force context.
-  Lease borrow(const VectorCRef& x, const VectorCRef& u) const;
+  using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+  /// A new mjData for this model (or any copy with other parameter values: the sizes are the same).
+  DataPtr make_data() const;
+  /// Puts `d` in the state (qpos, qvel) = x with ctrl = k .* u, no applied forces, zero time and warm
+  /// start, no passive-force context and no warnings, so that results never depend on the history of d.
+  void prepare(mjData* d, const VectorCRef& x, const VectorCRef& u) const;
 
   /// The index of the userdata slot that holds the passive-force context (mujoco_system.cpp).
   int context_slot() const { return m_->nuserdata - 1; }
@@ -87,8 +77,11 @@ class MujocoModel {
   std::string name_;
   std::vector<Quantity> states_, controls_, forces_;
   Vector gains_;
-  mutable std::mutex pool_mutex_;
-  mutable std::vector<mjData*> pool_;
+};
+
+/// A MujocoSystem's workspace: the caller's own mjData.
+struct MujocoWorkspace final : DynamicsWorkspace {
+  MujocoModel::DataPtr data;
 };
 
 }  // namespace gpilqg

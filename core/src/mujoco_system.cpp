@@ -18,10 +18,13 @@ namespace {
 
 using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-/// What the passive-force callback needs during one step: the decorated system's forces.
+/// What the passive-force callback needs during one step: the decorated system's forces, its
+/// workspace (with an mjData of its own: the step's is busy) and buffers.
 struct PassiveContext {
-  const EffectDynamics* effects;
-  const Vector* gains;  ///< k: the commanded input is ctrl ./ k
+  const EffectDynamics* effects = nullptr;
+  const Vector* gains = nullptr;  ///< k: the commanded input is ctrl ./ k
+  DynamicsWorkspace* workspace = nullptr;
+  Vector x, u, Q;
 };
 
 /// MuJoCo's passive-force callback (mjcb_passive, process-wide): adds the generalised forces of the
@@ -34,23 +37,31 @@ void add_effect_forces(const mjModel* m, mjData* d) {
   std::memcpy(&context, &slot, sizeof context);
   if (context == nullptr) return;
   const int nv = m->nv;
-  Vector x(2 * nv), u(m->nu), Q = Vector::Zero(nv);
   for (int i = 0; i < nv; ++i) {
-    x(i) = d->qpos[i];
-    x(nv + i) = d->qvel[i];
+    context->x(i) = d->qpos[i];
+    context->x(nv + i) = d->qvel[i];
   }
   for (int a = 0; a < m->nu; ++a) {
     const double k = (*context->gains)(a);
-    u(a) = k != 0.0 ? d->ctrl[a] / k : 0.0;
+    context->u(a) = k != 0.0 ? d->ctrl[a] / k : 0.0;
   }
-  context->effects->generalised_force(x, u, Q);
-  for (int i = 0; i < nv; ++i) d->qfrc_passive[i] += Q(i);
+  context->effects->generalised_force(context->x, context->u, context->Q, *context->workspace);
+  for (int i = 0; i < nv; ++i) d->qfrc_passive[i] += context->Q(i);
 }
 
 void install_passive_callback() {
   static std::once_flag once;
   std::call_once(once, [] { mjcb_passive = add_effect_forces; });
 }
+
+/// The caller's scratch for steps of a MujocoStepModel.
+struct MujocoStepWorkspace final : StepWorkspace {
+  MujocoModel::DataPtr data;                  ///< the stepping mjData
+  std::unique_ptr<DynamicsWorkspace> system;  ///< the decorated system's (noise, effect forces)
+  PassiveContext context;
+  RowMajorMatrix A_sub, B_sub;
+  Matrix A_chain, B_chain;  ///< the products of the chain rule
+};
 
 /// The model's own integrator and timestep as a StepModel: dt / timestep calls of mj_step.
 class MujocoStepModel final : public StepModel {
@@ -85,14 +96,34 @@ class MujocoStepModel final : public StepModel {
   int control_dim() const override { return model_->nu(); }
   double dt() const override { return dt_; }
 
+  std::unique_ptr<StepWorkspace> make_workspace() const override {
+    auto ws = std::make_unique<MujocoStepWorkspace>();
+    const int nv = model_->nq(), nu = model_->nu(), n = 2 * nv;
+    ws->data = model_->make_data();
+    ws->system = decorated_->make_workspace();
+    ws->context = {effects_, &gains_, ws->system.get(), Vector(n), Vector(nu), Vector(nv)};
+    ws->A_sub.resize(n, n);
+    ws->B_sub.resize(n, nu);
+    ws->A_chain.resize(n, n);
+    ws->B_chain.resize(n, nu);
+    return ws;
+  }
+
   void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians) const override {
+    const auto workspace = make_workspace();
+    step(x, u, x_next, jacobians, *workspace);
+  }
+
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
+            StepWorkspace& workspace) const override {
+    auto& ws = workspace_as<MujocoStepWorkspace>(workspace);
     const mjModel* m = model_->m();
+    mjData* d = ws.data.get();
     const int nv = m->nv, n = 2 * nv, nu = m->nu;
-    auto d = model_->borrow(x, u);
+    model_->prepare(d, x, u);
     for (int a = 0; a < nu; ++a) d->ctrl[a] = gains_(a) * u(a);
-    PassiveContext context{effects_, &gains_};
     if (effects_ != nullptr) {
-      const PassiveContext* pointer = &context;
+      const PassiveContext* pointer = &ws.context;
       std::memcpy(&d->userdata[model_->context_slot()], &pointer, sizeof pointer);
     }
     if (jacobians != nullptr) {
@@ -100,15 +131,17 @@ class MujocoStepModel final : public StepModel {
       jacobians->A.setIdentity();
       jacobians->B.setZero();
     }
-    RowMajorMatrix A_sub(n, n), B_sub(n, nu);
     for (int s = 0; s < substeps_; ++s) {
       if (jacobians != nullptr) {
         // Centred differences with MuJoCo's own step; the state of d is restored afterwards.
-        mjd_transitionFD(m, d.get(), 1e-6, 1, A_sub.data(), B_sub.data(), nullptr, nullptr);
-        jacobians->B = A_sub * jacobians->B + B_sub * gains_.asDiagonal();
-        jacobians->A = A_sub * jacobians->A;
+        mjd_transitionFD(m, d, 1e-6, 1, ws.A_sub.data(), ws.B_sub.data(), nullptr, nullptr);
+        ws.B_chain.noalias() = ws.A_sub * jacobians->B;
+        ws.B_chain.noalias() += ws.B_sub * gains_.asDiagonal();
+        jacobians->B = ws.B_chain;
+        ws.A_chain.noalias() = ws.A_sub * jacobians->A;
+        jacobians->A = ws.A_chain;
       }
-      mj_step(m, d.get());
+      mj_step(m, d);
     }
     const bool unstable = d->warning[mjWARN_BADQACC].number > 0 || d->warning[mjWARN_BADQPOS].number > 0 ||
                           d->warning[mjWARN_BADQVEL].number > 0;
@@ -124,6 +157,10 @@ class MujocoStepModel final : public StepModel {
   int noise_dim() const override { return decorated_->noise_dim(); }
   void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const override {
     decorated_->noise(x, u, out, derivatives);
+  }
+  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+             StepWorkspace& workspace) const override {
+    decorated_->noise(x, u, out, derivatives, *workspace_as<MujocoStepWorkspace>(workspace).system);
   }
 
  private:
@@ -180,40 +217,53 @@ int MujocoSystem::joint_dof(const std::string& joint) const {
   return id < 0 ? -1 : model_->m()->jnt_dofadr[id];
 }
 
+std::unique_ptr<DynamicsWorkspace> MujocoSystem::make_workspace() const {
+  auto ws = std::make_unique<MujocoWorkspace>();
+  ws->data = model_->make_data();
+  return ws;
+}
+
 void MujocoSystem::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot,
                             DynamicsJacobians* jacobians) const {
+  const auto workspace = make_workspace();
+  evaluate(x, u, xdot, jacobians, *workspace);
+}
+
+void MujocoSystem::evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot, DynamicsJacobians* jacobians,
+                            DynamicsWorkspace& workspace) const {
   const mjModel* m = model_->m();
+  mjData* d = workspace_as<MujocoWorkspace>(workspace).data.get();
   const int nv = m->nv;
-  {
-    auto d = model_->borrow(x, u);
-    mj_forward(m, d.get());
-    for (int i = 0; i < nv; ++i) {
-      xdot(i) = d->qvel[i];
-      xdot(nv + i) = d->qacc[i];
-    }
-  }
-  if (jacobians == nullptr) return;
-  const Vector x0 = x, u0 = u;
-  const auto f = [&](const Vector& xs, const Vector& us, Vector& out) {
-    auto d = model_->borrow(xs, us);
-    mj_forward(m, d.get());
+  const auto f = [&](const VectorCRef& xs, const VectorCRef& us, VectorRef out) {
+    model_->prepare(d, xs, us);
+    mj_forward(m, d);
     for (int i = 0; i < nv; ++i) {
       out(i) = d->qvel[i];
       out(nv + i) = d->qacc[i];
     }
   };
+  f(x, u, xdot);
+  if (jacobians == nullptr) return;
+  const Vector x0 = x, u0 = u;
   const int n = 2 * nv;
   jacobians->fx = central_difference_jacobian([&](const Vector& xs, Vector& out) { f(xs, u0, out); }, x0, n);
   jacobians->fu = central_difference_jacobian([&](const Vector& us, Vector& out) { f(x0, us, out); }, u0, n);
 }
 
 void MujocoSystem::generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const {
+  const auto workspace = make_workspace();
+  generalised_force_map(x, W, d_dx, *workspace);
+}
+
+void MujocoSystem::generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx,
+                                         DynamicsWorkspace& workspace) const {
   const mjModel* m = model_->m();
+  mjData* d = workspace_as<MujocoWorkspace>(workspace).data.get();
   const int nv = m->nv, n = 2 * nv;
   const Vector u0 = Vector::Zero(m->nu);
   const auto inverse_mass = [&](const Vector& xs) {
-    auto d = model_->borrow(xs, u0);
-    mj_forward(m, d.get());
+    model_->prepare(d, xs, u0);
+    mj_forward(m, d);
     RowMajorMatrix M(nv, nv);
     mj_fullM(m, M.data(), d->qM);
     return Matrix(M.llt().solve(Matrix::Identity(nv, nv)));

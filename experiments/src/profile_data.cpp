@@ -129,9 +129,10 @@ ProfileData read_measurement_profile(const std::filesystem::path& file, const Pr
     // x' - x = (x' - phi_sim(x, u)) + (phi_sim(x, u) - x): recover x' - x from the rows themselves.
     Vector x_next_minus_x(residual.size());
     Vector predicted(n);
+    const auto workspace = simulator.make_workspace();
     for (int t = 0; t < residual.size(); ++t) {
       simulator.step(residual.inputs.row(t).head(n).transpose(), residual.inputs.row(t).tail(residual.inputs.cols() - n).transpose(),
-                     predicted);
+                     predicted, nullptr, *workspace);
       x_next_minus_x(t) = targets(t) + predicted(output) - residual.inputs(t, output);
     }
     targets = x_next_minus_x;

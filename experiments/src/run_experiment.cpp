@@ -108,16 +108,19 @@ ModelSlice model_slice(const StepModel& world, const StepModel& model, const Tra
   s.simulator.resize(kPoints), s.mean.resize(kPoints), s.std.resize(kPoints), s.truth.resize(kPoints);
   Vector x_next(n);
   DiffusionColumns columns;
+  const auto simulator_ws = residual->simulator().make_workspace();
+  const auto residual_ws = residual->make_workspace();
+  const auto world_ws = world.make_workspace();
   for (int p = 0; p < kPoints; ++p) {
     Vector zp = s.base;
     zp(s.input) = s.grid(p);
-    residual->simulator().step(zp.head(n), zp.tail(m), x_next);
+    residual->simulator().step(zp.head(n), zp.tail(m), x_next, nullptr, *simulator_ws);
     s.simulator(p) = x_next(s.output);
-    residual->step(zp.head(n), zp.tail(m), x_next);
+    residual->step(zp.head(n), zp.tail(m), x_next, nullptr, *residual_ws);
     s.mean(p) = x_next(s.output);
-    world.step(zp.head(n), zp.tail(m), x_next);
+    world.step(zp.head(n), zp.tail(m), x_next, nullptr, *world_ws);
     s.truth(p) = x_next(s.output);
-    residual->uncertainty(zp.head(n), zp.tail(m), columns, false);
+    residual->uncertainty(zp.head(n), zp.tail(m), columns, false, *residual_ws);
     // G_ii = sqrt(var / dt) (residual_model.hpp), so the per-step std is G_ii sqrt(dt).
     s.std(p) = columns.columns(s.output, s.output) * std::sqrt(residual->dt());
   }

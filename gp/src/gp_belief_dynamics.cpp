@@ -67,17 +67,39 @@ GpBeliefDynamics GpBeliefDynamics::fit(int n, int m, double dt, const Matrix& in
   return dynamics;
 }
 
+namespace {
+
+/// The caller's scratch for GpBeliefDynamics::propagate.
+struct GpBeliefWorkspace final : BeliefWorkspace {
+  Vector mu, mu_z;
+  Matrix Sigma, Sigma_z, Sigma_next;
+  MomentMatch mm;
+};
+
+}  // namespace
+
+std::unique_ptr<BeliefWorkspace> GpBeliefDynamics::make_workspace() const {
+  return std::make_unique<GpBeliefWorkspace>();
+}
+
 void GpBeliefDynamics::propagate(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
                                  BeliefJacobians* jacobians) const {
+  const auto workspace = make_workspace();
+  propagate(v, u, v_next, jacobians, *workspace);
+}
+
+void GpBeliefDynamics::propagate(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
+                                 BeliefJacobians* jacobians, BeliefWorkspace& workspace) const {
   const int n = n_, m = m_, D = n + m, nb = belief_dim(n);
   if (v.size() != nb || u.size() != m || v_next.size() != nb)
     throw std::invalid_argument("GpBeliefDynamics::propagate: belief has " + std::to_string(v.size()) +
                                 " entries, control " + std::to_string(u.size()) + "; expected " +
                                 std::to_string(nb) + " and " + std::to_string(m));
-  // Per-thread buffers: this model is const and shared, and propagate must not allocate per step.
-  thread_local Vector mu, mu_z;
-  thread_local Matrix Sigma, Sigma_z, Sigma_next;
-  thread_local MomentMatch mm;
+  // The caller's buffers: this model is const and shared, and propagate must not allocate per step.
+  auto& ws = workspace_as<GpBeliefWorkspace>(workspace);
+  Vector &mu = ws.mu, &mu_z = ws.mu_z;
+  Matrix &Sigma = ws.Sigma, &Sigma_z = ws.Sigma_z, &Sigma_next = ws.Sigma_next;
+  MomentMatch& mm = ws.mm;
   mm.threads = threads_;
   unpack_belief(v, n, mu, Sigma);
   mu_z.resize(D);

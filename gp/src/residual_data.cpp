@@ -44,10 +44,11 @@ ResidualData make_residual_data(const StepModel& simulator, const MatrixCRef& x,
   data.inputs.resize(x.rows(), n + m);
   data.residuals.resize(x.rows(), n);
   Vector predicted(n);
+  const auto workspace = simulator.make_workspace();
   for (Eigen::Index t = 0; t < x.rows(); ++t) {
     data.inputs.row(t).head(n) = x.row(t);
     data.inputs.row(t).tail(m) = u.row(t);
-    simulator.step(x.row(t).transpose(), u.row(t).transpose(), predicted);
+    simulator.step(x.row(t).transpose(), u.row(t).transpose(), predicted, nullptr, *workspace);
     data.residuals.row(t) = x_next.row(t) - predicted.transpose();
   }
   return data;

@@ -11,22 +11,16 @@ namespace gpilqg::gp {
 
 namespace {
 
-/// Per-thread scratch space: a const model shared between threads never allocates per step once each
-/// thread has warmed up its buffers.
-struct StepScratch {
+/// The caller's scratch for one ResidualModel: a caller that keeps it never allocates per step once
+/// its buffers are warm.
+struct ResidualWorkspace final : StepWorkspace {
+  std::unique_ptr<StepWorkspace> simulator;
   Vector z;
   std::vector<Prediction> predictions;
   Vector values;     // shared path: the n means or variances
   Matrix gradients;  // shared path: their gradients as rows (n x (n + m))
+  detail::SharedExactPrediction::Cache shared;
 };
-
-StepScratch& step_scratch(int input_dim, int outputs) {
-  thread_local StepScratch scratch;
-  if (scratch.z.size() != input_dim) scratch.z.resize(input_dim);
-  if (scratch.predictions.size() < static_cast<std::size_t>(outputs))
-    scratch.predictions.resize(static_cast<std::size_t>(outputs));
-  return scratch;
-}
 
 }  // namespace
 
@@ -120,14 +114,28 @@ ResidualModel ResidualModel::fit(SimulatorPtr simulator, const MeasurementSet& m
   return fit(std::move(simulator), data, backend, options, report);
 }
 
+std::unique_ptr<StepWorkspace> ResidualModel::make_workspace() const {
+  auto ws = std::make_unique<ResidualWorkspace>();
+  ws->simulator = simulator_->make_workspace();
+  ws->z.resize(state_dim() + control_dim());
+  ws->predictions.resize(outputs_.size());
+  return ws;
+}
+
 void ResidualModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians) const {
-  simulator_->step(x, u, x_next, jacobians);
+  const auto workspace = make_workspace();
+  step(x, u, x_next, jacobians, *workspace);
+}
+
+void ResidualModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
+                         StepWorkspace& workspace) const {
+  auto& s = workspace_as<ResidualWorkspace>(workspace);
+  simulator_->step(x, u, x_next, jacobians, *s.simulator);
   const int n = state_dim(), m = control_dim();
-  StepScratch& s = step_scratch(n + m, n);
   s.z.head(n) = x;
   s.z.tail(m) = u;
   if (shared_) {
-    shared_->means(s.z, s.values, jacobians != nullptr ? &s.gradients : nullptr);
+    shared_->means(s.z, s.values, jacobians != nullptr ? &s.gradients : nullptr, s.shared);
     x_next += s.values;
     if (jacobians != nullptr) {
       jacobians->A += s.gradients.leftCols(n);
@@ -151,16 +159,27 @@ void ResidualModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionCol
   simulator_->noise(x, u, out, derivatives);
 }
 
+void ResidualModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+                          StepWorkspace& workspace) const {
+  simulator_->noise(x, u, out, derivatives, *workspace_as<ResidualWorkspace>(workspace).simulator);
+}
+
 void ResidualModel::uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
                                 bool derivatives) const {
+  const auto workspace = make_workspace();
+  uncertainty(x, u, out, derivatives, *workspace);
+}
+
+void ResidualModel::uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+                                StepWorkspace& workspace) const {
   const int n = state_dim(), m = control_dim();
   const double step = dt();
   out.resize(n, m, n);
-  StepScratch& s = step_scratch(n + m, n);
+  auto& s = workspace_as<ResidualWorkspace>(workspace);
   s.z.head(n) = x;
   s.z.tail(m) = u;
   if (shared_) {
-    shared_->variances(s.z, s.values, derivatives ? &s.gradients : nullptr);
+    shared_->variances(s.z, s.values, derivatives ? &s.gradients : nullptr, s.shared);
   } else {
     const PredictionRequest request{true, derivatives};
     s.values.resize(n);

@@ -13,14 +13,6 @@ std::uint64_t next_id() {
 
 }  // namespace
 
-struct SharedExactPrediction::Cache {
-  std::uint64_t id = 0;  // 0: empty (ids start at 1)
-  Vector z;
-  Matrix squared;  // (X - 1 z').^2, N x D
-  Matrix cross;    // k_a in column a, N x n
-  Vector gradient, weighted, scratch;
-};
-
 std::shared_ptr<const SharedExactPrediction> SharedExactPrediction::make(
     const std::vector<std::shared_ptr<const FittedGp>>& outputs) {
   std::vector<const ExactPredictor*> predictors;
@@ -41,8 +33,7 @@ SharedExactPrediction::SharedExactPrediction(std::vector<std::shared_ptr<const F
                                              std::vector<const ExactPredictor*> predictors)
     : outputs_(std::move(outputs)), predictors_(std::move(predictors)), id_(next_id()) {}
 
-SharedExactPrediction::Cache& SharedExactPrediction::at(const VectorCRef& z) const {
-  thread_local Cache cache;
+SharedExactPrediction::Cache& SharedExactPrediction::at(const VectorCRef& z, Cache& cache) const {
   if (cache.id == id_ && cache.z.size() == z.size() && cache.z == z) return cache;
   cache.id = 0;  // invalid until complete (an exception below leaves no stale entry)
   const Matrix& x = predictors_.front()->inputs();
@@ -56,8 +47,9 @@ SharedExactPrediction::Cache& SharedExactPrediction::at(const VectorCRef& z) con
 }
 
 template <class Stage>
-void SharedExactPrediction::each_output(const VectorCRef& z, Vector& values, Matrix* gradient, Stage&& stage) const {
-  Cache& c = at(z);
+void SharedExactPrediction::each_output(const VectorCRef& z, Vector& values, Matrix* gradient, Cache& cache,
+                                        Stage&& stage) const {
+  Cache& c = at(z, cache);
   const auto n = static_cast<Eigen::Index>(predictors_.size());
   values.resize(n);
   if (gradient != nullptr) gradient->resize(n, z.size());
@@ -67,14 +59,14 @@ void SharedExactPrediction::each_output(const VectorCRef& z, Vector& values, Mat
   }
 }
 
-void SharedExactPrediction::means(const VectorCRef& z, Vector& mean, Matrix* gradient) const {
-  each_output(z, mean, gradient, [&z](const ExactPredictor& p, Cache& c, const auto& k, Vector* g) {
+void SharedExactPrediction::means(const VectorCRef& z, Vector& mean, Matrix* gradient, Cache& cache) const {
+  each_output(z, mean, gradient, cache, [&z](const ExactPredictor& p, Cache& c, const auto& k, Vector* g) {
     return p.mean(z, k, g, c.scratch);
   });
 }
 
-void SharedExactPrediction::variances(const VectorCRef& z, Vector& variance, Matrix* gradient) const {
-  each_output(z, variance, gradient, [&z](const ExactPredictor& p, Cache& c, const auto& k, Vector* g) {
+void SharedExactPrediction::variances(const VectorCRef& z, Vector& variance, Matrix* gradient, Cache& cache) const {
+  each_output(z, variance, gradient, cache, [&z](const ExactPredictor& p, Cache& c, const auto& k, Vector* g) {
     return p.variance(z, k, g, c.weighted, c.scratch);
   });
 }

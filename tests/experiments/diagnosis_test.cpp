@@ -99,9 +99,10 @@ TEST(Diagnosis, NothingHiddenIsConsistentAndProposesNothing) {
 /// A test-only effect outside the library: a cubic spring pulling the cart to x = 0, Q_x = -k x^3.
 ForceEffectPtr cubic_spring() {
   return std::make_shared<LinearForceEffect>(
-      "cubic_spring", EffectParameter{"k", "N/m^3", 1.0}, "Q_x = -k x^3", 2, [](const VectorCRef& x, VectorRef g, Matrix* dg_dx) {
-        g(0) = -x(0) * x(0) * x(0);
-        if (dg_dx != nullptr) (*dg_dx)(0, 0) = -3.0 * x(0) * x(0);
+      "cubic_spring", EffectParameter{"k", "N/m^3", 1.0}, "Q_x = -k x^3", 2,
+      [](const VectorCRef& x, double k, VectorRef Q, Matrix* dQ_dx) {
+        Q(0) -= k * x(0) * x(0) * x(0);
+        if (dQ_dx != nullptr) (*dQ_dx)(0, 0) -= 3.0 * k * x(0) * x(0);
       });
 }
 

@@ -1,5 +1,5 @@
-/// Practice 1 of DESIGN.md: after a warm-up, prediction, the residual model's step and uncertainty,
-/// and moment matching (PDDP's belief step) do not touch the heap. Counted by interposing glibc's malloc in this test program.
+/// Practice 1 of DESIGN.md: after a warm-up, prediction, the residual model's step and uncertainty
+/// with the caller's workspace, and moment matching (PDDP's belief step) do not touch the heap. Counted by interposing glibc's malloc in this test program.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,7 @@
 
 #include "gp_test_support.hpp"
 #include "moment_matching_checks.hpp"
+#include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/gp/moment_matching.hpp"
@@ -93,16 +94,56 @@ TEST(Allocation, ResidualModelStepAndUncertaintyDoNotAllocateAfterWarmUp) {
   StepJacobians jac;
   jac.resize(4, 1);
   DiffusionColumns g;
-  model.step(x, u, next, &jac);  // warm-up
-  model.uncertainty(x, u, g, true);
+  // The caller's workspace (model/data split): the model itself is const and keeps no scratch.
+  const auto workspace = model.make_workspace();
+  model.step(x, u, next, &jac, *workspace);  // warm-up
+  model.uncertainty(x, u, g, true, *workspace);
   const long before = g_malloc_calls.load();
   for (int i = 0; i < 10; ++i) {
     x(0) = 0.01 * i;  // a new query each time (the shared prediction keeps the last one)
-    model.step(x, u, next, &jac);
-    model.step(x, u, next);
-    model.uncertainty(x, u, g, true);
+    model.step(x, u, next, &jac, *workspace);
+    model.step(x, u, next, nullptr, *workspace);
+    model.uncertainty(x, u, g, true, *workspace);
   }
   EXPECT_EQ(g_malloc_calls.load() - before, 0);
+}
+
+/// Steps with Jacobians and noise columns of `model` at a few states, with one workspace.
+long allocations_of_steps(const StepModel& model) {
+  const int n = model.state_dim(), m = model.control_dim();
+  const auto workspace = model.make_workspace();
+  Vector x = Vector::Constant(n, 0.1), next(n);
+  const Vector u = Vector::Constant(m, 0.2);
+  StepJacobians jac;
+  DiffusionColumns columns;
+  model.step(x, u, next, &jac, *workspace);  // warm-up
+  model.noise(x, u, columns, true, *workspace);
+  const long before = g_malloc_calls.load();
+  for (int i = 0; i < 10; ++i) {
+    x(0) = 0.01 * i;
+    model.step(x, u, next, &jac, *workspace);
+    model.step(x, u, next, nullptr, *workspace);
+    model.noise(x, u, columns, true, *workspace);
+  }
+  return g_malloc_calls.load() - before;
+}
+
+TEST(Allocation, SystemsWithEffectsStepWithoutAllocatingInTheirWorkspace) {
+  SKIP_WITHOUT_COUNTER();
+  ActuatorNoise noise;
+  noise.multiplicative_std = Vector::Constant(1, 0.1);
+  ModelSpec cartpole;
+  cartpole = cartpole.with(find_effect("cartpole", "cart_coulomb_friction"), Vector::Constant(1, 0.5));
+  cartpole = cartpole.with(find_effect("cartpole", "actuator_gain"), Vector::Constant(1, 0.9));
+  EXPECT_EQ(allocations_of_steps(*make_step_model(cartpole.build(noise), Integrator::RK4, 0.05, 2)), 0);
+
+  // A MuJoCo model: mj_step and mjd_transitionFD work in the workspace's mjData, and the effects'
+  // forces (joint damping here) in the workspace of the system they decorate.
+  const std::string arm = (gpilqg::test::source_dir() / "data" / "two_link_arm.xml").string();
+  ModelSpec damped;
+  damped.system = arm;
+  damped = damped.with(find_effect(arm, "joint_viscous_damping:elbow"), Vector::Constant(1, 0.3));
+  EXPECT_EQ(allocations_of_steps(*make_step_model(damped.build(), Integrator::RK4, 0.05)), 0);
 }
 
 TEST(Allocation, MomentMatchingDoesNotAllocateAfterWarmUp) {

@@ -26,9 +26,10 @@ Vector weighted_residual(const StepModel& model, const FitContext& c, const std:
   const Vector sqrt_w = c.weights.cwiseSqrt();
   Vector out(static_cast<Eigen::Index>(rows.size()) * n);
   Vector next(n);
+  const auto workspace = model.make_workspace();
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const int r = rows[k];
-    model.step(c.data->x.row(r).transpose(), c.data->u.row(r).transpose(), next);
+    model.step(c.data->x.row(r).transpose(), c.data->u.row(r).transpose(), next, nullptr, *workspace);
     if (!next.allFinite()) {
       if (finite != nullptr) *finite = false;
       out.segment(static_cast<Eigen::Index>(k) * n, n).setConstant(1e150);

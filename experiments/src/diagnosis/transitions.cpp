@@ -70,9 +70,10 @@ Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& 
 Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* non_finite) {
   Matrix out(data.size(), model.state_dim());
   Vector next(model.state_dim());
+  const auto workspace = model.make_workspace();
   int bad = 0;
   for (int i = 0; i < data.size(); ++i) {
-    model.step(data.x.row(i).transpose(), data.u.row(i).transpose(), next);
+    model.step(data.x.row(i).transpose(), data.u.row(i).transpose(), next, nullptr, *workspace);
     if (next.allFinite()) {
       out.row(i) = next.transpose();
     } else {
@@ -92,13 +93,14 @@ KStepPredictions k_step_predictions(const StepModel& model, const MeasurementSet
   out.k = k;
   std::vector<Vector> measured, predicted;
   Vector x(n), next(n);
+  const auto workspace = model.make_workspace();
   for (int index : episodes) {
     const Episode& e = set.episodes.at(static_cast<std::size_t>(index));
     for (int s = 0; s + k < e.length(); s += stride) {
       x = e.x.row(s).transpose();
       bool finite = true;
       for (int j = 0; j < k && finite; ++j) {
-        model.step(x, e.u.row(s + j).transpose(), next);
+        model.step(x, e.u.row(s + j).transpose(), next, nullptr, *workspace);
         finite = next.allFinite() && next.cwiseAbs().maxCoeff() < 1e12;
         x = next;
       }

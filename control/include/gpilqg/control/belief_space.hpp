@@ -24,8 +24,12 @@ class BeliefSpaceModel final : public StepModel {
   int state_dim() const override { return belief_dim(belief_.state_dim()); }
   int control_dim() const override { return belief_.control_dim(); }
   double dt() const override { return belief_.dt(); }
+  /// Holds the belief model's workspace and its Jacobians.
+  std::unique_ptr<StepWorkspace> make_workspace() const override;
   void step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
             StepJacobians* jacobians = nullptr) const override;
+  void step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next, StepJacobians* jacobians,
+            StepWorkspace& workspace) const override;
 
  private:
   const BeliefStepModel& belief_;

@@ -74,9 +74,10 @@ RolloutResult closed_loop_rollout(const StepModel& world, const VectorCRef& x0, 
 /// One sampled step, the shared mechanism of every simulated rollout in the project:
 ///   x' = phi(x, u) [+ sqrt(dt) F(x, u) xi] [+ sqrt(dt) G(x, u) xi_G]
 /// as `noise` selects (None: the mean step; rng may then be null). `scratch` holds the columns
-/// between calls. Returns false when x' is not finite (a diverging rollout).
+/// between calls and `workspace` (model.make_workspace()) the model's scratch. Returns false when x' is
+/// not finite (a diverging rollout).
 bool sample_step(const StepModel& model, const VectorCRef& x, const VectorCRef& u, RolloutNoise noise,
-                 DiffusionColumns& scratch, std::mt19937_64* rng, VectorRef x_next);
+                 DiffusionColumns& scratch, std::mt19937_64* rng, VectorRef x_next, StepWorkspace& workspace);
 
 /// Adds N(0, diag(std^2)) to x (a measurement of the state); no-op when `std` is empty.
 void add_observation_noise(const Vector& std, std::mt19937_64& rng, VectorRef x);

@@ -8,7 +8,10 @@
 /// column (Sigma_00, Sigma_10, ..., Sigma_n-1,0, Sigma_11, ...). Derivatives with respect to the packed
 /// entries treat Sigma as symmetric: moving packed entry (i, j), i != j, moves Sigma_ij and Sigma_ji.
 
+#include <memory>
+
 #include "gpilqg/core/types.hpp"
+#include "gpilqg/core/workspace.hpp"
 
 namespace gpilqg {
 
@@ -29,9 +32,16 @@ struct BeliefJacobians {
 };
 
 /// Deterministic belief dynamics v' = F(v, u) at step dt.
+/// The scratch space of one caller of a BeliefStepModel (the model/data split of step_model.hpp).
+struct BeliefWorkspace {
+  virtual ~BeliefWorkspace() = default;
+};
+
 class BeliefStepModel {
  public:
   virtual ~BeliefStepModel() = default;
+  /// A workspace for this model's propagations (the default is empty).
+  virtual std::unique_ptr<BeliefWorkspace> make_workspace() const { return std::make_unique<BeliefWorkspace>(); }
   virtual int state_dim() const = 0;
   virtual int control_dim() const = 0;
   virtual double dt() const = 0;
@@ -39,6 +49,11 @@ class BeliefStepModel {
   /// cannot be propagated (non-finite input) throws std::invalid_argument.
   virtual void propagate(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
                          BeliefJacobians* jacobians = nullptr) const = 0;
+  /// The same with the caller's workspace (from make_workspace()); the default calls the form without.
+  virtual void propagate(const VectorCRef& v, const VectorCRef& u, VectorRef v_next, BeliefJacobians* jacobians,
+                         BeliefWorkspace&) const {
+    propagate(v, u, v_next, jacobians);
+  }
 };
 
 }  // namespace gpilqg

@@ -10,6 +10,7 @@
 #include "gpilqg/core/noise.hpp"
 #include "gpilqg/core/quantity.hpp"
 #include "gpilqg/core/types.hpp"
+#include "gpilqg/core/workspace.hpp"
 
 namespace gpilqg {
 
@@ -28,8 +29,21 @@ struct InputMatrix {
   void resize(int n, int m);
 };
 
+/// The scratch space of one caller of a Dynamics (Crocoddyl's model/data split): made by the system's
+/// make_workspace(), owned by the caller, used by one thread at a time, and reused from call to call so
+/// that hot loops do not allocate. Systems with more scratch derive from it.
+struct DynamicsWorkspace {
+  virtual ~DynamicsWorkspace() = default;
+  InputMatrix input;  ///< b(x, u) for the noise columns
+};
+
 /// A continuous-time system. Implementations are immutable once built and safe to share between
-/// threads; all scratch space belongs to the caller.
+/// threads; all scratch space belongs to the caller (DynamicsWorkspace).
+///
+/// Each evaluation comes in two forms: with the caller's workspace (the one hot loops use), and
+/// without, which makes a temporary workspace (convenient, and free for systems without scratch).
+/// A system without scratch implements the forms without a workspace; a system with scratch overrides
+/// make_workspace() and the forms with a workspace, and implements the others through them.
 class Dynamics {
  public:
   virtual ~Dynamics() = default;
@@ -46,9 +60,15 @@ class Dynamics {
   int state_dim() const { return static_cast<int>(states().size()); }
   int control_dim() const { return static_cast<int>(controls().size()); }
 
+  /// A workspace for this system's evaluations (the default holds the noise's input matrix).
+  virtual std::unique_ptr<DynamicsWorkspace> make_workspace() const;
+
   /// xdot = f(x, u). When `jacobians` is not null, also fx and fu (resized if needed).
   virtual void evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot,
                         DynamicsJacobians* jacobians = nullptr) const = 0;
+  /// The same with the caller's workspace (from make_workspace()).
+  virtual void evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot, DynamicsJacobians* jacobians,
+                        DynamicsWorkspace& workspace) const;
 
   /// Convenience: returns f(x, u).
   Vector f(const VectorCRef& x, const VectorCRef& u) const;
@@ -56,6 +76,9 @@ class Dynamics {
   /// b(x, u) = df/du and its derivatives. The default differentiates fu from evaluate() by central
   /// differences (step 1e-6 scaled by the magnitude); systems with analytic forms override it.
   virtual void input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const;
+  /// The same with the caller's workspace; the default calls the form without one.
+  virtual void input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out,
+                            DynamicsWorkspace& workspace) const;
 
   /// The noise model behind F(x, u); see ActuatorNoise for the columns it produces.
   const ActuatorNoise& noise_model() const { return noise_; }
@@ -65,10 +88,19 @@ class Dynamics {
   int noise_dim() const { return noise_.column_count(); }
 
   /// F(x, u) (n x p) and, when `derivatives` is true, the derivative of every column.
+  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+             DynamicsWorkspace& workspace) const;
+  /// The same with a temporary workspace.
   void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const;
 
   /// The name, states and controls: what a measurement file must match.
   SystemSignature signature() const { return {name(), states(), controls()}; }
+
+ protected:
+  /// b and its derivatives by central differences of fu (the default input_matrix), evaluating with
+  /// `workspace` when not null.
+  void input_matrix_by_differences(const VectorCRef& x, const VectorCRef& u, InputMatrix& out,
+                                   DynamicsWorkspace* workspace) const;
 
  private:
   ActuatorNoise noise_;

@@ -16,6 +16,7 @@ namespace gpilqg::effect_bases {
 /// Width of the tanh that smooths Coulomb friction (DESIGN.md sections 5 and 10) [m/s or rad/s].
 inline constexpr double kCoulombWidth = 0.05;
 
+/// Each basis adds theta g(x) to Q and theta dg/dx to dQ/dx (LinearForceEffect::Basis).
 /// g = -x(velocity) on `component`: viscous friction or damping.
 LinearForceEffect::Basis viscous(int component, int velocity);
 /// g = -tanh(x(velocity) / 0.05) on `component`: Coulomb friction, smoothed.

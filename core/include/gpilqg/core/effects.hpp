@@ -58,6 +58,12 @@ class ForceEffect {
   /// dQ/du to `dQ_du` (k_Q x m). `u` is the commanded input. `theta` has parameters().size() entries.
   virtual void add_force(const VectorCRef& x, const VectorCRef& u, const VectorCRef& theta, VectorRef Q,
                          Matrix* dQ_dx, Matrix* dQ_du) const = 0;
+  /// The same with the workspace of the system the force acts on (for effects that evaluate the
+  /// system, such as a force at a MuJoCo body's centre of mass); the default calls the form without.
+  virtual void add_force(const VectorCRef& x, const VectorCRef& u, const VectorCRef& theta, VectorRef Q,
+                         Matrix* dQ_dx, Matrix* dQ_du, DynamicsWorkspace&) const {
+    add_force(x, u, theta, Q, dQ_dx, dQ_du);
+  }
 };
 
 using ForceEffectPtr = std::shared_ptr<const ForceEffect>;
@@ -66,9 +72,8 @@ using ForceEffectPtr = std::shared_ptr<const ForceEffect>;
 /// depend on u. Every force of the built-in library has this form.
 class LinearForceEffect final : public ForceEffect {
  public:
-  /// Writes g(x) into `g` (k_Q entries, zeroed by the caller) and, when not null, dg/dx into `dg_dx`
-  /// (k_Q x n, zeroed by the caller).
-  using Basis = std::function<void(const VectorCRef& x, VectorRef g, Matrix* dg_dx)>;
+  /// Adds theta g(x) to `Q` (k_Q entries) and, when not null, theta dg/dx to `dQ_dx` (k_Q x n).
+  using Basis = std::function<void(const VectorCRef& x, double theta, VectorRef Q, Matrix* dQ_dx)>;
 
   /// `force_dim` is k_Q of the systems this effect applies to. Throws std::invalid_argument for an
   /// empty name, a null basis or force_dim < 1.
@@ -110,15 +115,22 @@ class EffectDynamics final : public Dynamics {
   /// The base system's parameters, then "actuator_gain.k", then "<effect>.<parameter>" per effect.
   std::vector<Parameter> parameters() const override;
 
+  /// Holds the base system's workspace and the forces' buffers.
+  std::unique_ptr<DynamicsWorkspace> make_workspace() const override;
   void evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot,
                 DynamicsJacobians* jacobians = nullptr) const override;
+  void evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot, DynamicsJacobians* jacobians,
+                DynamicsWorkspace& workspace) const override;
   /// Analytic when no effect depends on u: b = k b^base(x, k u) + W dQ/du with dQ/du = 0, so
   /// db_j/dx = k db_j^base/dx and db_j/du = k^2 db_j^base/du_a; otherwise central differences.
   void input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const override;
+  void input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out,
+                    DynamicsWorkspace& workspace) const override;
 
   /// Q(x, u) = sum_e Q_e(x, u; theta_e) (k_Q entries, the base system's generalised forces); `u` is
   /// the commanded input. Used by systems that integrate the forces themselves (OwnIntegrator).
-  void generalised_force(const VectorCRef& x, const VectorCRef& u, VectorRef Q) const;
+  /// `workspace` is one of this system's (make_workspace()).
+  void generalised_force(const VectorCRef& x, const VectorCRef& u, VectorRef Q, DynamicsWorkspace& workspace) const;
 
   const Dynamics& base() const { return *base_; }
   double actuator_gain() const { return gain_; }

@@ -10,6 +10,7 @@
 
 #include <vector>
 
+#include "gpilqg/core/dynamics.hpp"
 #include "gpilqg/core/quantity.hpp"
 #include "gpilqg/core/types.hpp"
 
@@ -25,6 +26,12 @@ class GeneralisedForceInput {
   /// W(x) (n x k, resized if needed) such that xdot gains W(x) Q. When `d_dx` is not null it receives
   /// n matrices (n x k each): entry j is dW/dx_j.
   virtual void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const = 0;
+  /// The same with the workspace of the system (Dynamics::make_workspace()); the default calls the
+  /// form without one.
+  virtual void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx,
+                                     DynamicsWorkspace&) const {
+    generalised_force_map(x, W, d_dx);
+  }
 };
 
 }  // namespace gpilqg

@@ -38,17 +38,24 @@ class IntegratedStepModel final : public StepModel {
   int substeps() const { return substeps_; }
   const Dynamics& dynamics() const { return *dynamics_; }
 
+  /// Holds the stages of the integrator and the dynamics' workspace.
+  std::unique_ptr<StepWorkspace> make_workspace() const override;
   void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
             StepJacobians* jacobians = nullptr) const override;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
+            StepWorkspace& workspace) const override;
 
   int noise_dim() const override { return dynamics_->noise_dim(); }
   void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
              bool derivatives) const override;
+  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+             StepWorkspace& workspace) const override;
 
  private:
+  struct Workspace;
   /// One sub-step of length h from x; on return x holds the new state. When jac is not null, the
   /// sub-step's own A and B are written there.
-  void substep(Vector& x, const VectorCRef& u, double h, StepJacobians* jac) const;
+  void substep(Vector& x, const VectorCRef& u, double h, StepJacobians* jac, Workspace& ws) const;
 
   DynamicsPtr dynamics_;
   Integrator integrator_;

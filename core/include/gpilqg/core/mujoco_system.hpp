@@ -25,9 +25,9 @@
 ///   "<joint>.frictionloss", "<joint>.stiffness" (the model's units), "<actuator>.gear" (-),
 ///   "<actuator>.gain" (-, 1 in the file: the applied control is gain * u).
 ///
-/// Thread safety: a MujocoSystem is immutable. Every evaluation borrows an mjData from a pool owned by
-/// the shared model (each call sets the whole state first, so results do not depend on which mjData it
-/// gets), so any number of threads can step one model.
+/// Thread safety: a MujocoSystem and its step model are immutable; the mjData each call works in
+/// belongs to the caller's workspace (make_workspace()), and every call sets the whole state first, so
+/// results never depend on the workspace's history and any number of threads can step one model.
 
 #include <memory>
 #include <string>
@@ -40,7 +40,7 @@
 
 namespace gpilqg {
 
-class MujocoModel;  // the loaded mjModel with its names and mjData pool (mujoco_model.hpp, internal)
+class MujocoModel;  // the loaded mjModel with its names and fields (mujoco_model.hpp, internal)
 
 class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public OwnIntegrator {
  public:
@@ -57,12 +57,24 @@ class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public
   const std::vector<Quantity>& controls() const override;
   std::vector<Parameter> parameters() const override;
 
+  /// Holds the caller's own mjData.
+  std::unique_ptr<DynamicsWorkspace> make_workspace() const override;
   void evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot,
                 DynamicsJacobians* jacobians = nullptr) const override;
+  void evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot, DynamicsJacobians* jacobians,
+                DynamicsWorkspace& workspace) const override;
+
+  /// b = df/du by central differences of fu, in the caller's mjData.
+  void input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out,
+                    DynamicsWorkspace& workspace) const override {
+    input_matrix_by_differences(x, u, out, &workspace);
+  }
 
   const std::vector<Quantity>& generalised_forces() const override;
   /// W = [0; M(q)^-1] (n x nv); dW/dx_j by central differences over q_j (zero for velocities).
   void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const override;
+  void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx,
+                             DynamicsWorkspace& workspace) const override;
 
   /// The model's integrator and timestep with `decorated`'s effects (this system, or an EffectDynamics
   /// over it). Throws std::invalid_argument when dt is not a whole multiple of the timestep.

@@ -26,9 +26,25 @@ struct StepJacobians {
   void resize(int n, int m);
 };
 
+/// The scratch space of one caller of a StepModel (Crocoddyl's model/data split): made by the model's
+/// make_workspace(), owned by the caller, used by one thread at a time and reused from call to call,
+/// so that a solver's passes do not allocate. The step, noise and uncertainty at the same (x, u) may
+/// share work through it (the GP residual model's predictions). Models with scratch derive from it.
+struct StepWorkspace {
+  virtual ~StepWorkspace() = default;
+};
+
+/// A discrete-time model. Immutable once built and shareable between threads; all scratch space
+/// belongs to the caller. Like Dynamics, each call comes with the caller's workspace (what hot loops
+/// use) and without one (a temporary workspace; free for models without scratch): a model without
+/// scratch implements the forms without a workspace, a model with scratch overrides make_workspace()
+/// and the forms with one.
 class StepModel {
  public:
   virtual ~StepModel() = default;
+
+  /// A workspace for this model's calls (the default is empty).
+  virtual std::unique_ptr<StepWorkspace> make_workspace() const { return std::make_unique<StepWorkspace>(); }
 
   virtual int state_dim() const = 0;
   virtual int control_dim() const = 0;
@@ -38,18 +54,31 @@ class StepModel {
   /// Mean step x' = phi(x, u); fills A and B when `jacobians` is not null.
   virtual void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
                     StepJacobians* jacobians = nullptr) const = 0;
+  /// The same with the caller's workspace (from make_workspace()); the default calls the form without.
+  virtual void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
+                    StepWorkspace&) const {
+    step(x, u, x_next, jacobians);
+  }
 
   /// Number of process-noise columns p (0: deterministic).
   virtual int noise_dim() const { return 0; }
   /// F(x, u) with the derivatives of its columns when `derivatives` is true.
   virtual void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
                      bool derivatives) const;
+  virtual void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+                     StepWorkspace&) const {
+    noise(x, u, out, derivatives);
+  }
 
   /// Number of model-uncertainty columns q (0 for a model without learned uncertainty).
   virtual int uncertainty_dim() const { return 0; }
   /// G(x, u) with the derivatives of its columns (a GP residual model: G = diag(sigma_i(z))).
   virtual void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
                            bool derivatives) const;
+  virtual void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+                           StepWorkspace&) const {
+    uncertainty(x, u, out, derivatives);
+  }
 
   /// Convenience: returns phi(x, u).
   Vector next(const VectorCRef& x, const VectorCRef& u) const;

@@ -49,6 +49,11 @@ class GpBeliefDynamics final : public BeliefStepModel {
   double dt() const override { return dt_; }
   void propagate(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
                  BeliefJacobians* jacobians = nullptr) const override;
+  /// Holds the unpacked belief and the moment match (with its derivatives), so a caller that keeps it
+  /// does not allocate per step.
+  std::unique_ptr<BeliefWorkspace> make_workspace() const override;
+  void propagate(const VectorCRef& v, const VectorCRef& u, VectorRef v_next, BeliefJacobians* jacobians,
+                 BeliefWorkspace& workspace) const override;
 
   const MomentMatcher& matcher() const { return *matcher_; }
 

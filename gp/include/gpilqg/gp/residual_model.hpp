@@ -109,15 +109,25 @@ class ResidualModel final : public StepModel {
   int control_dim() const override { return simulator_->control_dim(); }
   double dt() const override { return simulator_->dt(); }
 
+  /// Holds the simulator's workspace, the outputs' predictions and the shared per-query cache (so
+  /// step and uncertainty at the same (x, u) with one workspace share their cross-covariances).
+  std::unique_ptr<StepWorkspace> make_workspace() const override;
+
   void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
             StepJacobians* jacobians = nullptr) const override;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
+            StepWorkspace& workspace) const override;
 
   int noise_dim() const override { return simulator_->noise_dim(); }
   void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const override;
+  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+             StepWorkspace& workspace) const override;
 
   int uncertainty_dim() const override { return state_dim(); }
   void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
                    bool derivatives) const override;
+  void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
+                   StepWorkspace& workspace) const override;
 
   /// Whether the outputs share per-query work (see the constructor).
   bool shares_outputs() const { return shared_ != nullptr; }
