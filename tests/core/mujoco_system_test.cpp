@@ -167,6 +167,26 @@ TEST(MujocoSystem, GeneralisedForceMapIsTheInverseMassMatrix) {
   EXPECT_TRUE(test::matrices_near(Eigen::Map<const Vector>(dW[0].data(), dW[0].size()), dW0.col(0), 1e-6, 1e-5));
 }
 
+TEST(MujocoSystem, ProcessNoiseColumnsAreTheInputMatrixScaled) {
+  // Additive actuator noise: column j is sigma_j b_j with b = df/du; for unit-gear motors b_j is
+  // column j of W = [0; M^-1] (noise.hpp), and the step model hands the columns through.
+  auto arm = MujocoSystem::load(arm_path());
+  ActuatorNoise noise;
+  noise.additive_std = (Vector(2) << 0.3, 0.7).finished();
+  arm->set_noise_model(noise);
+  const auto model = make_step_model(arm, Integrator::Euler, 0.05);
+  const Vector x = (Vector(4) << 0.5, -0.2, 0.1, 0.3).finished();
+  const Vector u = Vector::Zero(2);
+  DiffusionColumns columns;
+  const auto workspace = model->make_workspace();
+  model->noise(x, u, columns, true, *workspace);
+  ASSERT_EQ(columns.count(), 2);
+  Matrix W;
+  arm->generalised_force_map(x, W, nullptr);
+  EXPECT_TRUE(test::matrices_near(columns.columns.col(0), 0.3 * W.col(0), 1e-8, 1e-6));
+  EXPECT_TRUE(test::matrices_near(columns.columns.col(1), 0.7 * W.col(1), 1e-8, 1e-6));
+}
+
 TEST(MujocoSystem, SeveralThreadsStepOneModel) {
   const auto model = make_step_model(MujocoSystem::load(arm_path()), Integrator::Euler, 0.05);
   const Vector u = (Vector(2) << 0.3, -0.2).finished();

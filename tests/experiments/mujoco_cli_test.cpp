@@ -191,6 +191,24 @@ TEST(MujocoCli, BadInputGetsExitTwoWithWhatIsWrong) {
   EXPECT_EQ(sim.status, 2);
   EXPECT_NE(sim.err.find("not a whole multiple of the MuJoCo model's timestep"), std::string::npos) << sim.err;
 
+  // The same in a log given to diagnose: samples 0.015 s apart.
+  {
+    std::ofstream log(dir / "odd_log.csv");
+    log << "episode,t,shoulder,elbow,shoulder_dot,elbow_dot,shoulder_motor,elbow_motor\n";
+    for (int e = 0; e < 3; ++e)
+      for (int i = 0; i < 40; ++i) log << e << "," << 0.015 * i << ",0.1,0.2,0,0,0.5,-0.5\n";
+  }
+  const auto diag = test::run_cli("diagnose --system " + arm() + " --data " + quote(dir / "odd_log.csv"));
+  EXPECT_EQ(diag.status, 2);
+  EXPECT_NE(diag.err.find("not a whole multiple of the MuJoCo model's timestep 0.01"), std::string::npos) << diag.err;
+
+  // A free joint, through the command line.
+  std::ofstream(dir / "free.xml") << "<mujoco><worldbody><body name=\"b\"><joint name=\"hover\" type=\"free\"/>"
+                                     "<geom size=\"0.1\" mass=\"1\"/></body></worldbody></mujoco>";
+  const auto free_joint = test::run_cli("simulate --system " + quote(dir / "free.xml") + " --out " + quote(odd));
+  EXPECT_EQ(free_joint.status, 2);
+  EXPECT_NE(free_joint.err.find("('hover') is a free joint"), std::string::npos) << free_joint.err;
+
   // An unknown field override names the valid ones.
   const auto param = test::run_cli("simulate --system " + arm() + " --param elbow.weight=2 --out " + quote(odd));
   EXPECT_EQ(param.status, 2);
