@@ -8,9 +8,13 @@
 
 #include <H5Cpp.h>
 
+#include <fmt/format.h>
+
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "gpilqg/core/measurements.hpp"
+#include "gpilqg/core/systems.hpp"
 #include "test_support.hpp"
 
 namespace gpilqg {
@@ -166,6 +170,74 @@ TEST(MujocoCli, GpIlqgReachesTheOptimumOfTheChangedWorldOnThreeSeeds) {
     EXPECT_GT(sim(0, seed) / real(0, seed), 1.10) << "the simulator's policy is not clearly worse; the test shows nothing";
     EXPECT_LE(gp(3, seed) / real(3, seed), 1.05) << "seed " << seed + 1 << ": " << gp.col(seed).transpose();
   }
+}
+
+/// data/two_link_arm.xml with the forearm's mass and inertia scaled by `scale` and the elbow's damping
+/// set to `damping`: what the [world] parameters forearm.mass and elbow.damping do, as a second file.
+fs::path changed_arm(const fs::path& dir, double scale, double damping) {
+  std::ifstream in(test::source_dir() / "data" / "two_link_arm.xml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  replace(R"(<joint name="elbow" type="hinge" axis="0 1 0" damping="0.05"/>)",
+          fmt::format(R"(<joint name="elbow" type="hinge" axis="0 1 0" damping="{}"/>)", damping));
+  replace(R"(mass="0.6" diaginertia="0.008 0.008 0.0005")",
+          fmt::format(R"(mass="{}" diaginertia="{} {} {}")", 0.6 * scale, 0.008 * scale, 0.008 * scale, 0.0005 * scale));
+  const fs::path file = dir / "heavier_arm.xml";
+  std::ofstream(file) << text;
+  return file;
+}
+
+TEST(MujocoCli, AWorldFileIsTheSameWorldAsItsParameterOverrides) {
+  // The run's world from a second model file equals the world from [world] parameters: the true
+  // model's plan and its evaluated cost agree.
+  const fs::path dir = test::temporary_dir("mujoco_world_file");
+  const fs::path world = changed_arm(dir, 1.5, 0.3);
+  std::ifstream in(test::source_dir() / "data" / "two_link_arm_run.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    t.replace(t.find(from), from.size(), to);
+    return t;
+  };
+  const std::string by_parameters = with("name = \"two_link_arm.xml\"", "name = " + json((test::source_dir() / "data" / "two_link_arm.xml").string()).dump());
+  const std::string by_file = [&] {
+    std::string t = by_parameters;
+    const std::string from = R"(parameters = { "forearm.mass" = 0.9, "elbow.damping" = 0.3 })";
+    t.replace(t.find(from), from.size(), "model = \"heavier_arm.xml\"");
+    return t;
+  }();
+  std::ofstream(dir / "by_parameters.toml") << by_parameters;
+  std::ofstream(dir / "by_file.toml") << by_file;
+  for (const char* name : {"by_parameters", "by_file"}) {
+    const auto r = test::run_cli("run " + arm() + " --config " + quote(dir / (std::string(name) + ".toml")) +
+                                 " --seeds 1 --iterations 1 --out " + quote(dir / (std::string(name) + ".h5")));
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  const Matrix a = read_costs(dir / "by_parameters.h5", "/reach/ilqg_real/cost");
+  const Matrix b = read_costs(dir / "by_file.h5", "/reach/ilqg_real/cost");
+  // Equal up to the last digits of the file's decimal numbers and MuJoCo's derived constants.
+  EXPECT_TRUE(test::matrices_near(b, a, 0.0, 1e-6)) << a << "\n" << b;
+  const Matrix gp_a = read_costs(dir / "by_parameters.h5", "/reach/gp_ilqg/cost");
+  const Matrix gp_b = read_costs(dir / "by_file.h5", "/reach/gp_ilqg/cost");
+  EXPECT_TRUE(test::matrices_near(gp_b, gp_a, 0.0, 1e-4)) << gp_a << "\n" << gp_b;
+
+  // simulate --world: the same data as --param overrides.
+  const auto sim_file = test::run_cli("simulate --system " + arm() + " --world " + quote(world) +
+                                      " --episodes 2 --steps 50 --seed 4 --out " + quote(dir / "file.csv"));
+  ASSERT_EQ(sim_file.status, 0) << sim_file.err;
+  const auto sim_param = test::run_cli("simulate --system " + arm() + " --param forearm.mass=0.9 --param elbow.damping=0.3"
+                                       " --episodes 2 --steps 50 --seed 4 --out " + quote(dir / "param.csv"));
+  ASSERT_EQ(sim_param.status, 0) << sim_param.err;
+  const SystemSignature signature = system_signature((test::source_dir() / "data" / "two_link_arm.xml").string());
+  const MeasurementSet from_file = read_measurements(dir / "file.csv", signature);
+  const MeasurementSet from_param = read_measurements(dir / "param.csv", signature);
+  ASSERT_EQ(from_file.episodes.size(), from_param.episodes.size());
+  for (std::size_t e = 0; e < from_file.episodes.size(); ++e)
+    EXPECT_TRUE(test::matrices_near(from_file.episodes[e].x, from_param.episodes[e].x, 1e-12, 1e-9));
 }
 
 TEST(MujocoCli, BadInputGetsExitTwoWithWhatIsWrong) {
