@@ -103,16 +103,27 @@ void which_section(const DiagnosisReport& r, std::string& out) {
   const int worst = worst_state(r);
   out += fmt::format("\n3. Which effect is missing (fitted on training episodes, scored on held-out episodes {})\n",
                      fmt::join(r.heldout_episode_ids, ", "));
-  out += fmt::format("   {:<3} {:<24} {:<40} {:>16} {:>24}\n", "#", "effect", "parameter [95% interval]", "explained",
-                     "held-out rmse " + r.state_names[static_cast<std::size_t>(worst)]);
+  // Columns as wide as the longest name and parameter text (a MuJoCo model's effects have long names).
+  std::size_t name_width = 24, parameter_width = 40;
+  for (const RankedEffect& g : r.ranking) {
+    name_width = std::max(name_width, g.fit.effect.size());
+    parameter_width = std::max(parameter_width, parameter_text(g.fit, true).size());
+    for (const EffectFit& a : g.aliases) {
+      name_width = std::max(name_width, a.effect.size() + 6);  // "alias " takes 6 of the name's column
+      parameter_width = std::max(parameter_width, parameter_text(a, true).size());
+    }
+  }
+  out += fmt::format("   {:<3} {:<{}} {:<{}} {:>16} {:>24}\n", "#", "effect", name_width, "parameter [95% interval]",
+                     parameter_width, "explained", "held-out rmse " + r.state_names[static_cast<std::size_t>(worst)]);
   int rank = 1;
   for (const RankedEffect& g : r.ranking) {
     const EffectFit& f = g.fit;
-    out += fmt::format("   {:<3} {:<24} {:<40} {:>8} +-{:>6} {:>11.3e} -> {:.3e}\n", rank++, f.effect, parameter_text(f, true),
-                       percent(f.explained), percent(f.explained_ci), f.heldout_rmse_before(worst), f.heldout_rmse_after(worst));
+    out += fmt::format("   {:<3} {:<{}} {:<{}} {:>8} +-{:>6} {:>11.3e} -> {:.3e}\n", rank++, f.effect, name_width,
+                       parameter_text(f, true), parameter_width, percent(f.explained), percent(f.explained_ci),
+                       f.heldout_rmse_before(worst), f.heldout_rmse_after(worst));
     for (const EffectFit& a : g.aliases)
-      out += fmt::format("       alias {:<18} {:<40} {:>8}   (cannot be told apart on these data)\n", a.effect,
-                         parameter_text(a, true), percent(a.explained));
+      out += fmt::format("       alias {:<{}} {:<{}} {:>8}   (cannot be told apart on these data)\n", a.effect,
+                         name_width - 6, parameter_text(a, true), parameter_width, percent(a.explained));
   }
 }
 
