@@ -113,7 +113,7 @@ void which_section(const DiagnosisReport& r, std::string& out) {
       parameter_width = std::max(parameter_width, parameter_text(a, true).size());
     }
   }
-  out += fmt::format("   {:<3} {:<{}} {:<{}} {:>16} {:>24}\n", "#", "effect", name_width, "parameter [95% interval]",
+  out += fmt::format("   {:<3} {:<{}} {:<{}} {:>17} {:>24}\n", "#", "effect", name_width, "parameter [95% interval]",
                      parameter_width, "explained", "held-out rmse " + r.state_names[static_cast<std::size_t>(worst)]);
   int rank = 1;
   for (const RankedEffect& g : r.ranking) {
