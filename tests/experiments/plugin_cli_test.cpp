@@ -55,6 +55,14 @@ TEST(PluginCli, HiddenDampingOfTheAcrobotIsFoundThroughThePlugin) {
   EXPECT_EQ(j["verdict"]["status"], "explained") << j["verdict"].dump();
   EXPECT_EQ(j["verdict"]["effect"], "joint_viscous_damping:theta2") << j["verdict"].dump();
   EXPECT_NEAR(j["verdict"]["parameters"]["b"].get<double>(), 0.3, 0.15 * 0.3) << j["verdict"].dump();
+
+  // The suggested next command loads the plugin too.
+  const auto text = test::run_cli("--plugin " + quote(kAcrobot) + " diagnose --system acrobot --data " + quote(data) +
+                                  " --gp-points 100 --gp-restarts 0");
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_TRUE(contains(text.out, "next: gpilqg diagnose --plugin " + kAcrobot.string() + " --system acrobot --data " +
+                                     data.string() + " --add joint_viscous_damping:theta2"))
+      << text.out;
   fs::remove_all(dir);
 }
 
