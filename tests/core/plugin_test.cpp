@@ -122,6 +122,13 @@ TEST(Plugin, OtherVersionIsRefusedBeforeRegistration) {
   EXPECT_TRUE(contains(message, test_plugin("wrong_version_plugin").string())) << message;
 }
 
+TEST(Plugin, MissingSymbolSuggestsAnotherVersion) {
+  const std::string message = load_error(test_plugin("missing_symbol_plugin"));
+  EXPECT_TRUE(contains(message, "cannot be loaded: ")) << message;
+  EXPECT_TRUE(contains(message, "undefined symbol")) << message;
+  EXPECT_TRUE(contains(message, "was it built against another gpilqg than " + std::string(kVersionString))) << message;
+}
+
 TEST(Plugin, ThrowingRegistrationIsReportedAndRegistersNothing) {
   const std::string message = load_error(test_plugin("throwing_plugin"));
   EXPECT_TRUE(contains(message, "failed to register its systems: pendulum: calibration file 'pendulum.yaml' not found"))
