@@ -1,17 +1,32 @@
 /// The `gpilqg` command-line program. Subcommands are registered from src/commands/; see
 /// `gpilqg --help` and DESIGN.md section 8 for the fixed names.
+///
+/// `--plugin LIB.so` (repeatable) belongs to the program, not to one command: every subcommand falls
+/// through to it, so it may stand before or after the command's name. The plugins are loaded after
+/// the command line is parsed and before the command runs; a plugin that cannot be used is bad input
+/// (exit 2, plugin.hpp).
 
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "commands/commands.hpp"
+#include "gpilqg/core/plugin.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"gpilqg: data-driven robust optimal control (GP-corrected simulators, Robust-iLQG)",
                "gpilqg"};
   app.require_subcommand(1);
+  std::vector<std::string> plugins;
+  app.add_option("--plugin", plugins,
+                 "Load the systems of a plugin (a shared library built against gpilqg) before the command; "
+                 "repeatable, allowed after the command's name")
+      ->type_name("LIB.so")
+      ->allow_extra_args(false);
+  app.fallthrough();  // inherited by the subcommands added below
   gpilqg::cli::CommandAction action;
   gpilqg::cli::add_data_command(app, action);
   gpilqg::cli::add_solve_command(app, action);
@@ -34,5 +49,10 @@ int main(int argc, char** argv) {
     std::cerr << "error: no command given\n" << app.help();
     return gpilqg::kExitBadInput;
   }
-  return gpilqg::run_reporting_errors(action, std::cerr);
+  return gpilqg::run_reporting_errors(
+      [&] {
+        gpilqg::load_plugins(plugins);
+        return action();
+      },
+      std::cerr);
 }

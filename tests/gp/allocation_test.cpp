@@ -55,6 +55,10 @@ TEST(Allocation, TheCounterSeesAllocations) {
   Vector v(1000);
   v.setZero();
   EXPECT_GE(g_malloc_calls.load() - before, 2);
+  // Allocations inside the shared gpilqg libraries reach this program's malloc too.
+  const long before_library = g_malloc_calls.load();
+  const auto system = make_system("cartpole");
+  EXPECT_GE(g_malloc_calls.load() - before_library, 1);
 }
 
 TEST(Allocation, PredictionDoesNotAllocateAfterWarmUp) {

@@ -17,6 +17,7 @@
 
 #include "commands.hpp"
 #include "gpilqg/core/measurements.hpp"
+#include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/diagnosis/diagnosis.hpp"
@@ -58,6 +59,14 @@ void check_plotting() {
   } catch (const std::runtime_error& e) {
     throw InputError(std::string("--plots: ") + e.what());
   }
+}
+
+/// " --plugin LIB.so" when `system` was registered by a plugin (the entry's origin is the path the
+/// plugin was loaded from), so that the commands suggested below run as printed; empty otherwise.
+std::string plugin_option(const std::string& system) {
+  if (is_model_file_name(system)) return "";
+  const std::string& origin = find_system(system)->origin;
+  return origin == "built-in" ? "" : " --plugin " + origin;
 }
 
 diagnosis::DiagnosisOptions make_options(const DiagnoseOptions& o) {
@@ -110,7 +119,8 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (!o.write_model.empty())
     diagnosis::write_model_file(o.write_model, report.model_next,
                                 {fmt::format("written by gpilqg diagnose from {} (verdict: {})", o.data, report.verdict.status),
-                                 fmt::format("next: gpilqg diagnose --system {} --data {} --model {}", o.system, o.data, o.write_model)});
+                                 fmt::format("next: gpilqg diagnose{} --system {} --data {} --model {}", plugin_option(o.system),
+                                             o.system, o.data, o.write_model)});
   if (!o.plots.empty()) {
     // The script's own line goes to stdout; with --json, stdout holds the JSON document only.
     std::cout.flush();
@@ -138,8 +148,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (!o.plots.empty()) std::cout << "plots: " << o.plots << '\n';
   if (!o.write_model.empty()) std::cout << "model for the next round: " << o.write_model << '\n';
   if (report.verdict.effect && o.add.empty())
-    std::cout << fmt::format("next: gpilqg diagnose --system {} --data {}{} --add {}\n", o.system, o.data,
-                             o.model.empty() ? "" : " --model " + o.model, report.verdict.effect->effect);
+    std::cout << fmt::format("next: gpilqg diagnose{} --system {} --data {}{} --add {}\n", plugin_option(o.system),
+                             o.system, o.data, o.model.empty() ? "" : " --model " + o.model,
+                             report.verdict.effect->effect);
   return kExitSuccess;
 }
 
