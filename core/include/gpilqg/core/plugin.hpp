@@ -14,9 +14,10 @@
 /// gpilqg_plugin_abi(), before anything else of the plugin runs; gpilqg_register(), which collects
 /// entries; then the collected entries are checked against the registry and each other (a name, a
 /// builder, no name taken) and go into SystemRegistry::instance() with the plugin's path as their
-/// origin: none of them when a check fails. The gpilqg libraries are shared libraries, so a plugin linked against
-/// gpilqg::core and the program that loads it use one libgpilqg_core.so and therefore one registry.
-/// A plugin is never unloaded: the registry keeps its builders and effects until the process ends.
+/// origin: none of them when a check fails. The gpilqg libraries are shared libraries, so a plugin
+/// linked against gpilqg::core and the program that loads it use one libgpilqg_core.so and therefore
+/// one registry. A plugin whose registration ran is never unloaded: the registry keeps its builders
+/// and effects until the process ends.
 ///
 /// Every failure throws PluginError naming the file: a missing file; a file dlopen refuses (with
 /// dlerror's text); a library without the entry points; a plugin built against another gpilqg version
