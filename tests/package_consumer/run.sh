@@ -14,10 +14,12 @@ cmake --build "$work/consumer" >/dev/null
 "$work/consumer/consumer"
 
 gpilqg="$work/prefix/bin/gpilqg"
-# The installed program runs on the installed libraries, not on the build tree's.
-if ! ldd "$gpilqg" | grep -q "libgpilqg_core.so => $work/prefix/"; then
+# The installed program runs on the installed libraries, not on the build tree's. (ldd's output is
+# read whole: grep -q leaving a pipe early would fail the pipeline under pipefail.)
+libraries="$(ldd "$gpilqg")"
+if ! grep -q "libgpilqg_core.so => $work/prefix/" <<<"$libraries"; then
   echo "FAIL: the installed gpilqg does not load the installed libgpilqg_core.so:" >&2
-  ldd "$gpilqg" | grep gpilqg >&2
+  grep gpilqg <<<"$libraries" >&2
   exit 1
 fi
 
