@@ -146,8 +146,15 @@ PluginInfo load_plugin(const std::filesystem::path& path) {
   }
 
   PluginInfo info{shown, {}};
-  for (const SystemEntry& entry : registrar.entries_) {
+  for (SystemEntry& entry : registrar.entries_) {
     check_new_entry(entry, info.systems);
+    // Build each system once before any is registered, so that a plugin registers all its systems or
+    // none (the registry's own check then finds them complete).
+    try {
+      complete_system_entry(entry);
+    } catch (const std::invalid_argument& e) {
+      throw PluginError(fmt::format("plugin '{}': {}", shown, e.what()));
+    }
     info.systems.push_back(entry.name);
   }
   for (SystemEntry& entry : registrar.entries_) {
