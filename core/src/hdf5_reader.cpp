@@ -170,6 +170,19 @@ double Hdf5Reader::number_attribute(const std::string& object, const std::string
   });
 }
 
+std::vector<double> Hdf5Reader::number_list_attribute(const std::string& object, const std::string& name) const {
+  return guarded(file_, object + "@" + name, "reading attribute", [&] {
+    H5::Group g;
+    H5::DataSet d;
+    const H5::Attribute a = impl_->object(object, g, d).openAttribute(name);
+    if (a.getTypeClass() != H5T_FLOAT && a.getTypeClass() != H5T_INTEGER)
+      throw std::runtime_error(file_.string() + ": attribute '" + object + "@" + name + "' is not numeric");
+    std::vector<double> values(static_cast<std::size_t>(a.getSpace().getSimpleExtentNpoints()));
+    if (!values.empty()) a.read(H5::PredType::NATIVE_DOUBLE, values.data());
+    return values;
+  });
+}
+
 std::vector<std::string> Hdf5Reader::string_list_attribute(const std::string& object, const std::string& name) const {
   return guarded(file_, object + "@" + name, "reading attribute", [&] {
     H5::Group g;

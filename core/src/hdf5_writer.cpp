@@ -142,7 +142,18 @@ void Hdf5Writer::attribute(const std::string& object, const std::string& name, c
     std::vector<const char*> data;
     for (const auto& v : values) data.push_back(v.c_str());
     const hsize_t dims[1] = {values.size()};
-    impl_->object(object, g, d).createAttribute(name, type, H5::DataSpace(1, dims)).write(type, data.data());
+    H5::Attribute a = impl_->object(object, g, d).createAttribute(name, type, H5::DataSpace(1, dims));
+    if (!values.empty()) a.write(type, data.data());  // an empty list has nothing to write
+  });
+}
+
+void Hdf5Writer::attribute(const std::string& object, const std::string& name, const std::vector<double>& values) {
+  guarded(file_, object + "@" + name, "writing attribute", [&] {
+    H5::Group g;
+    H5::DataSet d;
+    const hsize_t dims[1] = {values.size()};
+    H5::Attribute a = impl_->object(object, g, d).createAttribute(name, H5::PredType::IEEE_F64LE, H5::DataSpace(1, dims));
+    if (!values.empty()) a.write(H5::PredType::NATIVE_DOUBLE, values.data());
   });
 }
 

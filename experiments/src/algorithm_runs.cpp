@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "gpilqg/control/belief_space.hpp"
+#include "gpilqg/experiments/gp_ilqg_round.hpp"
 #include "gpilqg/gp/gp_belief_dynamics.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 
@@ -15,19 +16,10 @@ namespace {
 
 /// Threads for the work inside one algorithm's iteration: the GPs' outputs are fitted concurrently,
 /// and PDDP's belief step shares its output pairs (the results do not depend on it).
-/// The machine the README's figures come from has 2 cores.
-constexpr int kThreads = 2;
+constexpr int kThreads = kGpFitThreads;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-/// A stable number for an algorithm's name (FNV-1a), so its random streams do not depend on the
-/// order in which algorithms run.
-std::uint64_t stream_id(const std::string& name) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (const char ch : name) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
-  return h;
 }
 
 void report(const TaskContext& c, const std::string& name, int k, const IterationRecord& r) {
@@ -57,7 +49,6 @@ AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, Transi
     run.name = name;
     run.data = std::move(initial);
   }
-  const std::uint64_t id = stream_id(name);
   const int K = c.config.iterations;
   bool stopped = run.converged_at >= 0 && borrowed == nullptr;
   for (int k = static_cast<int>(run.iterations.size()); k <= K; ++k) {
@@ -86,8 +77,7 @@ AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, Transi
       if (borrowed == nullptr && !stopped && k < K) {
         const auto start = std::chrono::steady_clock::now();
         for (int r = 0; r < c.config.rollouts; ++r) {
-          auto rng = make_rng(seed, c.task_index, RandomStream::DataRollout,
-                              {id, static_cast<std::uint64_t>(k), static_cast<std::uint64_t>(r)});
+          auto rng = data_rollout_rng(seed, c.task_index, name, k, r);
           run.data.append(roll_out(c, record.plan, c.config.exploration_std, rng), k);
         }
         record.rollout_seconds = seconds_since(start);
@@ -105,39 +95,13 @@ Matrix warm_start(const Plan* previous) { return previous != nullptr ? previous-
 
 gp::FitOptions fit_options(const TaskContext& c, std::uint64_t seed, const std::string& name, int data_rows) {
   gp::FitOptions options;
-  options.restarts = c.config.restarts;
-  options.max_evaluations = c.config.max_evaluations;
-  options.seed = derive_seed(seed, c.task_index, RandomStream::GpFit,
-                             {stream_id(name), static_cast<std::uint64_t>(data_rows)});
+  options.restarts = c.config.gp.restarts;
+  options.max_evaluations = c.config.gp.max_evaluations;
+  options.seed = gp_fit_seed(seed, c.task_index, name, data_rows);
   return options;
 }
 
 }  // namespace
-
-void TransitionData::append(const RealRollout& rollout, int iteration_index) {
-  const int T = rollout.steps_completed;
-  const int n = static_cast<int>(rollout.measured.rows());
-  const int m = static_cast<int>(rollout.truth.u.rows());
-  const int old = size();
-  x.conservativeResize(old + T, n);
-  u.conservativeResize(old + T, m);
-  x_next.conservativeResize(old + T, n);
-  for (int t = 0; t < T; ++t) {
-    x.row(old + t) = rollout.measured.col(t).transpose();
-    u.row(old + t) = rollout.truth.u.col(t).transpose();
-    x_next.row(old + t) = rollout.measured.col(t + 1).transpose();
-    iteration.push_back(iteration_index);
-  }
-}
-
-TransitionData TransitionData::head(int rows) const {
-  TransitionData out;
-  out.x = x.topRows(rows);
-  out.u = u.topRows(rows);
-  out.x_next = x_next.topRows(rows);
-  out.iteration.assign(iteration.begin(), iteration.begin() + rows);
-  return out;
-}
 
 AlgorithmRun run_fixed_model(const TaskContext& c, const std::string& name, std::shared_ptr<const StepModel> model,
                              std::uint64_t seed) {
@@ -163,28 +127,21 @@ AlgorithmRun run_fixed_model(const TaskContext& c, const std::string& name, std:
 
 AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp::GpBackend& backend,
                          TransitionData initial, std::uint64_t seed) {
+  const DdpTask task = ddp_task(c);
   const DataPlanner planner = [&](const TransitionData& data, const Plan* previous, IterationRecord& record) {
-    // Algorithm 1: without data, iLQG on the simulator (Robust-iLQG without G is iLQG).
-    if (data.size() == 0) return plan_with_ddp(c, c.models.simulator, DdpVariant::ILQG, warm_start(previous));
-    const auto start = std::chrono::steady_clock::now();
-    const gp::ResidualData all = gp::make_residual_data(*c.models.simulator, data.x, data.u, data.x_next);
-    // The paper's re-sample rule, judged on the newest rollouts.
-    const int newest = *std::max_element(data.iteration.begin(), data.iteration.end());
-    std::vector<int> recent;
-    for (int i = 0; i < data.size(); ++i)
-      if (data.iteration[static_cast<std::size_t>(i)] == newest) recent.push_back(i);
-    const gp::ResidualData validation = all.subset(recent);
+    GpRoundInputs inputs;
+    inputs.data = &data;
+    inputs.backend = &backend;
     // The previous iteration's GP (warm start, re-sample rule) is the model its plan was made on.
-    const auto last = previous != nullptr ? std::dynamic_pointer_cast<const gp::ResidualModel>(previous->model) : nullptr;
-    gp::ResidualModelOptions options;
-    options.fit = fit_options(c, seed, name, data.size());
-    options.threads = kThreads;
-    auto model = std::make_shared<const gp::ResidualModel>(gp::ResidualModel::fit(
-        c.models.simulator, all, backend, options, nullptr, last ? &validation : nullptr, last.get()));
-    record.fit_seconds = seconds_since(start);
-    const int D = static_cast<int>(all.inputs.cols());
-    for (int i = 0; i < model->state_dim(); ++i) record.hyperparameters.push_back(model->output(i).parameters().head(D + 2));
-    return plan_with_ddp(c, model, c.config.gp_variant, warm_start(previous));
+    inputs.previous_model =
+        previous != nullptr ? std::dynamic_pointer_cast<const gp::ResidualModel>(previous->model) : nullptr;
+    inputs.previous_u_bar = warm_start(previous);
+    inputs.fit = fit_options(c, seed, name, data.size());
+    inputs.variant = c.config.gp_variant;
+    GpRound round = plan_gp_ilqg_round(task, c.models.simulator, inputs);
+    record.fit_seconds = round.fit_seconds;
+    record.hyperparameters = std::move(round.hyperparameters);
+    return std::move(round.plan);
   };
   return learning_loop(c, name, std::move(initial), seed, planner);
 }
@@ -201,7 +158,7 @@ DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uin
     Matrix inputs(data.size(), n + m);
     inputs << data.x, data.u;
     const Matrix increments = data.x_next - data.x;
-    const auto backend = gp::make_backend(c.config.pddp_backend, c.config.backend_settings);
+    const auto backend = gp::make_backend(c.config.pddp_backend, c.config.gp.backend_settings);
     const auto dynamics = gp::GpBeliefDynamics::fit(n, m, c.config.dt, inputs, increments, *backend,
                                                     fit_options(c, seed, name, data.size()), nullptr, kThreads);
     record.fit_seconds = seconds_since(start);

@@ -100,7 +100,7 @@ std::optional<AlgorithmRun> RunCheckpoint::restore(const TaskContext& context, s
                                                    const std::string& name) const {
   const std::filesystem::path file = unit_file(context, seed, name);
   if (!std::filesystem::exists(file)) return std::nullopt;
-  AlgorithmRun run = read_algorithm_run(file, context.models.simulator, context.config.backend_settings);
+  AlgorithmRun run = read_algorithm_run(file, context.models.simulator, context.config.gp.backend_settings);
   if (run.name != name)
     throw std::runtime_error(fmt::format("{}: holds algorithm '{}', expected '{}'", file.string(), run.name, name));
   if (static_cast<int>(run.iterations.size()) > context.config.iterations + 1)

@@ -144,17 +144,7 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
   if (c.policy_tolerance < 0.0) f.fail("loop.policy_tolerance", "must be >= 0");
   c.evaluation_rollouts = positive_integer(f, "loop.evaluation_rollouts", 1);
 
-  c.backend = f.string("gp.backend");
-  c.backend_settings.exact_points = positive_integer(f, "gp.exact_points", 2);
-  c.backend_settings.inducing = positive_integer(f, "gp.inducing", 1);
-  c.backend_settings.frequencies = positive_integer(f, "gp.frequencies", 1);
-  try {
-    (void)gp::make_backend(c.backend, c.backend_settings);
-  } catch (const std::invalid_argument& e) {
-    f.fail("gp.backend", e.what());
-  }
-  c.restarts = positive_integer(f, "gp.restarts", 0);
-  c.max_evaluations = positive_integer(f, "gp.max_evaluations", 1);
+  c.gp = read_gp_settings(f, GpSettings{});  // every field is in the merged defaults
 
   c.solver.max_iterations = positive_integer(f, "solver.max_iterations", 1);
   c.solver.cost_tolerance = f.number("solver.tolerance");

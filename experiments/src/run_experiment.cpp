@@ -28,7 +28,7 @@ RunResults run_experiment(const RunConfig& config, const RunOptions& options) {
   results.options = options;
   results.options.journal = nullptr;  // the journal does not outlive the run
   const RunModels models = make_run_models(config);
-  const std::vector<std::string> backends = options.backends.empty() ? std::vector<std::string>{config.backend} : options.backends;
+  const std::vector<std::string> backends = options.backends.empty() ? std::vector<std::string>{config.gp.backend} : options.backends;
   const auto gp_name = [&](const std::string& backend) {
     return options.backends.empty() ? std::string("gp_ilqg") : "gp_ilqg_" + backend;
   };
@@ -52,7 +52,7 @@ RunResults run_experiment(const RunConfig& config, const RunOptions& options) {
       runs.push_back(run_fixed_model(context, "ilqg_real", models.world, seed));
       runs.push_back(run_fixed_model(context, "ilqg_sim", models.simulator, seed));
       for (const auto& backend_name : backends) {
-        const auto backend = gp::make_backend(backend_name, config.backend_settings);
+        const auto backend = gp::make_backend(backend_name, config.gp.backend_settings);
         const std::string name = gp_name(backend_name);
         runs.push_back(run_gp_ilqg(context, name, *backend, carried_data(name), seed));
       }

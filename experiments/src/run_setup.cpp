@@ -42,4 +42,19 @@ std::uint64_t derive_seed(std::uint64_t seed, int task, RandomStream stream, std
   return rng();
 }
 
+std::uint64_t stream_id(const std::string& algorithm) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const char ch : algorithm) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
+  return h;
+}
+
+std::uint64_t gp_fit_seed(std::uint64_t seed, int task, const std::string& algorithm, int rows) {
+  return derive_seed(seed, task, RandomStream::GpFit, {stream_id(algorithm), static_cast<std::uint64_t>(rows)});
+}
+
+std::mt19937_64 data_rollout_rng(std::uint64_t seed, int task, const std::string& algorithm, int round, int rollout) {
+  return make_rng(seed, task, RandomStream::DataRollout,
+                  {stream_id(algorithm), static_cast<std::uint64_t>(round), static_cast<std::uint64_t>(rollout)});
+}
+
 }  // namespace gpilqg

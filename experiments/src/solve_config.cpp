@@ -18,8 +18,14 @@ constexpr int kMaxSubsteps = 10'000;
 
 SolveConfig read_solve_config(const std::filesystem::path& file) {
   const toml::table root = TomlFields::parse(file);
-  const TomlFields f(root, file);
-  f.only_keys("", {"system", "noise", "problem", "solver"});
+  return read_solve_config(TomlFields(root, file), {}, "ilqr");
+}
+
+SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string>& extra_sections,
+                              const std::string& default_algorithm) {
+  std::vector<std::string> sections = {"system", "noise", "problem", "solver"};
+  sections.insert(sections.end(), extra_sections.begin(), extra_sections.end());
+  f.only_keys("", sections);
   f.require_section("system");
   f.require_section("problem");
   f.only_keys("system", {"name", "preset", "integrator", "dt", "substeps"});
@@ -64,7 +70,7 @@ SolveConfig read_solve_config(const std::filesystem::path& file) {
     f.fail("problem.u_min", "exceeds problem.u_max");
   c.u_init = f.vector("problem.u_init", m, Vector());
 
-  const std::string algorithm = f.string("solver.algorithm", "ilqr");
+  const std::string algorithm = f.string("solver.algorithm", default_algorithm);
   if (auto v = parse_variant(algorithm)) c.solver.variant = *v;
   else f.fail("solver.algorithm", fmt::format("'{}'; expected \"ilqr\", \"ilqg\" or \"robust_ilqg\"", algorithm));
   c.solver.max_iterations =
@@ -78,7 +84,7 @@ SolveConfig read_solve_config(const std::filesystem::path& file) {
   try {
     c.solver.validate();
   } catch (const std::invalid_argument& e) {
-    throw InputError(fmt::format("{}: [solver]: {}", file.string(), e.what()));
+    f.fail("solver", e.what());
   }
   return c;
 }

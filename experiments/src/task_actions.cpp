@@ -13,36 +13,48 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 Matrix repeated_u_init(const TaskContext& c) { return c.config.u_init.replicate(1, c.task.horizon); }
 
-/// Clamps u to [control] limits (empty: none).
-void clamp_to_limits(const RunConfig& config, VectorRef u) {
-  if (config.u_min.size()) u = u.cwiseMax(config.u_min);
-  if (config.u_max.size()) u = u.cwiseMin(config.u_max);
-}
-
 }  // namespace
 
-Plan plan_with_ddp(const TaskContext& c, std::shared_ptr<const StepModel> model, DdpVariant variant,
+DdpTask ddp_task(const TaskContext& c) {
+  DdpTask task;
+  task.cost = &c.cost;
+  task.x0 = c.task.x0;
+  task.horizon = c.task.horizon;
+  task.u_min = c.config.u_min;
+  task.u_max = c.config.u_max;
+  task.u_init = c.config.u_init;
+  task.solver = c.config.solver;
+  return task;
+}
+
+Plan plan_with_ddp(const DdpTask& task, std::shared_ptr<const StepModel> model, DdpVariant variant,
                    const Matrix& u_start) {
   DdpProblem problem;
   problem.model = model.get();
-  problem.cost = &c.cost;
-  problem.x0 = c.task.x0;
-  problem.horizon = c.task.horizon;
-  problem.u_min = c.config.u_min;
-  problem.u_max = c.config.u_max;
-  DdpOptions options = c.config.solver;
+  problem.cost = task.cost;
+  problem.x0 = task.x0;
+  problem.horizon = task.horizon;
+  problem.u_min = task.u_min;
+  problem.u_max = task.u_max;
+  DdpOptions options = task.solver;
   options.variant = variant;
   DdpSolver solver(options);
   const auto start = std::chrono::steady_clock::now();
-  DdpResult result = solver.solve(problem, u_start.size() ? u_start : repeated_u_init(c));
+  DdpResult result = solver.solve(problem, u_start.size() ? u_start : Matrix(task.u_init.replicate(1, task.horizon)));
   Plan plan;
   plan.solve_seconds = seconds_since(start);
   plan.policy = std::move(result.policy);
   plan.predicted_cost = result.expected_cost;
+  plan.nominal_cost = result.nominal_cost;
   plan.summary = std::move(result.summary);
   plan.model = std::move(model);
   plan.variant = variant;
   return plan;
+}
+
+Plan plan_with_ddp(const TaskContext& c, std::shared_ptr<const StepModel> model, DdpVariant variant,
+                   const Matrix& u_start) {
+  return plan_with_ddp(ddp_task(c), std::move(model), variant, u_start);
 }
 
 Plan open_loop_plan(const TaskContext& c) {
@@ -75,29 +87,44 @@ Controller make_controller(const TaskContext& c, const Plan& plan, std::unique_p
   return [mpc](int t, const VectorCRef& x, VectorRef u) { u = mpc->control(t, x); };
 }
 
-RealRollout roll_out(const TaskContext& c, const Plan& plan, const Vector& exploration, std::mt19937_64& rng) {
-  std::unique_ptr<MpcController> holder;
-  const Controller act = make_controller(c, plan, holder);
-  const int T = c.task.horizon;
+RealRollout roll_out(const WorldRollout& setup, const Controller& act, std::mt19937_64& rng) {
+  const int T = setup.horizon;
   RealRollout out;
-  out.measured.resize(c.task.x0.size(), T + 1);
+  out.measured.resize(setup.x0.size(), T + 1);
   std::normal_distribution<double> standard_normal;
+  const Vector& exploration = setup.exploration_std;
   const Controller explore = [&](int t, const VectorCRef& observed, VectorRef u) {
     out.measured.col(t) = observed;
     act(t, observed, u);
     for (Eigen::Index j = 0; j < exploration.size(); ++j) u(j) += exploration(j) * standard_normal(rng);
-    clamp_to_limits(c.config, u);
+    if (setup.u_min.size()) u = u.cwiseMax(setup.u_min);
+    if (setup.u_max.size()) u = u.cwiseMin(setup.u_max);
   };
-  RolloutResult r = closed_loop_rollout(*c.models.world, c.task.x0, T, explore, RolloutNoise::Process,
-                                        c.config.observation_std, &rng);
+  RolloutResult r = closed_loop_rollout(*setup.world, setup.x0, T, explore, RolloutNoise::Process,
+                                        setup.observation_std, &rng);
   Vector last = r.trajectory.x.col(T);
-  add_observation_noise(c.config.observation_std, rng, last);
+  add_observation_noise(setup.observation_std, rng, last);
   out.measured.col(T) = last;
   // A diverged rollout stops calling the controller: its remaining measurements repeat the last state.
   for (int t = r.steps_completed + 1; t <= T; ++t) out.measured.col(t) = r.trajectory.x.col(t);
   out.finite = r.finite;
   out.steps_completed = r.steps_completed;
   out.truth = std::move(r.trajectory);
+  return out;
+}
+
+RealRollout roll_out(const TaskContext& c, const Plan& plan, const Vector& exploration, std::mt19937_64& rng) {
+  std::unique_ptr<MpcController> holder;
+  const Controller act = make_controller(c, plan, holder);
+  WorldRollout setup;
+  setup.world = c.models.world.get();
+  setup.x0 = c.task.x0;
+  setup.horizon = c.task.horizon;
+  setup.exploration_std = exploration;
+  setup.observation_std = c.config.observation_std;
+  setup.u_min = c.config.u_min;
+  setup.u_max = c.config.u_max;
+  RealRollout out = roll_out(setup, act, rng);
   out.cost = trajectory_cost(c.cost, out.truth);
   return out;
 }
@@ -111,7 +138,8 @@ RealRollout random_rollout(const TaskContext& c, const Vector& amplitude, std::m
   for (int t = 0; t < T; t += kHoldSteps) {
     Vector level(m);
     for (int j = 0; j < m; ++j) level(j) = c.config.u_init(j) + amplitude(j) * unit(rng);
-    clamp_to_limits(c.config, level);
+    if (c.config.u_min.size()) level = level.cwiseMax(c.config.u_min);
+    if (c.config.u_max.size()) level = level.cwiseMin(c.config.u_max);
     for (int s = t; s < std::min(T, t + kHoldSteps); ++s) plan.policy.u_bar.col(s) = level;
   }
   return roll_out(c, plan, Vector(), rng);

@@ -15,6 +15,7 @@
 
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/systems.hpp"
+#include "arm_model.hpp"
 #include "test_support.hpp"
 
 namespace gpilqg {
@@ -172,24 +173,7 @@ TEST(MujocoCli, GpIlqgReachesTheOptimumOfTheChangedWorldOnThreeSeeds) {
   }
 }
 
-/// data/two_link_arm.xml with the forearm's mass and inertia scaled by `scale` and the elbow's damping
-/// set to `damping`: what the [world] parameters forearm.mass and elbow.damping do, as a second file.
-fs::path changed_arm(const fs::path& dir, double scale, double damping) {
-  std::ifstream in(test::source_dir() / "data" / "two_link_arm.xml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto replace = [&](const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    text.replace(at, from.size(), to);
-  };
-  replace(R"(<joint name="elbow" type="hinge" axis="0 1 0" damping="0.05"/>)",
-          fmt::format(R"(<joint name="elbow" type="hinge" axis="0 1 0" damping="{}"/>)", damping));
-  replace(R"(mass="0.6" diaginertia="0.008 0.008 0.0005")",
-          fmt::format(R"(mass="{}" diaginertia="{} {} {}")", 0.6 * scale, 0.008 * scale, 0.008 * scale, 0.0005 * scale));
-  const fs::path file = dir / "heavier_arm.xml";
-  std::ofstream(file) << text;
-  return file;
-}
+using test::changed_arm;
 
 TEST(MujocoCli, AWorldFileIsTheSameWorldAsItsParameterOverrides) {
   // The run's world from a second model file equals the world from [world] parameters: the true

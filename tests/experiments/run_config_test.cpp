@@ -26,8 +26,8 @@ TEST(RunConfig, EmbeddedDefaultsDescribeThePapersExperiments) {
   EXPECT_NEAR(cartpole.tasks[1].x0(2), -M_PI / 4, 1e-15);  // ... then -pi/4 from the first task's data
   EXPECT_FALSE(cartpole.tasks[0].transfer);
   EXPECT_TRUE(cartpole.tasks[1].transfer);
-  EXPECT_EQ(cartpole.backend, "exact");
-  EXPECT_EQ(cartpole.backend_settings.exact_points, 600);  // twice the paper's subsample (README: why)
+  EXPECT_EQ(cartpole.gp.backend, "exact");
+  EXPECT_EQ(cartpole.gp.backend_settings.exact_points, 600);  // twice the paper's subsample (README: why)
   EXPECT_EQ(cartpole.gp_variant, DdpVariant::RobustILQG);
   EXPECT_FALSE(cartpole.mpc);
 
@@ -64,8 +64,8 @@ transfer = false
 )", "user.toml");
   EXPECT_EQ(c.iterations, 2);
   EXPECT_EQ(c.rollouts, 5);  // untouched defaults stay
-  EXPECT_EQ(c.backend, "fitc");
-  EXPECT_EQ(c.backend_settings.inducing, 40);
+  EXPECT_EQ(c.gp.backend, "fitc");
+  EXPECT_EQ(c.gp.backend_settings.inducing, 40);
   ASSERT_EQ(c.tasks.size(), 1u);
   EXPECT_EQ(c.tasks[0].horizon, 10);
   EXPECT_NE(c.text.find("inducing = 40"), std::string::npos);

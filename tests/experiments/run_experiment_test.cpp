@@ -162,8 +162,8 @@ TEST(RunExperiment, ComparesGpBackendsOnTheSameSeedsAndLinksTheFirstAsGpIlqg) {
   config.tasks.resize(1);
   config.iterations = 1;
   config.pddp = false;
-  config.backend_settings.inducing = 10;
-  config.backend_settings.frequencies = 10;
+  config.gp.backend_settings.inducing = 10;
+  config.gp.backend_settings.frequencies = 10;
   RunOptions options;
   options.seeds = {7};
   options.backends = {"exact", "fitc", "ssgp"};

@@ -34,4 +34,10 @@ void add_run_command(CLI::App& app, CommandAction& action);
 /// `gpilqg profile DATA --backends LIST [--sizes LIST] [--json] [--out F.h5] [--plots DIR]`
 void add_profile_command(CLI::App& app, CommandAction& action);
 
+/// `gpilqg plan CONFIG.toml [--data FILE]... [--previous POLICY.h5] --out POLICY.h5 [--seed S] [--json]`
+void add_plan_command(CLI::App& app, CommandAction& action);
+
+/// `gpilqg rollout --system NAME --policy POLICY.h5 --out LOG.csv|LOG.h5 [...]`
+void add_rollout_command(CLI::App& app, CommandAction& action);
+
 }  // namespace gpilqg::cli

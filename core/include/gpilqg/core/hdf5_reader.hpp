@@ -45,6 +45,8 @@ class Hdf5Reader {
   /// Attributes of a group or dataset ("/" is the root).
   std::string string_attribute(const std::string& object, const std::string& name) const;
   double number_attribute(const std::string& object, const std::string& name) const;
+  /// A numeric attribute of any shape, flattened (a scalar gives one entry).
+  std::vector<double> number_list_attribute(const std::string& object, const std::string& name) const;
   std::vector<std::string> string_list_attribute(const std::string& object, const std::string& name) const;
   bool has_attribute(const std::string& object, const std::string& name) const;
 

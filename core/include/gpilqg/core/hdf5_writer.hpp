@@ -40,6 +40,8 @@ class Hdf5Writer {
   void attribute(const std::string& object, const std::string& name, double value);
   void attribute(const std::string& object, const std::string& name, std::int64_t value);
   void attribute(const std::string& object, const std::string& name, const std::vector<std::string>& values);
+  /// A 1-D float64 attribute (h5py reads it as a NumPy array).
+  void attribute(const std::string& object, const std::string& name, const std::vector<double>& values);
 
   /// A soft link at `path` to the object `target` (h5py follows it transparently).
   void link(const std::string& path, const std::string& target);

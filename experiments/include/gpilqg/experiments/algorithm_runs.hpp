@@ -20,20 +20,10 @@
 #include <vector>
 
 #include "gpilqg/experiments/task_actions.hpp"
+#include "gpilqg/experiments/transition_data.hpp"
 #include "gpilqg/gp/backend.hpp"
 
 namespace gpilqg {
-
-/// Measured transitions (rows): x_t, u_t, x_{t+1} as the real world's sensors saw them.
-struct TransitionData {
-  Matrix x, u, x_next;
-  std::vector<int> iteration;  ///< the iteration whose rollouts produced each row (-1: an earlier task)
-  int size() const { return static_cast<int>(x.rows()); }
-  /// Appends the completed transitions of a rollout.
-  void append(const RealRollout& rollout, int iteration);
-  /// The first `rows` rows.
-  TransitionData head(int rows) const;
-};
 
 struct IterationRecord {
   Plan plan;

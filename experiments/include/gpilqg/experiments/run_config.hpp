@@ -28,7 +28,7 @@
 #include "gpilqg/control/mpc.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/noise.hpp"
-#include "gpilqg/gp/backend_registry.hpp"
+#include "gpilqg/experiments/gp_settings.hpp"
 
 namespace gpilqg {
 
@@ -65,10 +65,7 @@ struct RunConfig {
   double policy_tolerance = 0.02;
   int evaluation_rollouts = 5;
   // [gp]
-  std::string backend = "exact";
-  gp::BackendSettings backend_settings;
-  int restarts = 1;
-  int max_evaluations = 150;
+  GpSettings gp;
   // [solver]
   DdpOptions solver;  ///< variant chosen per algorithm
   /// The variant GP-ILQG solves with: RobustILQG (the paper: F and the GP's G) or ILQG (an ablation

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <random>
+#include <string>
 
 #include "gpilqg/core/cost.hpp"
 #include "gpilqg/core/step_model.hpp"
@@ -41,5 +42,17 @@ enum class RandomStream : std::uint64_t {
 std::mt19937_64 make_rng(std::uint64_t seed, int task, RandomStream stream, std::initializer_list<std::uint64_t> index);
 /// A 64-bit seed drawn from the same streams (for APIs that take a seed, e.g. FitOptions::seed).
 std::uint64_t derive_seed(std::uint64_t seed, int task, RandomStream stream, std::initializer_list<std::uint64_t> index);
+
+/// A stable number for an algorithm's name (FNV-1a), so that its random streams do not depend on the
+/// order in which algorithms run.
+std::uint64_t stream_id(const std::string& algorithm);
+
+/// The streams of one round of Algorithm 1, named once so that `gpilqg run` and a scripted loop of
+/// `gpilqg plan` and `gpilqg rollout` with the same seed draw the same numbers:
+///  - the seed of the GP fit when the algorithm has `rows` transitions;
+///  - the stream of data rollout `rollout` after the plan of round `round`.
+/// `gpilqg plan --seed S` and `gpilqg rollout --seed S` are task 0 of algorithm "gp_ilqg".
+std::uint64_t gp_fit_seed(std::uint64_t seed, int task, const std::string& algorithm, int rows);
+std::mt19937_64 data_rollout_rng(std::uint64_t seed, int task, const std::string& algorithm, int round, int rollout);
 
 }  // namespace gpilqg

@@ -13,6 +13,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "gpilqg/control/ddp_solver.hpp"
 #include "gpilqg/core/integrator.hpp"
@@ -20,6 +21,8 @@
 #include "gpilqg/core/systems.hpp"
 
 namespace gpilqg {
+
+class TomlFields;
 
 struct SolveConfig {
   std::string system = "cartpole";
@@ -37,6 +40,12 @@ struct SolveConfig {
 
 /// Reads and validates a config; throws InputError naming the file, line and field.
 SolveConfig read_solve_config(const std::filesystem::path& file);
+
+/// The same schema inside a config with more tables (`gpilqg plan`'s [gp]): `extra_sections` are
+/// allowed beside the four above (the caller reads them), and [solver] algorithm defaults to
+/// `default_algorithm`.
+SolveConfig read_solve_config(const TomlFields& fields, const std::vector<std::string>& extra_sections,
+                              const std::string& default_algorithm);
 
 /// Builds the model and cost of the config and solves it.
 DdpResult solve_config(const SolveConfig& config);

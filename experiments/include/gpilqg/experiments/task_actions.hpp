@@ -25,7 +25,8 @@ namespace gpilqg {
 
 struct Plan {
   AffinePolicy policy;          ///< x_bar, u_bar, K (k = 0); what the result stores as iter_<k>/{x,u,K,k}
-  double predicted_cost = 0.0;  ///< the solver's expected cost on its own model
+  double predicted_cost = 0.0;  ///< the solver's expected cost on its own model (with its noise terms)
+  double nominal_cost = 0.0;    ///< the cost of the nominal trajectory x_bar, u_bar on that model
   double solve_seconds = 0.0;
   DdpSummary summary;
   std::shared_ptr<const StepModel> model;  ///< what MPC re-plans on (null: the policy only, e.g. PDDP's)
@@ -46,8 +47,26 @@ struct TaskContext {
   RunJournal* journal = nullptr;  ///< where completed iterations are kept for --resume (null: nowhere)
 };
 
-/// DDP on `model` (kept alive by the plan, for MPC) from the controls `u_start` (m x T; empty: config.u_init repeated), limited by
-/// [control]; `variant` ILQG (process noise F) or RobustILQG (F and the GP's G).
+/// What every DDP solve of one task shares, whoever poses it (`gpilqg run`'s tasks, `gpilqg plan`'s
+/// [problem]): the cost, the start, the horizon, the box limits, the initial controls and the solver.
+struct DdpTask {
+  const Cost* cost = nullptr;
+  Vector x0;
+  int horizon = 0;
+  Vector u_min, u_max;  ///< empty: unconstrained
+  Vector u_init;        ///< m: the constant controls a solve starts from when no better guess is known
+  DdpOptions solver;    ///< the variant is chosen per solve
+};
+
+/// The DdpTask of a task of `gpilqg run`: its cost, x0 and horizon, [control] and [solver].
+DdpTask ddp_task(const TaskContext& context);
+
+/// DDP on `model` (kept alive by the plan, for MPC) from the controls `u_start` (m x T; empty:
+/// task.u_init repeated), within the task's limits; `variant` ILQG (process noise F) or RobustILQG (F
+/// and the GP's G).
+Plan plan_with_ddp(const DdpTask& task, std::shared_ptr<const StepModel> model, DdpVariant variant,
+                   const Matrix& u_start);
+/// The same for a task of `gpilqg run`.
 Plan plan_with_ddp(const TaskContext& context, std::shared_ptr<const StepModel> model, DdpVariant variant,
                    const Matrix& u_start);
 
@@ -67,6 +86,22 @@ struct RealRollout {
   bool finite = true;  ///< false: the world diverged (the trajectory holds the last finite state)
   double cost = 0.0;   ///< the task cost of the true trajectory
 };
+
+/// Where and how a controller runs on the (simulated) real world.
+struct WorldRollout {
+  const StepModel* world = nullptr;  ///< samples its process noise at every step
+  Vector x0;
+  int horizon = 0;
+  Vector exploration_std;  ///< Gaussian noise added to every control (empty: none), then clamped
+  Vector observation_std;  ///< the controller sees x + N(0, diag(std^2)); the log records what it saw
+  Vector u_min, u_max;     ///< limits of the applied control (empty: none)
+};
+
+/// Runs `act` on setup.world: at each step the controller sees the measured state, exploration is
+/// added to its control and the sum clamped to the limits. The rollout's cost is left 0 (the caller's
+/// task knows its cost). Every draw comes from `rng`, in a fixed order, so equal seeds give equal
+/// rollouts wherever they run (`gpilqg run` and `gpilqg rollout`).
+RealRollout roll_out(const WorldRollout& setup, const Controller& act, std::mt19937_64& rng);
 
 /// Runs `plan` on the world from the task's x0 for its horizon, with Gaussian exploration of std
 /// `exploration` (empty: none) added to every control.

@@ -1,0 +1,49 @@
+#pragma once
+/// @file gp_ilqg_round.hpp
+/// One round of the paper's Algorithm 1 on measured transitions: the planning step that `gpilqg run`
+/// (algorithm gp_ilqg) and `gpilqg plan` (one round on a real robot's logs) both call.
+///
+///  - No data: iLQG on the simulator alone (Robust-iLQG without the GP's G is iLQG), the paper's
+///    iteration 0.
+///  - Data: the residual GP learns the simulator's one-step error on every transition, z = [x; u] ->
+///    x' - phi_sim(x, u) (gp/residual_model.hpp). With the previous round's GP it is warm-started
+///    from that GP's hyperparameters and the paper's re-sample rule decides, on the newest rows (the
+///    rows with the largest round label), whether the previous training points are kept
+///    (gp/resample.hpp). Then Robust-iLQG (F and G = diag(sigma(z))) or, as an ablation, iLQG on the
+///    GP mean solves the task on simulator + GP, warm-started from the previous round's controls.
+
+#include <memory>
+#include <vector>
+
+#include "gpilqg/experiments/task_actions.hpp"
+#include "gpilqg/experiments/transition_data.hpp"
+#include "gpilqg/gp/backend.hpp"
+#include "gpilqg/gp/fit.hpp"
+#include "gpilqg/gp/residual_model.hpp"
+
+namespace gpilqg {
+
+struct GpRoundInputs {
+  const TransitionData* data = nullptr;  ///< every transition so far, labelled by round
+  const gp::GpBackend* backend = nullptr;
+  std::shared_ptr<const gp::ResidualModel> previous_model;  ///< the previous round's GP (null: none)
+  Matrix previous_u_bar;  ///< the previous round's nominal controls, m x T (empty: task.u_init)
+  gp::FitOptions fit;     ///< seed, restarts and evaluations of the hyperparameter fit
+  DdpVariant variant = DdpVariant::RobustILQG;  ///< with data: RobustILQG (the paper) or ILQG (GP mean)
+};
+
+struct GpRound {
+  Plan plan;  ///< plan.model is the simulator (no data) or the fitted gp::ResidualModel
+  double fit_seconds = 0.0;
+  std::vector<Vector> hyperparameters;  ///< per state: [log l (n+m); log sf; log sn] (empty: no GP)
+};
+
+/// Threads used to fit the GP's outputs concurrently (the results do not depend on it).
+inline constexpr int kGpFitThreads = 2;
+
+/// The round (see the file comment). Throws std::invalid_argument for inconsistent inputs (data of
+/// another size than the simulator's, a previous u_bar of another shape).
+GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const StepModel>& simulator,
+                           const GpRoundInputs& inputs);
+
+}  // namespace gpilqg

@@ -1,0 +1,28 @@
+#pragma once
+/// @file gp_settings.hpp
+/// The `[gp]` table that `gpilqg run` and `gpilqg plan` share: which backend learns the simulator's
+/// error and how hard its hyperparameters are fitted (DESIGN.md sections 8 and 11).
+///
+///   [gp]  backend ("exact"|"fitc"|"ssgp"|"compact"), exact_points, inducing, frequencies,
+///         restarts, max_evaluations
+
+#include <string>
+
+#include "gpilqg/gp/backend_registry.hpp"
+
+namespace gpilqg {
+
+class TomlFields;
+
+struct GpSettings {
+  std::string backend = "exact";
+  gp::BackendSettings backend_settings;  ///< sizes of the backends (exact_points, inducing, frequencies)
+  int restarts = 1;                      ///< random restarts of the hyperparameter fit, beside the data-driven start
+  int max_evaluations = 150;             ///< NLopt evaluations per start
+};
+
+/// Reads [gp] through `f` (errors name the file, line and field); a field the table lacks takes its
+/// value from `defaults`. The backend name and sizes are checked by building the backend once.
+GpSettings read_gp_settings(const TomlFields& f, const GpSettings& defaults);
+
+}  // namespace gpilqg

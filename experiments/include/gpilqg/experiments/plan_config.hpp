@@ -1,0 +1,25 @@
+#pragma once
+/// @file plan_config.hpp
+/// The config of `gpilqg plan` (DESIGN.md section 11): the `gpilqg solve` schema (solve_config.hpp)
+/// plus an optional [gp] table (gp_settings.hpp; missing fields take GpSettings' defaults).
+///
+/// [solver] algorithm is the solver of the rounds with data: "robust_ilqg" (the default, the paper's
+/// Robust-iLQG with the GP's uncertainty G) or "ilqg" (the GP's mean only). The round without data is
+/// iLQG on the simulator whatever it says, as in `gpilqg run`.
+
+#include <filesystem>
+
+#include "gpilqg/experiments/gp_settings.hpp"
+#include "gpilqg/experiments/solve_config.hpp"
+
+namespace gpilqg {
+
+struct PlanConfig {
+  SolveConfig problem;  ///< the simulator (the GP's mean function), its noise F, the task and the solver
+  GpSettings gp;
+};
+
+/// Reads and validates a plan config; throws InputError naming the file, line and field.
+PlanConfig read_plan_config(const std::filesystem::path& file);
+
+}  // namespace gpilqg

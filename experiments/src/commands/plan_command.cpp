@@ -1,0 +1,91 @@
+/// `gpilqg plan CONFIG.toml [--data FILE]... [--previous POLICY.h5] --out POLICY.h5 [--seed S] [--json]`:
+/// one round of Algorithm 1 on measurements from the real system (DESIGN.md section 11).
+
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/planning.hpp"
+
+namespace gpilqg::cli {
+
+namespace {
+
+struct PlanOptions {
+  std::string config;
+  std::vector<std::string> data;
+  std::string previous;
+  std::string out;
+  std::uint64_t seed = 1;
+  bool json = false;
+};
+
+int run_plan(const PlanOptions& o) {
+  PlanRequest request;
+  request.config = read_plan_config(o.config);
+  for (const auto& file : o.data) request.data_files.emplace_back(file);
+  if (!o.previous.empty()) request.previous = o.previous;
+  request.seed = o.seed;
+  const PlannedPolicy planned = plan_policy(request);
+  const DdpSummary& s = planned.summary;
+  if (s.termination == DdpTermination::InitialRolloutDiverged) {
+    std::cerr << fmt::format("error: the initial controls drive the model to non-finite states; no policy was "
+                             "written to {} (try other [problem] u_init or a shorter horizon)\n", o.out);
+    return kExitInternalFailure;
+  }
+  write_policy_file(o.out, planned.file, planned.model.get());
+  if (o.json) {
+    nlohmann::json out = policy_json(planned.file, planned.model.get());
+    out["out"] = o.out;
+    out["solver"] = {{"algorithm", std::string(to_string(planned.model ? request.config.problem.solver.variant : DdpVariant::ILQG))},
+                     {"termination", std::string(to_string(s.termination))},
+                     {"converged", converged(s.termination)},
+                     {"iterations", s.iterations},
+                     {"solve_time_s", s.timings.total_s}};
+    out["data_rows"] = planned.data_rows;
+    out["fit_time_s"] = planned.fit_seconds;
+    out["gp_warm_start"] = planned.warm_started_gp;
+    std::cout << out.dump() << '\n';
+  } else {
+    const PolicyFile& f = planned.file;
+    if (planned.model)
+      std::cout << fmt::format("round {}: residual GP ({}) fitted on {} transitions from {} file(s) in {:.1f} s{}\n",
+                               f.round, planned.model->output(0).backend_name(), planned.data_rows,
+                               f.data_files.size(), planned.fit_seconds,
+                               planned.warm_started_gp ? ", warm-started from --previous" : "");
+    else
+      std::cout << fmt::format("round {}: no data; planned on the simulator alone\n", f.round);
+    std::cout << s.report(to_string(planned.model ? request.config.problem.solver.variant : DdpVariant::ILQG)) << '\n';
+    std::cout << fmt::format("predicted cost {:.6g}, expected cost {:.6g}; wrote {} (horizon {}, dt {} s)\n",
+                             f.predicted_cost, f.expected_cost, o.out, f.policy.horizon(), f.dt);
+  }
+  if (!converged(s.termination))
+    std::cerr << fmt::format("warning: the solver stopped without converging ({}); the policy is its last "
+                             "iterate\n", to_string(s.termination));
+  return kExitSuccess;
+}
+
+}  // namespace
+
+void add_plan_command(CLI::App& app, CommandAction& action) {
+  auto o = std::make_shared<PlanOptions>();
+  auto* cmd = app.add_subcommand("plan", "One round of Algorithm 1 on measurements: fit the residual GP on the "
+                                         "data files, solve with Robust-iLQG, write the policy file");
+  cmd->add_option("CONFIG", o->config, "TOML: the `gpilqg solve` schema plus an optional [gp] table")->required();
+  cmd->add_option("--data", o->data, "A measurement file (CSV or HDF5), repeatable, oldest first; the last holds "
+                                     "the newest rollouts. None: plan on the simulator alone (round 0)");
+  cmd->add_option("--previous", o->previous, "The previous round's policy file: warm start of the controls and "
+                                             "of the GP, and the re-sample rule");
+  cmd->add_option("--out", o->out, "The policy file to write (HDF5, DESIGN.md section 11)")->required();
+  cmd->add_option("--seed", o->seed, "Seed of the GP fit; equal seeds give the policies of `gpilqg run` with that seed")
+      ->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print the policy file's content and the solver's summary as one JSON document");
+  cmd->callback([&action, o] { action = [o] { return run_plan(*o); }; });
+}
+
+}  // namespace gpilqg::cli

@@ -1,0 +1,82 @@
+#include "world_options.hpp"
+
+#include <fmt/format.h>
+
+#include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
+#include "commands.hpp"
+
+namespace gpilqg::cli {
+
+void add_world_options(CLI::App& cmd, WorldOptions& o) {
+  cmd.add_option("--system", o.system, kSystemHelp)->required();
+  cmd.add_option("--world", o.world_file,
+                 "A second MuJoCo model file with the same joints and actuators to simulate instead of --system");
+  cmd.add_option("--preset", o.preset, "Parameter set: sim or real")->capture_default_str();
+  cmd.add_option("--param", o.parameters, "Override a physical parameter, NAME=VALUE (repeatable)");
+  cmd.add_option("--effect", o.effects, "Add a physical effect of the library to the world, EFFECT=VALUE (repeatable)");
+  cmd.add_option("--actuator-noise", o.actuator_noise,
+                 "Additive actuator noise std [u/sqrt(s)]: one value, or one per control (comma-separated)")
+      ->delimiter(',');
+  cmd.add_option("--multiplicative-noise", o.multiplicative_noise,
+                 "Control-multiplicative noise std [1/sqrt(s)]: one value, or one per control (comma-separated)")
+      ->delimiter(',');
+}
+
+std::map<std::string, double> parse_assignments(const std::vector<std::string>& items, const std::string& option) {
+  std::map<std::string, double> out;
+  for (const auto& item : items) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(fmt::format("{} '{}': expected NAME=VALUE, e.g. pole_length=1.3", option, item));
+    try {
+      std::size_t used = 0;
+      const double value = std::stod(item.substr(eq + 1), &used);
+      if (used != item.size() - eq - 1) throw std::invalid_argument("trailing text");
+      out[item.substr(0, eq)] = value;
+    } catch (const std::exception&) {
+      throw InputError(fmt::format("{} '{}': the value is not a number", option, item));
+    }
+  }
+  return out;
+}
+
+Vector per_quantity(const std::vector<double>& values, int size, const std::string& option, const Vector& fallback) {
+  if (values.empty()) return fallback;
+  for (const double v : values)
+    if (!(v >= 0.0) || !std::isfinite(v)) throw InputError(fmt::format("{} {}: expected standard deviations >= 0", option, v));
+  if (values.size() == 1) return Vector::Constant(size, values.front());
+  if (static_cast<int>(values.size()) != size)
+    throw InputError(fmt::format("{}: {} values; expected one, or {} (one per entry)", option, values.size(), size));
+  return Eigen::Map<const Vector>(values.data(), size);
+}
+
+DynamicsPtr build_world(const WorldOptions& o) {
+  const auto preset = parse_preset(o.preset);
+  if (!preset) throw InputError("--preset '" + o.preset + "': expected 'sim' or 'real'");
+  const SystemSignature signature = system_signature(o.system);
+  const int m = static_cast<int>(signature.controls.size());
+  ActuatorNoise noise;
+  noise.additive_std = per_quantity(o.actuator_noise, m, "--actuator-noise", Vector());
+  noise.multiplicative_std = per_quantity(o.multiplicative_noise, m, "--multiplicative-noise", Vector());
+  ModelSpec world;
+  world.system = o.system;
+  if (!o.world_file.empty()) {
+    // Another model file with the same joints and actuators is the world; the data are the system's.
+    const std::string mismatch = signature_mismatch(signature, system_signature(o.world_file));
+    if (!mismatch.empty()) throw InputError("--world " + o.world_file + ": " + mismatch);
+    world.system = o.world_file;
+  }
+  world.preset = *preset;
+  world.parameters = parse_assignments(o.parameters, "--param");
+  for (const std::string& text : o.effects) {
+    const diagnosis::EffectRequest request = diagnosis::parse_add_option(text, world.system, "--effect");
+    if (!request.values) throw InputError("--effect '" + text + "': expected EFFECT=VALUE, e.g. cart_coulomb_friction=1");
+    world = world.with(find_effect(world.system, request.effect), *request.values);
+  }
+  return world.build(noise);
+}
+
+}  // namespace gpilqg::cli

@@ -1,0 +1,42 @@
+#pragma once
+/// @file world_options.hpp
+/// The simulated "real world" of `gpilqg simulate` and `gpilqg rollout`, from one set of options: a
+/// system's preset with parameter overrides and hidden effects of the library, or a second MuJoCo
+/// model file, with actuator noise. Per-quantity noise options take one value (every entry) or one
+/// value per control or state, comma-separated.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "gpilqg/core/dynamics.hpp"
+#include "gpilqg/core/quantity.hpp"
+
+namespace gpilqg::cli {
+
+struct WorldOptions {
+  std::string system;
+  std::string world_file;
+  std::string preset = "real";
+  std::vector<std::string> parameters;  ///< NAME=VALUE
+  std::vector<std::string> effects;     ///< EFFECT=VALUE
+  std::vector<double> actuator_noise;        ///< additive std per control [u/sqrt(s)]
+  std::vector<double> multiplicative_noise;  ///< std per control [1/sqrt(s)]
+};
+
+/// Adds --system, --world, --preset, --param, --effect, --actuator-noise and --multiplicative-noise.
+void add_world_options(CLI::App& command, WorldOptions& options);
+
+/// "name=value" items of option `option` -> {name: value}; an InputError names the option and the text.
+std::map<std::string, double> parse_assignments(const std::vector<std::string>& items, const std::string& option);
+
+/// A per-quantity option: empty -> `fallback`; one value -> that value `size` times; `size` values ->
+/// them. Negative entries or another count are an InputError naming the option.
+Vector per_quantity(const std::vector<double>& values, int size, const std::string& option, const Vector& fallback);
+
+/// The world's dynamics with its noise; the signature it must share is `system`'s (checked for --world).
+DynamicsPtr build_world(const WorldOptions& options);
+
+}  // namespace gpilqg::cli

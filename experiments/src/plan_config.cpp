@@ -1,0 +1,19 @@
+#include "gpilqg/experiments/plan_config.hpp"
+
+#include "gpilqg/experiments/toml_fields.hpp"
+
+namespace gpilqg {
+
+PlanConfig read_plan_config(const std::filesystem::path& file) {
+  const toml::table root = TomlFields::parse(file);
+  const TomlFields f(root, file);
+  PlanConfig c;
+  c.problem = read_solve_config(f, {"gp"}, "robust_ilqg");
+  if (c.problem.solver.variant == DdpVariant::ILQR)
+    f.fail("solver.algorithm", "'ilqr' ignores the noise and the GP's uncertainty; expected \"robust_ilqg\" (the "
+                               "paper) or \"ilqg\" (the GP's mean only)");
+  c.gp = read_gp_settings(f, GpSettings{});
+  return c;
+}
+
+}  // namespace gpilqg
