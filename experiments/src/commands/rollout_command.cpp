@@ -13,7 +13,9 @@
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/systems.hpp"
+#include "gpilqg/core/cost.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/plan_config.hpp"
 #include "gpilqg/experiments/policy_file.hpp"
 #include "gpilqg/experiments/run_setup.hpp"
 #include "gpilqg/experiments/task_actions.hpp"
@@ -33,6 +35,7 @@ struct RolloutOptions {
   std::vector<double> exploration;
   std::vector<double> observation_noise;
   std::vector<double> x0;
+  std::string cost_config;
   std::uint64_t seed = 1;
   CLI::Option* integrator_option = nullptr;
   CLI::Option* substeps_option = nullptr;
@@ -92,6 +95,19 @@ int run_rollout(const RolloutOptions& o) {
   const AffinePolicy& law = policy.policy;
   const Controller act = [&law](int t, const VectorCRef& x, VectorRef u) { law.control(t, x, u); };
 
+  // The task's cost of each episode's true trajectory, when a plan config says what the task is.
+  std::unique_ptr<QuadraticCost> cost;
+  if (!o.cost_config.empty()) {
+    const SolveConfig task = read_plan_config(o.cost_config).problem;
+    const std::string mismatch = signature_mismatch(signature, system_signature(task.system));
+    if (!mismatch.empty()) throw InputError(fmt::format("--cost {}: {}", o.cost_config, mismatch));
+    if (task.horizon != setup.horizon)
+      throw InputError(fmt::format("--cost {}: [problem] horizon is {}; expected the policy's {}", o.cost_config,
+                                   task.horizon, setup.horizon));
+    cost = std::make_unique<QuadraticCost>(task.dt, task.Q.asDiagonal(), task.R.asDiagonal(), task.Qf.asDiagonal(), task.goal);
+  }
+  std::vector<double> costs;
+
   MeasurementSet log;
   log.system = signature;
   int diverged = 0, dropped = 0;
@@ -100,6 +116,7 @@ int run_rollout(const RolloutOptions& o) {
     auto rng = data_rollout_rng(o.seed, 0, "gp_ilqg", policy.round, r);
     const RealRollout rollout = roll_out(setup, act, rng);
     if (!rollout.finite) ++diverged;
+    if (cost && rollout.finite) costs.push_back(trajectory_cost(*cost, rollout.truth));
     if (rollout.steps_completed == 0) {
       ++dropped;
       continue;
@@ -113,6 +130,12 @@ int run_rollout(const RolloutOptions& o) {
                            o.out, log.episodes.size(), policy.round, o.policy,
                            o.world.world_file.empty() ? o.world.system : o.world.world_file, o.world.preset,
                            log.sample_count(), policy.dt, o.seed);
+  if (!costs.empty()) {
+    double mean = 0.0;
+    for (const double c : costs) mean += c / static_cast<double>(costs.size());
+    std::cout << fmt::format("task cost of the true trajectories ({}): mean {:.6g} over {} finite episode(s): {:.6g}\n",
+                             o.cost_config, mean, costs.size(), fmt::join(costs, ", "));
+  }
   if (diverged > 0)
     std::cout << fmt::format("note: {} episode(s) diverged; each is kept up to its last finite state{}\n", diverged,
                              dropped > 0 ? fmt::format(" ({} with no finite step were left out)", dropped) : "");
@@ -139,6 +162,8 @@ void add_rollout_command(CLI::App& app, CommandAction& action) {
                   "Std of the noise on each measured state: one value, or one per state (comma-separated)")
       ->delimiter(',');
   cmd->add_option("--x0", o->x0, "Initial state, comma-separated (default: the policy's x_bar at t = 0)")->delimiter(',');
+  cmd->add_option("--cost", o->cost_config, "A `gpilqg plan` config: print each episode's task cost (of its true "
+                                            "states and applied controls)");
   cmd->add_option("--seed", o->seed, "Random seed; with `gpilqg plan --seed` the same seed gives `gpilqg run`'s draws")
       ->capture_default_str();
   cmd->callback([&action, o] { action = [o] { return run_rollout(*o); }; });
