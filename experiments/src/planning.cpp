@@ -8,6 +8,7 @@
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/systems.hpp"
+#include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/core/version.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/run_setup.hpp"

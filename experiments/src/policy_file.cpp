@@ -1,8 +1,6 @@
 #include "gpilqg/experiments/policy_file.hpp"
 
-#include <chrono>
 #include <cmath>
-#include <ctime>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -10,6 +8,7 @@
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_reader.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
+#include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/gp/gp_io.hpp"
 
@@ -60,15 +59,6 @@ AffinePolicy file_policy(const AffinePolicy& policy) {
   if (out.k.size()) out.u_bar += out.k;
   out.k = Matrix::Zero(out.u_bar.rows(), out.u_bar.cols());
   return out;
-}
-
-std::string utc_timestamp() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return text;
 }
 
 void write_policy_file(const std::filesystem::path& file, const PolicyFile& p, const gp::ResidualModel* model) {

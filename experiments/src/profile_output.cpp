@@ -11,6 +11,8 @@
 #include <sstream>
 
 #include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/utc_time.hpp"
+#include "gpilqg/core/version.hpp"
 #include "gpilqg/experiments/profile.hpp"
 #include "gpilqg/experiments/plot_script.hpp"
 
@@ -22,15 +24,6 @@ bool scored(const ProfileRow& row) { return row.status == "ok"; }
 
 nlohmann::json number_or_null(const ProfileRow& row, double value) {
   return scored(row) && std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
-
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  char buffer[32];
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  std::strftime(buffer, sizeof(buffer), "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buffer;
 }
 
 void write_string_attribute(H5::H5Object& object, const std::string& name, const std::string& value) {
@@ -135,8 +128,8 @@ void write_profile_hdf5(const std::filesystem::path& file, const ProfileReport& 
       H5::H5File h5(temporary.c_str(), H5F_ACC_EXCL);
       H5::Group root = h5.openGroup("/");
       write_int_attribute(root, "schema_version", 1);
-      write_string_attribute(root, "gpilqg_version", "0.1.0");
-      write_string_attribute(root, "created", utc_now());
+      write_string_attribute(root, "gpilqg_version", kVersionString);
+      write_string_attribute(root, "created", utc_timestamp());
       write_string_attribute(root, "data_file", report.file);
       write_string_attribute(root, "data_name", report.data.name);
       write_string_attribute(root, "target", report.data.target);

@@ -8,22 +8,11 @@
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
 #include "gpilqg/core/systems.hpp"
-
-#ifndef GPILQG_VERSION
-#define GPILQG_VERSION "unknown"
-#endif
+#include "gpilqg/core/utc_time.hpp"
+#include "gpilqg/core/version.hpp"
 
 namespace gpilqg {
 namespace {
-
-std::string utc_now() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buffer[32];
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buffer;
-}
 
 using u64 = std::uint64_t;
 
@@ -186,10 +175,10 @@ void write_file(const std::filesystem::path& file, const RunResults& results) {
   for (const auto& q : signature.states) state_names.push_back(q.name);
 
   h5.attribute("/", "schema_version", std::int64_t{1});
-  h5.attribute("/", "gpilqg_version", std::string(GPILQG_VERSION));
+  h5.attribute("/", "gpilqg_version", std::string(kVersionString));
   h5.attribute("/", "config", c.text);
   h5.attribute("/", "seed", static_cast<std::int64_t>(results.options.seeds.front()));
-  h5.attribute("/", "created", utc_now());
+  h5.attribute("/", "created", utc_timestamp());
   h5.attribute("/", "system", c.system);
   std::vector<double> seeds(results.options.seeds.begin(), results.options.seeds.end());
   h5.write_vector("/seeds", seeds);

@@ -7,6 +7,8 @@
 
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
+#include "gpilqg/core/utc_time.hpp"
+#include "gpilqg/core/version.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 
@@ -132,24 +134,15 @@ void write_add(Hdf5Writer& h5, const DiagnosisReport& r) {
   h5.attribute("/add", "model", names);
 }
 
-std::string now_utc() {
-  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  char buffer[32];
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buffer;
-}
-
 }  // namespace
 
 void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport& r) {
   write_atomically(file, [&](const std::filesystem::path& temporary) {
     Hdf5Writer h5(temporary);
     h5.attribute("/", "schema_version", std::int64_t{1});
-    h5.attribute("/", "gpilqg_version", std::string(GPILQG_VERSION));
+    h5.attribute("/", "gpilqg_version", std::string(kVersionString));
     h5.attribute("/", "system", r.system);
-    h5.attribute("/", "created", now_utc());
+    h5.attribute("/", "created", utc_timestamp());
     h5.attribute("/", "status", r.verdict.status);
     h5.attribute("/", "verdict_effect", r.verdict.effect ? r.verdict.effect->effect : std::string());
     h5.attribute("/", "consistent", std::int64_t{r.consistent ? 1 : 0});

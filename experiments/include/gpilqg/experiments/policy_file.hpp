@@ -65,7 +65,5 @@ std::shared_ptr<const gp::ResidualModel> read_policy_model(const std::filesystem
 /// [log l..., log sf, log sn]}}. Arrays nest in the file's row-major order.
 nlohmann::json policy_json(const PolicyFile& policy, const gp::ResidualModel* model);
 
-/// The current UTC time as ISO 8601 ("2026-11-24T01:02:03Z").
-std::string utc_timestamp();
 
 }  // namespace gpilqg
