@@ -40,8 +40,8 @@ Vector mapped_values(const RawLog& log, const ColumnMapping& mapping, long rows,
               fmt::format("one of its columns: {}", log.column_names()));
   if (!column->unusable.empty())
     throw DataError(log.file, log.location(column->name),
-                    fmt::format("{} (mapped to '{}' by {}:{}) cannot be used: {}", log.location(column->name), mapping.target,
-                                mapping.origin.file.string(), mapping.origin.location(), column->unusable),
+                    fmt::format("mapped to '{}' by {}:{}, but it cannot be used: {}", mapping.target, mapping.origin.file.string(),
+                                mapping.origin.location(), column->unusable),
                     "a numeric vector with a finite number for every sample");
   if (rows >= 0 && static_cast<long>(column->values.size()) != rows)
     throw DataError(log.file, log.location(column->name), fmt::format("{} values", column->values.size()),
@@ -175,7 +175,7 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
       t(static_cast<Eigen::Index>(i)) = t_all(g.rows[i]);
       if (i > 0 && !(t(i) > t(i - 1)))
         throw DataError(log.file, log.location(map.time.column, g.rows[i]),
-                        fmt::format("time {} s {} the previous sample's {} s ({}){}", t(i), t(i) == t(i - 1) ? "repeats" : "is before",
+                        fmt::format("time {:.9g} s {} the previous sample's {:.9g} s ({}){}", t(i), t(i) == t(i - 1) ? "repeats" : "is before",
                                     t(i - 1), log.location(map.time.column, g.rows[i - 1]),
                                     map.episode ? fmt::format(" in episode {}", g.episode) : ""),
                         map.episode ? "time to increase strictly within an episode"
