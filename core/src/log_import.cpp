@@ -202,6 +202,7 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
     report.dt = steps.size() % 2 == 1 ? steps[mid] : 0.5 * (steps[mid - 1] + steps[mid]);
   }
   report.max_gap_from_map = map.max_gap.has_value();
+  report.average_controls = map.average_controls;
   report.max_gap = map.max_gap.value_or(3.0 * report.dt);
   if (report.max_gap < report.dt)
     map_error(map.resample_section,
@@ -260,7 +261,9 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
       for (const auto& [velocity, position] : report.estimated)
         episode.x.col(index_of(system.states, velocity)) =
             differentiator->differentiate(episode.x.col(index_of(system.states, position)), report.dt);
-      for (int j = 0; j < m; ++j) episode.u.col(j) = hold_zero_order(t, gather(control_columns[j]), tau);
+      for (int j = 0; j < m; ++j)
+        episode.u.col(j) = map.average_controls ? average_held(t, gather(control_columns[j]), tau, report.dt)
+                                                : hold_zero_order(t, gather(control_columns[j]), tau);
       report.episodes.push_back({episode.id, groups[g].episode, t(0), r.size(), static_cast<long>(tau.size())});
       report.rows_used += r.size();
       report.samples_written += tau.size();

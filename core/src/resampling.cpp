@@ -63,6 +63,23 @@ Matrix hold_zero_order(const VectorCRef& t, const MatrixCRef& y, const VectorCRe
   return out;
 }
 
+Matrix average_held(const VectorCRef& t, const MatrixCRef& y, const VectorCRef& tau, double dt) {
+  Matrix out = Matrix::Zero(tau.size(), y.cols());
+  const long n = static_cast<long>(t.size());
+  for (long k = 0; k < tau.size(); ++k) {
+    const double end = tau(k) + dt;
+    double a = tau(k);
+    for (long i = last_at_or_before(t, a); a < end; ++i) {
+      const double segment_end = i + 1 < n ? std::min(t(i + 1), end) : end;
+      if (segment_end > a) out.row(k) += (segment_end - a) * y.row(i);
+      a = std::max(a, segment_end);
+      if (i + 1 >= n) break;
+    }
+    out.row(k) /= dt;
+  }
+  return out;
+}
+
 double median_step(const VectorCRef& t, const std::vector<SampleRange>& ranges) {
   std::vector<double> steps;
   for (const SampleRange& r : ranges)

@@ -62,7 +62,11 @@ LogMap read_import_map(const std::filesystem::path& file) {
 
   map.resample_section = section_origin(root, file, "resample");
   if (fields.has("resample")) {
-    fields.only_keys("resample", {"dt", "max_gap"});
+    fields.only_keys("resample", {"dt", "max_gap", "controls"});
+    const std::string controls = fields.string("resample.controls", "hold");
+    if (controls != "hold" && controls != "average")
+      fields.fail("resample.controls", fmt::format("unknown rule '{}'; expected \"hold\" or \"average\"", controls));
+    map.average_controls = controls == "average";
     if (fields.has("resample.dt")) {
       map.dt = fields.number("resample.dt");
       if (!(*map.dt > 0.0)) fields.fail("resample.dt", fmt::format("{} s; expected a positive step", *map.dt));

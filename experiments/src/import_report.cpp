@@ -17,6 +17,7 @@ std::string format_import_report(const ImportReport& r, const std::filesystem::p
   text += fmt::format("imported {} ({}) for {} into {}\n", r.log.string(), r.format, r.system, out.string());
   text += fmt::format("rows: {} read, {} used, {} dropped; {} samples written at dt = {} s ({})\n", r.rows_read, r.rows_used,
                       r.rows_dropped, r.samples_written, r.dt, r.dt_from_map ? "from the map" : "the median logged step");
+  text += fmt::format("controls: {}\n", r.average_controls ? "averaged over each step" : "held (the control in force at each sample)");
   text += fmt::format("episodes: {} written; {} gap{} longer than {} s ({}) split the log; logged steps {} .. {} s\n",
                       r.episodes.size(), r.gaps, r.gaps == 1 ? "" : "s", r.max_gap, r.max_gap_from_map ? "from the map" : "3 dt",
                       r.step_min, r.step_max);
@@ -75,6 +76,7 @@ nlohmann::json import_report_json(const ImportReport& r, const std::filesystem::
           {"dt_source", r.dt_from_map ? "map" : "median step"},
           {"max_gap", r.max_gap},
           {"max_gap_source", r.max_gap_from_map ? "map" : "3 dt"},
+          {"controls", r.average_controls ? "average" : "hold"},
           {"logged_step", {{"min", r.step_min}, {"max", r.step_max}}},
           {"gaps_split", r.gaps},
           {"columns", columns},

@@ -74,6 +74,23 @@ TEST(Resampling, HeldControlsAreTheLastSampleAtOrBefore) {
   EXPECT_EQ(hold_zero_order(t, u, Vector::Constant(1, 0.11))(0, 0), 2);
 }
 
+TEST(Resampling, AveragedControlsHaveTheImpulseOfTheHeldSignal) {
+  const Vector t = (Vector(5) << 0.0, 0.11, 0.19, 0.305, 0.4).finished();
+  const Matrix u = (Matrix(5, 1) << 1, 2, 3, 4, 5).finished();
+  const Vector tau = uniform_grid(t, 0.1);
+  const Matrix avg = average_held(t, u, tau, 0.1);
+  // [0, 0.1): 1 throughout; [0.1, 0.2): 1 for 0.01, 2 for 0.08, 3 for 0.01; [0.3, 0.4): 3 for 0.005, 4 for 0.095.
+  EXPECT_NEAR(avg(0, 0), 1.0, 1e-12);
+  EXPECT_NEAR(avg(1, 0), (0.01 * 1 + 0.08 * 2 + 0.01 * 3) / 0.1, 1e-12);
+  EXPECT_NEAR(avg(2, 0), (0.09 * 3 + 0.01 * 3) / 0.1, 1e-12);
+  EXPECT_NEAR(avg(3, 0), (0.005 * 3 + 0.095 * 4) / 0.1, 1e-12);
+  EXPECT_NEAR(avg(4, 0), 5.0, 1e-12);  // past the last sample its value is held
+  // With every switch on the grid the average is the hold.
+  const Vector regular = (Vector(4) << 0.0, 0.1, 0.2, 0.3).finished();
+  const Matrix v = (Matrix(4, 1) << 1, -2, 3, 7).finished();
+  EXPECT_MATRIX_NEAR(average_held(regular, v, uniform_grid(regular, 0.1), 0.1), v, 1e-12);
+}
+
 TEST(Resampling, SplitsAtGapsLongerThanTheLimit) {
   const Vector t = (Vector(8) << 0.0, 0.1, 0.2, 0.5, 0.6, 0.7, 0.8, 1.2).finished();
   const auto ranges = split_at_gaps(t, 0.25);

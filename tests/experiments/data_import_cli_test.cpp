@@ -16,6 +16,7 @@
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
 #include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/savitzky_golay.hpp"
 #include "mat_file.hpp"
 #include "test_support.hpp"
 
@@ -171,7 +172,8 @@ Diagnosis diagnose(const fs::path& data) {
   if (result.status != 0) return {};
   const json j = json::parse(result.out);
   if (j["verdict"]["effect"].is_null()) return {"none", 0.0};
-  return {j["verdict"]["effect"].get<std::string>(), j["verdict"]["parameters"]["mu"].get<double>()};
+  const json& parameters = j["verdict"]["parameters"];  // {"mu": ...} for the Coulomb friction
+  return {j["verdict"]["effect"].get<std::string>(), parameters.empty() ? 0.0 : parameters.begin()->get<double>()};
 }
 
 json import(const fs::path& log, const fs::path& map, const fs::path& out) {
@@ -223,13 +225,17 @@ TEST_F(DataImportDefects, TimestampJitterIsResampled) {
   const auto logs = simulate_logs(true, 5);
   const fs::path log = *dir_ / "jitter.csv";
   write_csv(log, table_of(logs, 1.0, 1.0, 1.0, true, kAll));
-  const fs::path map = write_map(*dir_ / "jitter.toml", kMapHead + "[resample]\ndt = 0.02\n\n" + kStatesSi + kControls);
+  // A switch logged late would be held for the whole grid step with controls = "hold" (the control in
+  // force at the grid time), which biases the fitted friction by ~15% and hides the effect on some
+  // seeds; the step average gives each grid step the control's true impulse.
+  const fs::path map = write_map(*dir_ / "jitter.toml", kMapHead + "[resample]\ndt = 0.02\ncontrols = \"average\"\n\n" + kStatesSi + kControls);
   const json report = import(log, map, *dir_ / "jitter.h5");
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["episodes"], kEpisodes);
   EXPECT_EQ(report["rows"]["read"], kEpisodes * kSamples);
   EXPECT_EQ(report["rows"]["dropped"], 0);
   EXPECT_EQ(report["dt_source"], "map");
+  EXPECT_EQ(report["controls"], "average");
   EXPECT_GT(report["logged_step"]["max"].get<double>(), kDt);  // the jitter is there
   EXPECT_LT(report["logged_step"]["min"].get<double>(), kDt);
   expect_same_diagnosis(*dir_ / "jitter.h5", "jitter");
@@ -269,9 +275,13 @@ TEST_F(DataImportDefects, ExtraColumnsAreIgnoredAndListed) {
     battery[r] = 24.0 - 1e-3 * static_cast<double>(r);
     temperature[r] = 40.0 + std::sin(0.01 * static_cast<double>(r));
   }
-  table.names.insert(table.names.begin() + 2, "battery_v");
-  table.columns.insert(table.columns.begin() + 2, battery);
-  table.add("motor_temp", temperature);
+  LogTable extra;  // battery_v after the time column, motor_temp last, then the text column "mode"
+  for (std::size_t c = 0; c < table.names.size(); ++c) {
+    extra.add(table.names[c], table.columns[c]);
+    if (table.names[c] == "time") extra.add("battery_v", battery);
+  }
+  extra.add("motor_temp", temperature);
+  table = extra;
   const fs::path log = *dir_ / "extra.csv";
   write_csv(log, table, {"auto", "manual"});
   std::string head = kMapHead;
@@ -320,17 +330,21 @@ TEST_F(DataImportDefects, DegreesAndMillimetresInAMatFile) {
   expect_same_diagnosis(*dir_ / "degrees.h5", "degrees");
 }
 
+// The velocity has a corner at every control switch (the acceleration jumps), and a polynomial fit
+// across a corner smooths the jump: with window 7 / order 2 the diagnosis of this data reads the
+// smoothed steps as a weaker actuator (actuator_gain ~0.6 on every seed tried), window 5 / order 2
+// passes on most seeds; window 9 / order 4 follows the corners closely enough on all seeds tried.
 TEST_F(DataImportDefects, PositionsOnlyGetEstimatedVelocities) {
   const fs::path log = *dir_ / "positions.csv";
   write_csv(log, table_of(*clean_logs_, 1.0, 1.0, 1.0, false, kAll));
   const fs::path map = write_map(*dir_ / "positions.toml",
                                  kMapHead + "[states]\nx = { column = \"cart_pos\" }\ntheta = { column = \"pole_angle\" }\n\n" +
-                                     kControls + "\n[velocities]\nmethod = \"savitzky_golay\"\nwindow = 5\norder = 2\n");
+                                     kControls + "\n[velocities]\nmethod = \"savitzky_golay\"\nwindow = 9\norder = 4\n");
   const json report = import(log, map, *dir_ / "positions.h5");
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["velocities"]["estimated"], json({{"x_dot", "x"}, {"theta_dot", "theta"}}));
   EXPECT_EQ(report["velocities"]["lag_s"], 0.0);
-  EXPECT_NEAR(report["velocities"]["noise_gain"].get<double>(), std::sqrt(0.1) / kDt, 1e-9);
+  EXPECT_NEAR(report["velocities"]["noise_gain"].get<double>(), SavitzkyGolayDerivative(9, 4).noise_gain(kDt), 1e-9);
   std::cout << "[ estimator ] noise gain " << report["velocities"]["noise_gain"] << " /s\n";
   expect_same_diagnosis(*dir_ / "positions.h5", "positions only");
 }

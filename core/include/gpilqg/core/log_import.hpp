@@ -7,7 +7,8 @@
 /// 2. rows are grouped by the episode column (in order of first appearance; one episode without it),
 ///    and time must increase strictly within each group;
 /// 3. each group is split where two consecutive samples are more than max_gap apart;
-/// 4. each piece is resampled onto t_0 + k dt (resampling.hpp): states linearly, controls held;
+/// 4. each piece is resampled onto t_0 + k dt (resampling.hpp): states linearly, controls held (or
+///    averaged over each step when the map asks for it);
 /// 5. velocities the log lacks (`<q>_dot` for a mapped `<q>`) are estimated from the resampled
 ///    positions by a Savitzky-Golay differentiator (savitzky_golay.hpp);
 /// 6. pieces with fewer than 2 samples (or fewer than the differentiator's window) are dropped and
@@ -57,6 +58,9 @@ struct LogMap {
   std::optional<ColumnMapping> episode;
   std::optional<double> dt;       ///< resampling step [s]; default the median step of the log
   std::optional<double> max_gap;  ///< [s], a longer step starts a new episode; default 3 dt
+  /// Controls on the grid: false, the hold (the control in force at tau_k); true, the step average
+  /// over [tau_k, tau_k + dt) (resampling.hpp).
+  bool average_controls = false;
   std::vector<ColumnMapping> states;
   std::vector<ColumnMapping> controls;
   std::optional<VelocityEstimator> velocities;
@@ -97,6 +101,7 @@ struct ImportReport {
   bool dt_from_map = false;  ///< else the median step of the log
   double max_gap = 0.0;      ///< [s]
   bool max_gap_from_map = false;  ///< else 3 dt
+  bool average_controls = false;  ///< controls averaged over each step, else held
   double step_min = 0.0;     ///< smallest logged step within a piece [s]
   double step_max = 0.0;     ///< largest logged step within a piece (<= max_gap) [s]
   long gaps = 0;             ///< steps longer than max_gap, each starting a new piece

@@ -9,7 +9,10 @@
 /// - linear:  y(tau) = y_i + (tau - t_i) (y_{i+1} - y_i) / (t_{i+1} - t_i) for t_i <= tau <= t_{i+1},
 ///   exact for signals linear in time;
 /// - zero-order hold: y(tau) = y_i with i the last sample at or before tau, i.e. the control in
-///   force at tau (a control logged at t_i is applied from t_i until the next sample).
+///   force at tau (a control logged at t_i is applied from t_i until the next sample);
+/// - step average: y_k = (1 / dt) * integral over [tau_k, tau_k + dt) of the held signal, the constant
+///   input with the same impulse over the step. It equals the hold when every switch is on the grid,
+///   and differs from it only in steps where a logged (jittered) switch falls inside the step.
 
 #include <vector>
 
@@ -37,6 +40,10 @@ Matrix interpolate_linear(const VectorCRef& t, const MatrixCRef& y, const Vector
 
 /// Each column of `y` held from its sample time to the next (zero-order hold), read at `tau` (>= t_0).
 Matrix hold_zero_order(const VectorCRef& t, const MatrixCRef& y, const VectorCRef& tau);
+
+/// The step average of each column of `y` held from its sample times, over [tau_k, tau_k + dt);
+/// past the last sample the last value is held.
+Matrix average_held(const VectorCRef& t, const MatrixCRef& y, const VectorCRef& tau, double dt);
 
 /// The median of the steps t_{i+1} - t_i over the given ranges (0 when no range has two samples).
 double median_step(const VectorCRef& t, const std::vector<SampleRange>& ranges);

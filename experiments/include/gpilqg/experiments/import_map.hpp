@@ -12,6 +12,7 @@
 /// [resample]                       # optional
 /// dt = 0.02                        # [s]; default the median logged step
 /// max_gap = 0.1                    # [s]; a longer step starts a new episode; default 3 dt
+/// controls = "hold"                # or "average": the control averaged over each step
 /// [states]
 /// x = { column = "cart_pos_mm", unit = "mm" }
 /// theta = { column = "angle_deg", unit = "deg" }

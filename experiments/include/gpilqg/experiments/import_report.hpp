@@ -16,7 +16,7 @@ std::string format_import_report(const ImportReport& report, const std::filesyst
 
 /// The JSON object: "log", "map", "out", "format", "system", "rows": {"read", "used", "dropped"},
 /// "samples_written", "episodes" (count), "dt", "dt_source" ("map" or "median step"), "max_gap",
-/// "max_gap_source" ("map" or "3 dt"), "logged_step": {"min", "max"}, "gaps_split", "columns": [{"target",
+/// "max_gap_source" ("map" or "3 dt"), "controls" ("hold" or "average"), "logged_step": {"min", "max"}, "gaps_split", "columns": [{"target",
 /// "column", "unit", "scale"}], "ignored_columns": [names], "velocities": null or {"method", "window",
 /// "order", "estimated": {target: position}, "lag_s", "noise_gain", "end_noise_gain"}, "episode_list":
 /// [{"id", "source_episode", "t_start", "rows", "samples"}], "dropped": [{"source_episode", "t_start",
