@@ -184,52 +184,46 @@ json import(const fs::path& log, const fs::path& map, const fs::path& out) {
   return result.status == 0 ? json::parse(result.out) : json();
 }
 
+/// Each test makes the clean data and its diagnosis itself, in a folder of its own, so tests can run
+/// in parallel processes (ctest -j).
 class DataImportDefects : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    dir_ = new fs::path(test::temporary_dir("data_import_defects"));
-    clean_logs_ = new std::vector<LoggedEpisode>(simulate_logs(false, 5));
-    write_measurements(*dir_ / "clean.csv", as_measurements(*clean_logs_));
-    clean_ = new Diagnosis(diagnose(*dir_ / "clean.csv"));
-  }
-  static void TearDownTestSuite() {
-    delete dir_;
-    delete clean_logs_;
-    delete clean_;
+  void SetUp() override {
+    dir = test::temporary_dir("data_import");
+    clean_logs = simulate_logs(false, 5);
+    write_measurements(dir / "clean.csv", as_measurements(clean_logs));
+    clean = diagnose(dir / "clean.csv");
   }
   /// The imported file's diagnosis names the clean data's effect, with mu within 20% of its value.
-  static void expect_same_diagnosis(const fs::path& imported, const std::string& defect) {
-    ASSERT_EQ(clean_->effect, "cart_coulomb_friction") << "the clean data must show the hidden effect";
+  void expect_same_diagnosis(const fs::path& imported, const std::string& defect) const {
+    ASSERT_EQ(clean.effect, "cart_coulomb_friction") << "the clean data must show the hidden effect";
     const Diagnosis d = diagnose(imported);
-    std::cout << "[ diagnosis ] " << defect << ": " << d.effect << " mu = " << d.value << " (clean: " << clean_->value << ")\n";
-    EXPECT_EQ(d.effect, clean_->effect) << defect;
-    EXPECT_NEAR(d.value, clean_->value, 0.2 * clean_->value) << defect;
+    std::cout << "[ diagnosis ] " << defect << ": " << d.effect << " mu = " << d.value << " (clean: " << clean.value << ")\n";
+    EXPECT_EQ(d.effect, clean.effect) << defect;
+    EXPECT_NEAR(d.value, clean.value, 0.2 * clean.value) << defect;
   }
-  static fs::path* dir_;
-  static std::vector<LoggedEpisode>* clean_logs_;
-  static Diagnosis* clean_;
+  fs::path dir;
+  std::vector<LoggedEpisode> clean_logs;
+  Diagnosis clean;
 };
-fs::path* DataImportDefects::dir_ = nullptr;
-std::vector<LoggedEpisode>* DataImportDefects::clean_logs_ = nullptr;
-Diagnosis* DataImportDefects::clean_ = nullptr;
 
 const auto kAll = [](int, int) { return true; };
 
 TEST_F(DataImportDefects, CleanDataNamesTheHiddenEffect) {
-  std::cout << "[ diagnosis ] clean: " << clean_->effect << " mu = " << clean_->value << '\n';
-  EXPECT_EQ(clean_->effect, "cart_coulomb_friction");
-  EXPECT_NEAR(clean_->value, kMu, 0.2 * kMu);
+  std::cout << "[ diagnosis ] clean: " << clean.effect << " mu = " << clean.value << '\n';
+  EXPECT_EQ(clean.effect, "cart_coulomb_friction");
+  EXPECT_NEAR(clean.value, kMu, 0.2 * kMu);
 }
 
 TEST_F(DataImportDefects, TimestampJitterIsResampled) {
   const auto logs = simulate_logs(true, 5);
-  const fs::path log = *dir_ / "jitter.csv";
+  const fs::path log = dir / "jitter.csv";
   write_csv(log, table_of(logs, 1.0, 1.0, 1.0, true, kAll));
   // A switch logged late would be held for the whole grid step with controls = "hold" (the control in
   // force at the grid time), which biases the fitted friction by ~15% and hides the effect on some
   // seeds; the step average gives each grid step the control's true impulse.
-  const fs::path map = write_map(*dir_ / "jitter.toml", kMapHead + "[resample]\ndt = 0.02\ncontrols = \"average\"\n\n" + kStatesSi + kControls);
-  const json report = import(log, map, *dir_ / "jitter.h5");
+  const fs::path map = write_map(dir / "jitter.toml", kMapHead + "[resample]\ndt = 0.02\ncontrols = \"average\"\n\n" + kStatesSi + kControls);
+  const json report = import(log, map, dir / "jitter.h5");
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["episodes"], kEpisodes);
   EXPECT_EQ(report["rows"]["read"], kEpisodes * kSamples);
@@ -238,13 +232,13 @@ TEST_F(DataImportDefects, TimestampJitterIsResampled) {
   EXPECT_EQ(report["controls"], "average");
   EXPECT_GT(report["logged_step"]["max"].get<double>(), kDt);  // the jitter is there
   EXPECT_LT(report["logged_step"]["min"].get<double>(), kDt);
-  expect_same_diagnosis(*dir_ / "jitter.h5", "jitter");
+  expect_same_diagnosis(dir / "jitter.h5", "jitter");
 }
 
 TEST_F(DataImportDefects, ADroppedBlockSplitsAnEpisode) {
-  const fs::path log = *dir_ / "dropped.h5";
+  const fs::path log = dir / "dropped.h5";
   // 20 samples (0.4 s) of episode 3 lost; an HDF5 log of 1-D datasets under /log.
-  const LogTable table = table_of(*clean_logs_, 1.0, 1.0, 1.0, true, [](int e, int k) { return !(e == 3 && k >= 50 && k < 70); });
+  const LogTable table = table_of(clean_logs, 1.0, 1.0, 1.0, true, [](int e, int k) { return !(e == 3 && k >= 50 && k < 70); });
   {
     Hdf5Writer h5(log);
     for (std::size_t c = 0; c < table.names.size(); ++c) h5.write_vector("/log/" + table.names[c], table.columns[c]);
@@ -255,8 +249,8 @@ TEST_F(DataImportDefects, ADroppedBlockSplitsAnEpisode) {
   head.replace(head.find("\"time\""), 6, "\"/log/time\"");
   head.replace(head.find("\"trial\""), 7, "\"log/trial\"");
   const fs::path map =
-      write_map(*dir_ / "dropped.toml", head + "[resample]\nmax_gap = 0.05\n\n" + states + "[controls]\nforce = \"log/force\"\n");
-  const json report = import(log, map, *dir_ / "dropped.h5.out.h5");
+      write_map(dir / "dropped.toml", head + "[resample]\nmax_gap = 0.05\n\n" + states + "[controls]\nforce = \"log/force\"\n");
+  const json report = import(log, map, dir / "dropped.h5.out.h5");
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["format"], "hdf5");
   EXPECT_EQ(report["episodes"], kEpisodes + 1);
@@ -265,11 +259,11 @@ TEST_F(DataImportDefects, ADroppedBlockSplitsAnEpisode) {
   EXPECT_EQ(report["samples_written"], kEpisodes * kSamples - 20);
   EXPECT_EQ(report["dt_source"], "median step");
   EXPECT_NEAR(report["dt"].get<double>(), kDt, 1e-12);
-  expect_same_diagnosis(*dir_ / "dropped.h5.out.h5", "dropped block");
+  expect_same_diagnosis(dir / "dropped.h5.out.h5", "dropped block");
 }
 
 TEST_F(DataImportDefects, ExtraColumnsAreIgnoredAndListed) {
-  LogTable table = table_of(*clean_logs_, 1000.0, 1.0, 1.0, true, kAll);  // time in ms
+  LogTable table = table_of(clean_logs, 1000.0, 1.0, 1.0, true, kAll);  // time in ms
   std::vector<double> battery(table.columns[0].size()), temperature(table.columns[0].size());
   for (std::size_t r = 0; r < battery.size(); ++r) {
     battery[r] = 24.0 - 1e-3 * static_cast<double>(r);
@@ -282,52 +276,52 @@ TEST_F(DataImportDefects, ExtraColumnsAreIgnoredAndListed) {
   }
   extra.add("motor_temp", temperature);
   table = extra;
-  const fs::path log = *dir_ / "extra.csv";
+  const fs::path log = dir / "extra.csv";
   write_csv(log, table, {"auto", "manual"});
   std::string head = kMapHead;
   head.replace(head.find("column = \"time\""), 15, "column = \"time\"\nunit = \"ms\"");
-  const fs::path map = write_map(*dir_ / "extra.toml", head + kStatesSi + kControls);
-  const json report = import(log, map, *dir_ / "extra.h5");
+  const fs::path map = write_map(dir / "extra.toml", head + kStatesSi + kControls);
+  const json report = import(log, map, dir / "extra.h5");
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["ignored_columns"], json({"battery_v", "motor_temp", "mode"}));
   EXPECT_EQ(report["rows"]["dropped"], 0);
   EXPECT_NEAR(report["dt"].get<double>(), kDt, 1e-12);
   // The text report says the same.
   const auto text = test::run_cli("data import " + quote(log) + " --system cartpole --map " + quote(map) + " --out " +
-                                  quote(*dir_ / "extra.csv.out.csv"));
+                                  quote(dir / "extra.csv.out.csv"));
   ASSERT_EQ(text.status, 0) << text.err;
   EXPECT_NE(text.out.find("ignored columns: battery_v, motor_temp, mode"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("840 read, 840 used, 0 dropped; 840 samples written"), std::string::npos) << text.out;
-  EXPECT_EQ(read_measurements(*dir_ / "extra.csv.out.csv", system_signature("cartpole")).sample_count(), 840);
-  expect_same_diagnosis(*dir_ / "extra.h5", "extra columns");
+  EXPECT_EQ(read_measurements(dir / "extra.csv.out.csv", system_signature("cartpole")).sample_count(), 840);
+  expect_same_diagnosis(dir / "extra.h5", "extra columns");
 }
 
 TEST_F(DataImportDefects, DegreesAndMillimetresInAMatFile) {
   const double deg = 180.0 / std::numbers::pi;
-  const LogTable table = table_of(*clean_logs_, 1.0, 1000.0, deg, true, kAll);
+  const LogTable table = table_of(clean_logs, 1.0, 1000.0, deg, true, kAll);
   // time, trial, cart and force as vectors; the pole's angle and rate as fields of a struct "pole".
   test::MatVectors vectors, pole;
   for (std::size_t c = 0; c < table.names.size(); ++c) {
     if (table.names[c].starts_with("pole_")) pole.emplace_back(table.names[c], table.columns[c]);
     else vectors.emplace_back(table.names[c], table.columns[c]);
   }
-  const fs::path log = *dir_ / "degrees.mat";
+  const fs::path log = dir / "degrees.mat";
   test::write_mat_file(log, vectors, "pole", pole);
-  const fs::path map = write_map(*dir_ / "degrees.toml",
+  const fs::path map = write_map(dir / "degrees.toml",
                                  kMapHead +
                                      "[states]\nx = { column = \"cart_pos\", unit = \"mm\" }\n"
                                      "x_dot = { column = \"cart_vel\", unit = \"mm/s\" }\n"
                                      "theta = { column = \"pole.pole_angle\", unit = \"deg\" }\n"
                                      "theta_dot = { column = \"pole.pole_rate\", unit = \"deg/s\" }\n\n" +
                                      kControls);
-  const json report = import(log, map, *dir_ / "degrees.h5");
+  const json report = import(log, map, dir / "degrees.h5");
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["format"], "mat");
-  const MeasurementSet set = read_measurements(*dir_ / "degrees.h5", system_signature("cartpole"));
+  const MeasurementSet set = read_measurements(dir / "degrees.h5", system_signature("cartpole"));
   ASSERT_EQ(set.episodes.size(), static_cast<std::size_t>(kEpisodes));
-  EXPECT_NEAR(set.episodes[2].x(17, 2), (*clean_logs_)[2].x(17, 2), 1e-12);  // back in radians
-  EXPECT_NEAR(set.episodes[2].x(17, 0), (*clean_logs_)[2].x(17, 0), 1e-12);  // back in metres
-  expect_same_diagnosis(*dir_ / "degrees.h5", "degrees");
+  EXPECT_NEAR(set.episodes[2].x(17, 2), clean_logs[2].x(17, 2), 1e-12);  // back in radians
+  EXPECT_NEAR(set.episodes[2].x(17, 0), clean_logs[2].x(17, 0), 1e-12);  // back in metres
+  expect_same_diagnosis(dir / "degrees.h5", "degrees");
 }
 
 // The velocity has a corner at every control switch (the acceleration jumps), and a polynomial fit
@@ -335,18 +329,18 @@ TEST_F(DataImportDefects, DegreesAndMillimetresInAMatFile) {
 // smoothed steps as a weaker actuator (actuator_gain ~0.6 on every seed tried), window 5 / order 2
 // passes on most seeds; window 9 / order 4 follows the corners closely enough on all seeds tried.
 TEST_F(DataImportDefects, PositionsOnlyGetEstimatedVelocities) {
-  const fs::path log = *dir_ / "positions.csv";
-  write_csv(log, table_of(*clean_logs_, 1.0, 1.0, 1.0, false, kAll));
-  const fs::path map = write_map(*dir_ / "positions.toml",
+  const fs::path log = dir / "positions.csv";
+  write_csv(log, table_of(clean_logs, 1.0, 1.0, 1.0, false, kAll));
+  const fs::path map = write_map(dir / "positions.toml",
                                  kMapHead + "[states]\nx = { column = \"cart_pos\" }\ntheta = { column = \"pole_angle\" }\n\n" +
                                      kControls + "\n[velocities]\nmethod = \"savitzky_golay\"\nwindow = 9\norder = 4\n");
-  const json report = import(log, map, *dir_ / "positions.h5");
+  const json report = import(log, map, dir / "positions.h5");
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["velocities"]["estimated"], json({{"x_dot", "x"}, {"theta_dot", "theta"}}));
   EXPECT_EQ(report["velocities"]["lag_s"], 0.0);
   EXPECT_NEAR(report["velocities"]["noise_gain"].get<double>(), SavitzkyGolayDerivative(9, 4).noise_gain(kDt), 1e-9);
   std::cout << "[ estimator ] noise gain " << report["velocities"]["noise_gain"] << " /s\n";
-  expect_same_diagnosis(*dir_ / "positions.h5", "positions only");
+  expect_same_diagnosis(dir / "positions.h5", "positions only");
 }
 
 // Bad maps and logs: exit 2, "error:", the file and the line and field or column.
