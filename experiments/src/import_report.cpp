@@ -15,10 +15,10 @@ std::string unit_or_si(const ColumnMapping& c) { return c.unit.empty() ? "SI" : 
 std::string format_import_report(const ImportReport& r, const std::filesystem::path& out) {
   std::string text;
   text += fmt::format("imported {} ({}) for {} into {}\n", r.log.string(), r.format, r.system, out.string());
-  text += fmt::format("rows: {} read, {} used, {} dropped; {} samples written at dt = {} s ({})\n", r.rows_read, r.rows_used,
+  text += fmt::format("rows: {} read, {} used, {} dropped; {} samples written at dt = {:.6g} s ({})\n", r.rows_read, r.rows_used,
                       r.rows_dropped, r.samples_written, r.dt, r.dt_from_map ? "from the map" : "the median logged step");
   text += fmt::format("controls: {}\n", r.average_controls ? "averaged over each step" : "held (the control in force at each sample)");
-  text += fmt::format("episodes: {} written; {} gap{} longer than {} s ({}) split the log; logged steps {} .. {} s\n",
+  text += fmt::format("episodes: {} written; {} gap{} longer than {:.6g} s ({}) split the log; logged steps {:.6g} .. {:.6g} s\n",
                       r.episodes.size(), r.gaps, r.gaps == 1 ? "" : "s", r.max_gap, r.max_gap_from_map ? "from the map" : "3 dt",
                       r.step_min, r.step_max);
   for (const ColumnMapping& c : r.columns)
@@ -26,7 +26,7 @@ std::string format_import_report(const ImportReport& r, const std::filesystem::p
   for (const auto& [velocity, position] : r.estimated)
     text += fmt::format("  {:<12} <- d/dt {} (Savitzky-Golay)\n", velocity, position);
   if (r.estimator)
-    text += fmt::format("velocity estimator: Savitzky-Golay, window {}, order {}: lag {} s, noise gain {:.4g} /s "
+    text += fmt::format("velocity estimator: Savitzky-Golay, window {}, order {}: lag {:.6g} s, noise gain {:.4g} /s "
                         "({:.4g} /s at the first and last samples)\n",
                         r.estimator->window, r.estimator->order, r.estimator_lag, r.estimator_noise_gain,
                         r.estimator_end_noise_gain);
@@ -34,7 +34,7 @@ std::string format_import_report(const ImportReport& r, const std::filesystem::p
   for (const std::string& name : r.ignored_columns) ignored += (ignored.empty() ? "" : ", ") + name;
   text += fmt::format("ignored columns: {}\n", ignored.empty() ? "none" : ignored);
   for (const DroppedPiece& d : r.dropped)
-    text += fmt::format("dropped: episode {} from t = {} s to {} s, {} rows: {}\n", d.source_episode, d.t_start, d.t_end,
+    text += fmt::format("dropped: episode {} from t = {:.6g} s to {:.6g} s, {} rows: {}\n", d.source_episode, d.t_start, d.t_end,
                         d.rows, d.reason);
   return text;
 }

@@ -417,6 +417,8 @@ TEST_F(BadInput, BadLogsAndOtherMapMistakes) {
   expect_error(run(map_text("x = \"x\""), dir / "log.txt"), {"log.txt: unknown extension '.txt'"});
   expect_error(run(map_text("x = \"x\"") + "[velocity]\nwindow = 5\n", log),
                {"map.toml:line 12: unknown field 'velocity'; expected one of: time, episode"});
+  expect_error(run(map_text("x = \"x\"") + "[resample]\ncontrols = \"linear\"\n", log),
+               {"map.toml:line 13: field 'resample.controls': unknown rule 'linear'; expected \"hold\" or \"average\""});
   expect_error(run("[time]\ncolumn = \"time\"\n[states]\nx = \"x\"\n", log), {"map.toml: missing section [controls]"});
 }
 
