@@ -16,7 +16,7 @@ packages=(
   cmake make g++ pkg-config
   libeigen3-dev libsuitesparse-dev libnlopt-cxx-dev libhdf5-dev libbenchmark-dev libgtest-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev python3-h5py python3-matplotlib
-  libmujoco-dev
+  libmujoco-dev libmatio-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,5 +1,6 @@
 /// `gpilqg data info FILE --system NAME [--json]`: summarise a measurement file (CSV or HDF5,
-/// DESIGN.md section 4), or reject it with an error naming the file and the line or dataset.
+/// DESIGN.md section 4), or reject it with an error naming the file and the line or dataset; and
+/// `gpilqg data import` (data_import_command.cpp).
 
 #include <iostream>
 #include <memory>
@@ -7,6 +8,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "data_import_command.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -38,7 +40,7 @@ int run_data_info(const DataInfoOptions& options) {
 }  // namespace
 
 void add_data_command(CLI::App& app, CommandAction& action) {
-  CLI::App* data = app.add_subcommand("data", "Inspect measurement files (CSV or HDF5)");
+  CLI::App* data = app.add_subcommand("data", "Inspect measurement files (CSV or HDF5) and import robot logs");
   data->require_subcommand(1);
 
   CLI::App* info = data->add_subcommand(
@@ -50,6 +52,8 @@ void add_data_command(CLI::App& app, CommandAction& action) {
   info->add_option("--system", options->system, kSystemHelp)->required();
   info->add_flag("--json", options->json, "Print one JSON document on stdout instead of the table");
   info->callback([options, &action] { action = [options] { return run_data_info(*options); }; });
+
+  add_data_import_command(*data, action);
 }
 
 }  // namespace gpilqg::cli

@@ -1,0 +1,68 @@
+/// Choosing a raw-log reader by extension, and naming places in a log for error messages.
+
+#include "gpilqg/core/raw_log.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+#include <fmt/format.h>
+
+#include "gpilqg/core/measurements.hpp"
+
+namespace gpilqg {
+
+namespace {
+
+std::string without_leading_slash(const std::string& name) {
+  return !name.empty() && name.front() == '/' ? name.substr(1) : name;
+}
+
+}  // namespace
+
+const LogColumn* RawLog::find(const std::string& name) const {
+  const std::string key = format == LogFormat::Hdf5 ? without_leading_slash(name) : name;
+  for (const LogColumn& column : columns)
+    if (column.name == key) return &column;
+  return nullptr;
+}
+
+std::string RawLog::column_names() const {
+  std::string list;
+  for (const LogColumn& column : columns) list += (list.empty() ? "'" : ", '") + column.name + "'";
+  return list;
+}
+
+std::string RawLog::location(const std::string& name) const {
+  switch (format) {
+    case LogFormat::Csv: return fmt::format("column '{}'", name);
+    case LogFormat::Mat: return fmt::format("variable '{}'", name);
+    case LogFormat::Hdf5: return fmt::format("dataset '/{}'", without_leading_slash(name));
+  }
+  return name;
+}
+
+std::string RawLog::location(const std::string& name, long row) const {
+  if (format == LogFormat::Csv) return fmt::format("line {}, column '{}'", row + 2, name);
+  return fmt::format("{}, element {}", location(name), row);
+}
+
+RawLog read_raw_log(const std::filesystem::path& file) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::error_code error;
+  if (!std::filesystem::exists(file, error)) throw DataError(file, "", "no such file", "an existing log file");
+  RawLog log;
+  if (extension == ".csv") log = read_raw_log_csv(file);
+  else if (extension == ".mat") log = read_raw_log_mat(file);
+  else if (extension == ".h5" || extension == ".hdf5") log = read_raw_log_hdf5(file);
+  else
+    throw DataError(file, "", fmt::format("unknown extension '{}'", extension), "a log ending in .csv, .mat, .h5 or .hdf5");
+  const bool any_usable =
+      std::any_of(log.columns.begin(), log.columns.end(), [](const LogColumn& c) { return c.unusable.empty(); });
+  if (!any_usable)
+    throw DataError(file, "", "no numeric column", "named numeric vectors, one per column (docs/data-import.md)");
+  return log;
+}
+
+}  // namespace gpilqg

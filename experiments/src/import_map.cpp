@@ -1,0 +1,109 @@
+#include "gpilqg/experiments/import_map.hpp"
+
+#include <fmt/format.h>
+
+#include "gpilqg/core/units.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/toml_fields.hpp"
+
+namespace gpilqg {
+
+namespace {
+
+long line_of(const toml::node* node) { return node != nullptr ? static_cast<long>(node->source().begin.line) : 0; }
+
+/// The entry at `path` (a table {column, unit} or a column name): its column and unit scale.
+ColumnMapping read_mapping(const TomlFields& fields, const toml::node* node, const std::filesystem::path& file,
+                           const std::string& path, const std::string& target, bool allow_unit) {
+  ColumnMapping mapping;
+  mapping.target = target;
+  if (node != nullptr && node->is_string()) {
+    mapping.column = node->as_string()->get();
+    mapping.origin = {file, line_of(node), path};
+  } else {
+    if (node == nullptr || !node->is_table())
+      fields.fail(path, "expected a table { column = \"...\", unit = \"...\" } or a column name");
+    fields.only_keys(path, allow_unit ? std::vector<std::string>{"column", "unit"} : std::vector<std::string>{"column"});
+    mapping.column = fields.string(path + ".column");
+    mapping.origin = {file, line_of(node->as_table()->get("column")), path + ".column"};
+    if (allow_unit && fields.has(path + ".unit")) {
+      mapping.unit = fields.string(path + ".unit");
+      const auto unit = find_unit(mapping.unit);
+      if (!unit) fields.fail(path + ".unit", fmt::format("unknown unit '{}'; expected one of: {}", mapping.unit, unit_names()));
+      mapping.scale = unit->factor;
+    }
+  }
+  if (mapping.column.empty()) fields.fail(path, "an empty column name; expected the log's name for the column");
+  return mapping;
+}
+
+MapOrigin section_origin(const toml::table& root, const std::filesystem::path& file, const std::string& section) {
+  return {file, line_of(root.get(section)), section};
+}
+
+}  // namespace
+
+LogMap read_import_map(const std::filesystem::path& file) {
+  const toml::table root = TomlFields::parse(file);
+  const TomlFields fields(root, file);
+  fields.only_keys("", {"time", "episode", "resample", "states", "controls", "velocities"});
+  for (const char* section : {"time", "states", "controls"}) fields.require_section(section);
+
+  LogMap map;
+  map.file = file;
+  fields.only_keys("time", {"column", "unit"});
+  map.time = read_mapping(fields, root.get("time"), file, "time", "time", true);
+  if (!map.time.unit.empty() && find_unit(map.time.unit)->dimension != "time")
+    fields.fail("time.unit", fmt::format("'{}' is not a unit of time; expected s, ms, us or ns", map.time.unit));
+  if (fields.has("episode")) {
+    fields.only_keys("episode", {"column"});
+    map.episode = read_mapping(fields, root.get("episode"), file, "episode", "episode", false);
+  }
+
+  map.resample_section = section_origin(root, file, "resample");
+  if (fields.has("resample")) {
+    fields.only_keys("resample", {"dt", "max_gap", "controls"});
+    const std::string controls = fields.string("resample.controls", "hold");
+    if (controls != "hold" && controls != "average")
+      fields.fail("resample.controls", fmt::format("unknown rule '{}'; expected \"hold\" or \"average\"", controls));
+    map.average_controls = controls == "average";
+    if (fields.has("resample.dt")) {
+      map.dt = fields.number("resample.dt");
+      if (!(*map.dt > 0.0)) fields.fail("resample.dt", fmt::format("{} s; expected a positive step", *map.dt));
+    }
+    if (fields.has("resample.max_gap")) {
+      map.max_gap = fields.number("resample.max_gap");
+      if (!(*map.max_gap > 0.0)) fields.fail("resample.max_gap", fmt::format("{} s; expected a positive time", *map.max_gap));
+      if (map.dt && *map.max_gap < *map.dt)
+        fields.fail("resample.max_gap", fmt::format("{} s is shorter than dt = {} s; expected max_gap >= dt", *map.max_gap, *map.dt));
+    }
+  }
+
+  for (const char* section : {"states", "controls"}) {
+    const toml::table* table = root.get(section)->as_table();
+    std::vector<ColumnMapping>& list = std::string(section) == "states" ? map.states : map.controls;
+    for (const auto& [key, node] : *table) {
+      const std::string target(key.str());
+      list.push_back(read_mapping(fields, &node, file, std::string(section) + "." + toml_key(target), target, true));
+    }
+  }
+  map.states_section = section_origin(root, file, "states");
+  map.controls_section = section_origin(root, file, "controls");
+
+  if (fields.has("velocities")) {
+    fields.only_keys("velocities", {"method", "window", "order"});
+    const std::string method = fields.string("velocities.method");
+    if (method != "savitzky_golay")
+      fields.fail("velocities.method", fmt::format("unknown method '{}'; expected \"savitzky_golay\"", method));
+    VelocityEstimator estimator;
+    estimator.window = fields.integer_in("velocities.window", 3, 1001, 7);
+    if (estimator.window % 2 == 0)
+      fields.fail("velocities.window", fmt::format("{} is even; expected an odd number of samples", estimator.window));
+    estimator.order = fields.integer_in("velocities.order", 1, estimator.window - 1, 2);
+    estimator.origin = section_origin(root, file, "velocities");
+    map.velocities = estimator;
+  }
+  return map;
+}
+
+}  // namespace gpilqg
