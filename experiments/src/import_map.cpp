@@ -1,5 +1,6 @@
 #include "gpilqg/experiments/import_map.hpp"
 
+#include <algorithm>
 #include <fmt/format.h>
 
 #include "gpilqg/core/units.hpp"
@@ -95,11 +96,11 @@ LogMap read_import_map(const std::filesystem::path& file) {
     const std::string method = fields.string("velocities.method");
     if (method != "savitzky_golay")
       fields.fail("velocities.method", fmt::format("unknown method '{}'; expected \"savitzky_golay\"", method));
-    VelocityEstimator estimator;
-    estimator.window = fields.integer_in("velocities.window", 3, 1001, 7);
+    VelocityEstimator estimator;  // its members hold the defaults
+    estimator.window = fields.integer_in("velocities.window", 3, 1001, estimator.window);
     if (estimator.window % 2 == 0)
       fields.fail("velocities.window", fmt::format("{} is even; expected an odd number of samples", estimator.window));
-    estimator.order = fields.integer_in("velocities.order", 1, estimator.window - 1, 2);
+    estimator.order = fields.integer_in("velocities.order", 1, estimator.window - 1, std::min(estimator.order, estimator.window - 1));
     estimator.origin = section_origin(root, file, "velocities");
     map.velocities = estimator;
   }

@@ -327,13 +327,14 @@ TEST_F(DataImportDefects, DegreesAndMillimetresInAMatFile) {
 // The velocity has a corner at every control switch (the acceleration jumps), and a polynomial fit
 // across a corner smooths the jump: with window 7 / order 2 the diagnosis of this data reads the
 // smoothed steps as a weaker actuator (actuator_gain ~0.6 on every seed tried), window 5 / order 2
-// passes on most seeds; window 9 / order 4 follows the corners closely enough on all seeds tried.
+// passes on most seeds; window 9 / order 4, the map's defaults, follows the corners closely enough on
+// all seeds tried.
 TEST_F(DataImportDefects, PositionsOnlyGetEstimatedVelocities) {
   const fs::path log = dir / "positions.csv";
   write_csv(log, table_of(clean_logs, 1.0, 1.0, 1.0, false, kAll));
   const fs::path map = write_map(dir / "positions.toml",
                                  kMapHead + "[states]\nx = { column = \"cart_pos\" }\ntheta = { column = \"pole_angle\" }\n\n" +
-                                     kControls + "\n[velocities]\nmethod = \"savitzky_golay\"\nwindow = 9\norder = 4\n");
+                                     kControls + "\n[velocities]\nmethod = \"savitzky_golay\"\n");  // the defaults
   const json report = import(log, map, dir / "positions.h5");
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["velocities"]["estimated"], json({{"x_dot", "x"}, {"theta_dot", "theta"}}));

@@ -47,8 +47,10 @@ struct ColumnMapping {
 
 /// Settings of the velocity estimator for `<q>_dot` states without a column.
 struct VelocityEstimator {
-  int window = 7;  ///< odd number of samples of the centred fit
-  int order = 2;   ///< degree of the local polynomial
+  /// Defaults: a quartic over 9 samples keeps the velocity's corners at control switches, where a
+  /// quadratic over 7 rounded them off enough to mislead a diagnosis (docs/data-import.md).
+  int window = 9;  ///< odd number of samples of the centred fit
+  int order = 4;   ///< degree of the local polynomial
   MapOrigin origin;
 };
 
