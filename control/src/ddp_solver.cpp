@@ -477,6 +477,10 @@ DdpResult Engine::run(const Matrix& initial_controls) {
       summary.termination = DdpTermination::WallTime;
       stop = true;
     }
+    if (!stop && opt_.on_iteration && !opt_.on_iteration(summary.trace.back())) {
+      summary.termination = DdpTermination::Cancelled;
+      stop = true;
+    }
     if (!stop && iter == opt_.max_iterations) summary.termination = DdpTermination::MaxIterations;
   }
   summary.iterations = static_cast<int>(summary.trace.size());

@@ -12,6 +12,7 @@ std::string_view to_string(DdpTermination termination) {
     case DdpTermination::WallTime: return "wall_time";
     case DdpTermination::RegularizationLimit: return "regularization_limit";
     case DdpTermination::InitialRolloutDiverged: return "initial_rollout_diverged";
+    case DdpTermination::Cancelled: return "cancelled";
   }
   return "?";
 }

@@ -177,5 +177,25 @@ TEST(RolloutFault, EachWayOfDivergingHasItsStatus) {
   EXPECT_THROW(rollout(world, Vector::Constant(4, std::nan("")), Matrix::Zero(1, 3)), std::invalid_argument);
 }
 
+TEST(SolverFault, AnIterationCallbackThatSaysStopCancelsWithTheLastAcceptedTrajectory) {
+  // DdpOptions::on_iteration sees every iteration in order; returning false ends the solve there, with
+  // a finite result and termination Cancelled (how Ctrl-C reaches inside a solve from Python).
+  const SwingUp s;
+  DdpOptions options;
+  options.max_iterations = 100;
+  std::vector<int> seen;
+  options.on_iteration = [&](const DdpIteration& record) {
+    seen.push_back(record.iteration);
+    return seen.size() < 3;
+  };
+  const DdpResult r = DdpSolver(options).solve(s.problem(Vector::Zero(4), 40), Matrix::Zero(1, 40));
+  EXPECT_EQ(r.summary.termination, DdpTermination::Cancelled);
+  EXPECT_EQ(seen, (std::vector<int>{1, 2, 3}));
+  EXPECT_EQ(r.summary.iterations, 3);
+  EXPECT_FALSE(converged(r.summary.termination));
+  EXPECT_TRUE(result_finite(r));
+  EXPECT_LT(r.summary.final_cost, r.summary.initial_cost);
+}
+
 }  // namespace
 }  // namespace gpilqg

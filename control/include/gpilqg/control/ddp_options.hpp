@@ -3,10 +3,13 @@
 /// Settings of the DDP engine. Every field has a documented default; validate() rejects bad values
 /// with a message naming the field.
 
+#include <functional>
 #include <optional>
 #include <string_view>
 
 namespace gpilqg {
+
+struct DdpIteration;
 
 /// Which stochastic terms enter the Q-expansion (paper, Robust-ILQG section, the sums in q, Q, g, G, H):
 enum class DdpVariant {
@@ -47,6 +50,11 @@ struct DdpOptions {
   int line_search_steps = 11;
   /// Accept a step when actual / expected reduction exceeds this (0: any real decrease).
   double min_reduction_ratio = 0.0;
+
+  /// Called on the solving thread after every iteration with its record (ddp_summary.hpp). Returning
+  /// false stops the solve at once with termination Cancelled and the last accepted trajectory: the
+  /// way progress lines and Ctrl-C (`gpilqg` from Python) reach inside a long solve. Empty: none.
+  std::function<bool(const DdpIteration&)> on_iteration;
 
   /// Throws std::invalid_argument naming the field and the expected range.
   void validate() const;

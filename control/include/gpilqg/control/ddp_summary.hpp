@@ -15,6 +15,7 @@ enum class DdpTermination {
   WallTime,            ///< max_seconds reached
   RegularizationLimit, ///< no acceptable step even at lambda_max (numerical trouble or a local minimum)
   InitialRolloutDiverged,  ///< the initial controls drive the model to non-finite states
+  Cancelled,           ///< DdpOptions::on_iteration asked to stop
 };
 
 std::string_view to_string(DdpTermination termination);
