@@ -231,4 +231,6 @@ MeasurementSummary summarize(const MeasurementSet& set) {
   return summary;
 }
 
+void check_measurement_set(const MeasurementSet& set) { measurements_detail::check_writable(set); }
+
 }  // namespace gpilqg

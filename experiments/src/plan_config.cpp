@@ -6,7 +6,10 @@ namespace gpilqg {
 
 PlanConfig read_plan_config(const std::filesystem::path& file) {
   const toml::table root = TomlFields::parse(file);
-  const TomlFields f(root, file);
+  return read_plan_config(TomlFields(root, file));
+}
+
+PlanConfig read_plan_config(const TomlFields& f) {
   PlanConfig c;
   c.problem = read_solve_config(f, {"gp"}, "robust_ilqg");
   if (c.problem.solver.variant == DdpVariant::ILQR)

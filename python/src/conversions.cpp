@@ -6,8 +6,8 @@
 namespace gpilqg::python {
 
 void register_errors(py::module_& m) {
-  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
-  static py::exception<DataError> data_error(m, "DataError", input_error.ptr());
+  auto& input_error = py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  auto& data_error = py::register_exception<DataError>(m, "DataError", input_error.ptr());
   input_error.attr("__doc__") = "Bad input (a config field, an option, a file): the command line's exit status 2.";
   data_error.attr("__doc__") = "A measurement file that breaks the data format; the message names the file and line.";
   // std::invalid_argument from the library becomes ValueError (pybind11's default translation).

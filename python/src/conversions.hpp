@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 #include <pybind11/pybind11.h>
 
+#include "gpilqg/core/dynamics.hpp"
+
 namespace gpilqg::python {
 
 namespace py = pybind11;
@@ -18,6 +20,9 @@ namespace py = pybind11;
 /// gpilqg.InputError (bad input: a config field, a data file; the command line's exit 2) and
 /// gpilqg.DataError (a subclass: a measurement file), both ValueErrors, with the library's messages.
 void register_errors(py::module_& m);
+
+/// A system given from Python: a registry name (str) or a gpilqg.Dynamics object.
+DynamicsPtr system_from_python(const py::object& system);
 
 /// A JSON document as the Python object json.loads would give (dicts, lists, floats, None).
 py::object to_python(const nlohmann::json& document);

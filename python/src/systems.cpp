@@ -1,7 +1,255 @@
+/// Systems from Python: the registry's systems (built-in, MuJoCo model files, plugins), their
+/// discrete-time step models, and dynamics written in Python (a subclass of gpilqg.Dynamics) that
+/// every command of the library can use once registered.
+
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include <fmt/format.h>
+
 #include "bindings.hpp"
+#include "conversions.hpp"
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/plugin.hpp"
+#include "gpilqg/core/system_registry.hpp"
+#include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
 
 namespace gpilqg::python {
+namespace {
 
-void bind_systems(py::module_& m) { (void)m; }
+std::vector<Quantity> quantities(const std::vector<py::object>& items, const char* what) {
+  std::vector<Quantity> out;
+  for (const py::object& item : items) {
+    if (py::isinstance<py::str>(item)) out.push_back({item.cast<std::string>(), ""});
+    else if (py::isinstance<py::tuple>(item) && py::len(item) == 2)
+      out.push_back({item.cast<py::tuple>()[0].cast<std::string>(), item.cast<py::tuple>()[1].cast<std::string>()});
+    else throw py::value_error(fmt::format("{}: expected names, or (name, unit) pairs", what));
+  }
+  return out;
+}
+
+/// A Dynamics whose f (and optionally Jacobians) are the methods of a Python subclass. Every call
+/// takes the GIL, so a solve that runs without it (LongCall) still calls back safely.
+class PythonDynamics : public Dynamics {
+ public:
+  PythonDynamics(std::string name, std::vector<Quantity> states, std::vector<Quantity> controls)
+      : name_(std::move(name)), states_(std::move(states)), controls_(std::move(controls)) {
+    if (name_.empty()) throw py::value_error("Dynamics: the name is empty");
+    if (states_.empty() || controls_.empty()) throw py::value_error("Dynamics: needs at least one state and one control");
+  }
+  const std::string& name() const override { return name_; }
+  const std::vector<Quantity>& states() const override { return states_; }
+  const std::vector<Quantity>& controls() const override { return controls_; }
+
+  std::vector<Parameter> parameters() const override {
+    py::gil_scoped_acquire gil;
+    const py::function method = py::get_override(this, "parameters");
+    if (!method) return {};
+    std::vector<Parameter> out;
+    for (const auto& [key, value] : method().cast<py::dict>())
+      out.push_back({key.cast<std::string>(), "", value.cast<double>()});
+    return out;
+  }
+
+  /// f from the Python method f(x, u); Jacobians from jacobians(x, u) when the subclass defines it,
+  /// else central differences of f with the step 1e-6 (1 + |x_i|) per coordinate.
+  void evaluate(const VectorCRef& x, const VectorCRef& u, VectorRef xdot, DynamicsJacobians* jacobians) const override {
+    py::gil_scoped_acquire gil;
+    const py::function f = py::get_override(this, "f");
+    if (!f) throw py::type_error(fmt::format("Dynamics '{}': the subclass does not define f(x, u)", name_));
+    xdot = call_f(f, x, u);
+    if (jacobians == nullptr) return;
+    jacobians->resize(state_dim(), control_dim());
+    if (const py::function analytic = py::get_override(this, "jacobians")) {
+      const py::tuple pair = analytic(Vector(x), Vector(u)).cast<py::tuple>();
+      if (pair.size() != 2) throw py::value_error(fmt::format("Dynamics '{}': jacobians() must return (fx, fu)", name_));
+      jacobians->fx = checked(pair[0].cast<Matrix>(), state_dim(), state_dim(), "fx");
+      jacobians->fu = checked(pair[1].cast<Matrix>(), state_dim(), control_dim(), "fu");
+      return;
+    }
+    Vector z(x.size() + u.size());
+    z << x, u;
+    for (Eigen::Index j = 0; j < z.size(); ++j) {
+      const double h = 1e-6 * (1.0 + std::abs(z(j)));
+      Vector plus = z, minus = z;
+      plus(j) += h;
+      minus(j) -= h;
+      const Vector column = (call_f(f, plus.head(x.size()), plus.tail(u.size())) -
+                             call_f(f, minus.head(x.size()), minus.tail(u.size()))) / (2.0 * h);
+      if (j < x.size()) jacobians->fx.col(j) = column;
+      else jacobians->fu.col(j - x.size()) = column;
+    }
+  }
+
+ private:
+  Vector call_f(const py::function& f, const VectorCRef& x, const VectorCRef& u) const {
+    return checked(f(Vector(x), Vector(u)).cast<Vector>(), state_dim(), 1, "f(x, u)");
+  }
+  template <typename M>
+  M checked(M value, int rows, int cols, const char* what) const {
+    if (value.rows() != rows || value.cols() != cols)
+      throw py::value_error(fmt::format("Dynamics '{}': {} has shape ({}, {}); expected ({}, {})", name_, what,
+                                        value.rows(), value.cols(), rows, cols));
+    return value;
+  }
+  std::string name_;
+  std::vector<Quantity> states_, controls_;
+};
+
+/// A Python Dynamics object as a DynamicsPtr that keeps the Python object alive (and releases it
+/// with the GIL held).
+DynamicsPtr hold(py::object object) {
+  Dynamics* raw = object.cast<Dynamics*>();
+  return std::shared_ptr<const Dynamics>(raw, [object](const Dynamics*) mutable {
+    py::gil_scoped_acquire gil;
+    object = py::object();
+  });
+}
+
+ActuatorNoise noise_of(const py::object& noise) {
+  ActuatorNoise out;
+  if (noise.is_none()) return out;
+  const py::dict d = noise.cast<py::dict>();
+  for (const auto& [key, value] : d) {
+    const std::string k = key.cast<std::string>();
+    if (k == "actuator_additive") out.additive_std = value.cast<Vector>();
+    else if (k == "actuator_multiplicative") out.multiplicative_std = value.cast<Vector>();
+    else if (k == "state") out.state_std = value.cast<Vector>();
+    else throw py::value_error(fmt::format("noise: unknown key '{}'; expected actuator_additive, "
+                                           "actuator_multiplicative or state", k));
+  }
+  return out;
+}
+
+Preset preset_of(const std::string& preset) {
+  if (const auto p = parse_preset(preset)) return *p;
+  throw InputError(fmt::format("preset '{}': expected 'sim' or 'real'", preset));
+}
+
+}  // namespace
+
+DynamicsPtr system_from_python(const py::object& system) {
+  if (py::isinstance<py::str>(system)) return make_system(system.cast<std::string>());
+  return hold(system);  // keeps a Python subclass's Python part alive as long as the library holds it
+}
+
+void bind_systems(py::module_& m) {
+  py::class_<Dynamics, PythonDynamics, std::shared_ptr<Dynamics>>(m, "Dynamics", R"(
+Continuous-time controlled dynamics xdot = f(x, u) with named states and controls.
+
+Systems of the library come from gpilqg.system(name, ...). Subclass it to write dynamics in Python:
+
+    class Pendulum(gpilqg.Dynamics):
+        def __init__(self):
+            super().__init__("pendulum", states=[("theta", "rad"), ("theta_dot", "rad/s")],
+                             controls=[("tau", "N m")])
+        def f(self, x, u):                 # x: (n,), u: (m,) -> xdot: (n,)
+            return np.array([x[1], -9.81 * np.sin(x[0]) + u[0]])
+        def jacobians(self, x, u):         # optional: (fx (n, n), fu (n, m)); else central differences
+            ...
+
+and gpilqg.register_system(...) to use it by name in configs, solve, diagnose and plan.)")
+      .def(py::init([](std::string name, std::vector<py::object> states, std::vector<py::object> controls) {
+             return new PythonDynamics(std::move(name), quantities(states, "states"), quantities(controls, "controls"));
+           }),
+           py::arg("name"), py::arg("states"), py::arg("controls"),
+           "name: the registry name; states, controls: names or (name, unit) pairs, in order")
+      .def_property_readonly("name", &Dynamics::name)
+      .def_property_readonly("state_names", [](const Dynamics& d) { return names_of(d.states()); })
+      .def_property_readonly("control_names", [](const Dynamics& d) { return names_of(d.controls()); })
+      .def_property_readonly("state_units", [](const Dynamics& d) {
+        std::vector<std::string> units;
+        for (const auto& q : d.states()) units.push_back(q.unit);
+        return units;
+      })
+      .def_property_readonly("state_dim", &Dynamics::state_dim)
+      .def_property_readonly("control_dim", &Dynamics::control_dim)
+      .def_property_readonly("parameter_values", [](const Dynamics& d) {
+        std::map<std::string, double> out;
+        for (const Parameter& p : d.parameters()) out[p.name] = p.value;
+        return out;
+      }, "dict: the physical parameters and their values")
+      .def("xdot", [](const Dynamics& d, const Vector& x, const Vector& u) { return d.f(x, u); }, py::arg("x"),
+           py::arg("u"), "xdot = f(x, u), shape (n,)")
+      .def("derivatives", [](const Dynamics& d, const Vector& x, const Vector& u) {
+             Vector xdot(d.state_dim());
+             DynamicsJacobians j;
+             d.evaluate(x, u, xdot, &j);
+             return py::make_tuple(xdot, j.fx, j.fu);
+           }, py::arg("x"), py::arg("u"), "(xdot (n,), fx = df/dx (n, n), fu = df/du (n, m))");
+
+  m.def("system", [](const std::string& name, const std::string& preset, const std::map<std::string, double>& parameters,
+                     const py::object& noise) {
+          return std::const_pointer_cast<Dynamics>(make_system(name, preset_of(preset), parameters, noise_of(noise)));
+        },
+        py::arg("name"), py::arg("preset") = "sim", py::arg("parameters") = std::map<std::string, double>{},
+        py::arg("noise") = py::none(), R"(
+A system of the registry: "cartpole", "quadrotor", a MuJoCo model file (.xml, .urdf), a plugin's
+system or one registered from Python. preset: "sim" or "real"; parameters: overrides by name;
+noise: dict with actuator_additive (m,), actuator_multiplicative (m,), state (n,) standard deviations.)");
+
+  m.def("systems", [] { return SystemRegistry::instance().names(); }, "The registered system names.");
+
+  m.def("register_system", [](const std::string& name, const py::function& builder, const std::string& description) {
+          // The registry lives until the process ends, after the interpreter: it keeps the builder
+          // with a reference that is never released (a Python object must not be freed then).
+          PyObject* function = builder.inc_ref().ptr();
+          SystemEntry entry;
+          entry.name = name;
+          entry.description = description.empty() ? "defined in Python" : description;
+          entry.origin = "Python";
+          entry.build = [function](Preset preset, const std::map<std::string, double>& overrides,
+                                   const ActuatorNoise& noise) -> DynamicsPtr {
+            py::gil_scoped_acquire gil;
+            py::object made = py::reinterpret_borrow<py::function>(function)(std::string(to_string(preset)), overrides);
+            auto* dynamics = made.cast<Dynamics*>();
+            const_cast<Dynamics*>(dynamics)->set_noise_model(noise);
+            return hold(made);
+          };
+          complete_system_entry(entry);
+          SystemRegistry::instance().add(std::move(entry));
+        },
+        py::arg("name"), py::arg("builder"), py::arg("description") = "", R"(
+Registers a system by name so that configs, solve, diagnose, plan and run can use it.
+builder(preset: str, parameters: dict) -> a new gpilqg.Dynamics (a Python subclass, or any system);
+it must raise for a parameter name it does not know. A name can be registered once per process.)");
+
+  m.def("load_plugin", [](const std::string& path) { return load_plugin(path).systems; }, py::arg("path"),
+        "Loads a plugin (a shared library built against gpilqg) and returns the names of the systems it registered.");
+
+  py::class_<StepModel, std::shared_ptr<StepModel>>(m, "StepModel", R"(
+A discrete-time model x' = phi(x, u) of a system at step dt: the integrator of the library (explicit
+Euler or RK4 with sub-steps) or, for a MuJoCo model, MuJoCo's own.)")
+      .def(py::init([](const py::object& system, double dt, const std::string& integrator, int substeps) {
+             const auto parsed = parse_integrator(integrator);
+             if (!parsed) throw InputError(fmt::format("integrator '{}': expected 'euler' or 'rk4'", integrator));
+             return std::const_pointer_cast<StepModel>(make_step_model(system_from_python(system), *parsed, dt, substeps));
+           }),
+           py::arg("system"), py::arg("dt"), py::arg("integrator") = "rk4", py::arg("substeps") = 1,
+           "system: a gpilqg.Dynamics or a registry name")
+      .def_property_readonly("dt", &StepModel::dt)
+      .def_property_readonly("state_dim", &StepModel::state_dim)
+      .def_property_readonly("control_dim", &StepModel::control_dim)
+      .def("step", [](const StepModel& s, const Vector& x, const Vector& u) {
+             Vector next(s.state_dim());
+             {
+               py::gil_scoped_release release;  // Python dynamics take it back per call
+               s.step(x, u, next);
+             }
+             return next;
+           }, py::arg("x"), py::arg("u"), "x' = phi(x, u), shape (n,)")
+      .def("jacobians", [](const StepModel& s, const Vector& x, const Vector& u) {
+             Vector next(s.state_dim());
+             StepJacobians j;
+             j.resize(s.state_dim(), s.control_dim());
+             {
+               py::gil_scoped_release release;
+               s.step(x, u, next, &j);
+             }
+             return py::make_tuple(next, j.A, j.B);
+           }, py::arg("x"), py::arg("u"), "(x' (n,), A = dphi/dx (n, n), B = dphi/du (n, m))");
+}
 
 }  // namespace gpilqg::python

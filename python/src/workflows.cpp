@@ -1,7 +1,267 @@
+/// The library's workflows from Python, each the same code as its command: diagnose (`gpilqg
+/// diagnose --json`), solve (`gpilqg solve`), plan (`gpilqg plan`, with the Policy it returns), run
+/// (`gpilqg run`). Each runs without the GIL, reports progress to an optional Python callback, and
+/// stops on Ctrl-C within one iteration (LongCall).
+
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
+
+#include <fmt/format.h>
+
 #include "bindings.hpp"
+#include "conversions.hpp"
+#include "gpilqg/core/measurements.hpp"
+#include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
+#include "gpilqg/experiments/diagnosis/report.hpp"
+#include "gpilqg/experiments/planning.hpp"
+#include "gpilqg/experiments/run_config.hpp"
+#include "gpilqg/experiments/run_experiment.hpp"
+#include "gpilqg/experiments/run_results_io.hpp"
+#include "gpilqg/experiments/solve_config.hpp"
+#include "gpilqg/experiments/toml_fields.hpp"
 
 namespace gpilqg::python {
+namespace {
 
-void bind_workflows(py::module_& m) { (void)m; }
+/// A policy of `gpilqg plan` (DESIGN.md section 11) with the GP it was planned on.
+struct Policy {
+  PolicyFile file;
+  std::shared_ptr<const gp::ResidualModel> model;
+};
+
+/// Progress lines of a DDP solve, and Ctrl-C between its iterations.
+void watch_iterations(DdpOptions& options, LongCall& call) {
+  options.on_iteration = [&call](const DdpIteration& r) {
+    return call.checkpoint(fmt::format("iteration {}: cost {:.6g}{}", r.iteration, r.cost, r.accepted ? "" : " (rejected)"));
+  };
+}
+
+/// (T+1, n) from the library's n x (T+1): one row per time step, as in the files.
+Matrix rows(const Matrix& columns) { return columns.transpose(); }
+
+/// K as a (T, m, n) array.
+py::array_t<double> gains(const std::vector<Matrix>& K, Eigen::Index m, Eigen::Index n) {
+  py::array_t<double> out({static_cast<py::ssize_t>(K.size()), static_cast<py::ssize_t>(m), static_cast<py::ssize_t>(n)});
+  auto view = out.mutable_unchecked<3>();
+  for (std::size_t t = 0; t < K.size(); ++t)
+    for (Eigen::Index j = 0; j < m; ++j)
+      for (Eigen::Index i = 0; i < n; ++i) view(static_cast<py::ssize_t>(t), j, i) = K[t](j, i);
+  return out;
+}
+
+py::dict summary_dict(const DdpSummary& s) {
+  py::dict d;
+  d["termination"] = std::string(to_string(s.termination));
+  d["converged"] = converged(s.termination);
+  d["iterations"] = s.iterations;
+  d["initial_cost"] = s.initial_cost;
+  d["final_cost"] = s.final_cost;
+  d["gradient_norm"] = s.final_gradient_norm;
+  d["solve_time_s"] = s.timings.total_s;
+  return d;
+}
+
+/// A config given as a file path, or as TOML text (the package turns dicts into TOML text).
+struct ConfigSource {
+  std::optional<std::filesystem::path> file;
+  std::string text;
+};
+
+SolveConfig solve_config_of(const ConfigSource& source) {
+  if (source.file) return read_solve_config(*source.file);
+  const toml::table root = TomlFields::parse_text(source.text, "<config>");
+  return read_solve_config(TomlFields(root, "<config>"), {}, "ilqr");
+}
+
+PlanConfig plan_config_of(const ConfigSource& source) {
+  if (source.file) return read_plan_config(*source.file);
+  const toml::table root = TomlFields::parse_text(source.text, "<config>");
+  return read_plan_config(TomlFields(root, "<config>"));
+}
+
+py::dict solve(const ConfigSource& source, const py::object& progress) {
+  SolveConfig config = solve_config_of(source);
+  LongCall call(progress);
+  watch_iterations(config.solver, call);
+  const DdpResult r = call.run<DdpResult>([&] { return solve_config(config); });
+  py::dict out = summary_dict(r.summary);
+  out["cost"] = r.nominal_cost;
+  out["expected_cost"] = r.expected_cost;
+  out["algorithm"] = std::string(to_string(config.solver.variant));
+  out["x"] = rows(r.trajectory.x);
+  out["u"] = rows(r.trajectory.u);
+  Policy policy;
+  policy.file.policy = file_policy(r.policy);
+  policy.file.dt = config.dt;
+  policy.file.system = config.system;
+  const SystemSignature signature = system_signature(config.system);
+  policy.file.state_names = names_of(signature.states);
+  policy.file.control_names = names_of(signature.controls);
+  policy.file.predicted_cost = r.nominal_cost;
+  policy.file.expected_cost = r.expected_cost;
+  out["policy"] = py::cast(std::move(policy));
+  return out;
+}
+
+Policy plan(const ConfigSource& source, const std::vector<std::filesystem::path>& data,
+            const std::optional<std::filesystem::path>& previous, const std::optional<std::filesystem::path>& out,
+            std::uint64_t seed, const py::object& progress) {
+  PlanRequest request;
+  request.config = plan_config_of(source);
+  request.data_files = data;
+  request.previous = previous;
+  request.seed = seed;
+  LongCall call(progress);
+  watch_iterations(request.config.problem.solver, call);
+  PlannedPolicy planned = call.run<PlannedPolicy>([&] { return plan_policy(request); });
+  if (planned.summary.termination == DdpTermination::InitialRolloutDiverged)
+    throw std::runtime_error("the initial controls drive the model to non-finite states; no policy");
+  if (out) write_policy_file(*out, planned.file, planned.model.get());
+  return {std::move(planned.file), std::move(planned.model)};
+}
+
+std::string run(const std::string& system, const ConfigSource& source, int seeds, std::uint64_t first_seed,
+                std::optional<int> iterations, const std::vector<std::string>& backends, const std::filesystem::path& out,
+                const py::object& progress) {
+  RunConfig config = source.file ? load_run_config(system, *source.file)
+                                 : (source.text.empty() ? load_run_config(system, std::nullopt)
+                                                        : parse_run_config(system, source.text, "<config>"));
+  if (iterations) {
+    if (*iterations < 1) throw InputError(fmt::format("iterations {}: expected >= 1", *iterations));
+    config.iterations = *iterations;
+  }
+  if (seeds < 1) throw InputError(fmt::format("seeds {}: expected >= 1", seeds));
+  RunOptions options;
+  options.seeds.clear();
+  for (int s = 0; s < seeds; ++s) options.seeds.push_back(first_seed + static_cast<std::uint64_t>(s));
+  options.backends = backends;
+  LongCall call(progress);
+  options.progress = [&call](const std::string& line) { call.throwing_checkpoint(line); };
+  if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
+  call.run<int>([&] {
+    write_run_results(out, run_experiment(config, options));
+    return 0;
+  });
+  return out.string();
+}
+
+py::object diagnose(const py::object& system, const py::object& data, const std::string& model,
+                    const std::string& preset, const std::vector<std::string>& add, const std::string& integrator,
+                    double heldout, int gp_points, int gp_restarts, const std::string& backend, std::uint64_t seed) {
+  diagnosis::DiagnoseRequest request;
+  request.system = py::isinstance<py::str>(system) ? system.cast<std::string>() : system_from_python(system)->name();
+  request.model_file = model;
+  request.preset = preset;
+  request.add = add;
+  request.integrator = integrator;
+  request.heldout = heldout;
+  request.gp_points = gp_points;
+  request.gp_restarts = gp_restarts;
+  request.backend = backend;
+  request.seed = seed;
+  const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(request);
+  const MeasurementSet set = py::isinstance<MeasurementSet>(data)
+                                 ? data.cast<MeasurementSet>()
+                                 : read_measurements(data.cast<std::filesystem::path>(), system_signature(request.system));
+  LongCall call;
+  const nlohmann::json report = call.run<nlohmann::json>([&] {
+    try {
+      return diagnosis::report_json(diagnosis::diagnose(set, options));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(e.what());
+    }
+  });
+  return to_python(report);
+}
+
+ConfigSource source_of(const py::object& config) {
+  ConfigSource s;
+  if (config.is_none()) return s;
+  if (py::isinstance<py::str>(config) && config.cast<std::string>().find('\n') != std::string::npos) {
+    s.text = config.cast<std::string>();  // TOML text (what the package makes of a dict)
+    return s;
+  }
+  s.file = config.cast<std::filesystem::path>();
+  return s;
+}
+
+}  // namespace
+
+void bind_workflows(py::module_& m) {
+  py::class_<Policy>(m, "Policy", R"(
+An affine feedback policy (DESIGN.md section 11): u_t = clip(u_bar[t] + K[t] (x - x_bar[t]), u_min, u_max).
+Call it as policy(t, x). Arrays have one row per time step: x_bar (T+1, n), u_bar (T, m), K (T, m, n).)")
+      .def("__call__", [](const Policy& p, int t, const Vector& x) {
+             if (t < 0 || t >= p.file.policy.horizon())
+               throw py::index_error(fmt::format("t = {}: the policy has steps 0 to {}", t, p.file.policy.horizon() - 1));
+             if (x.size() != p.file.policy.x_bar.rows())
+               throw py::value_error(fmt::format("x has {} entries; expected {}", x.size(), p.file.policy.x_bar.rows()));
+             Vector u(p.file.policy.u_bar.rows());
+             p.file.policy.control(t, x, u);
+             return u;
+           }, py::arg("t"), py::arg("x"), "The control (m,) at step t for the measured state x (n,).")
+      .def_property_readonly("x_bar", [](const Policy& p) { return rows(p.file.policy.x_bar); })
+      .def_property_readonly("u_bar", [](const Policy& p) { return rows(p.file.policy.u_bar); })
+      .def_property_readonly("K", [](const Policy& p) {
+        return gains(p.file.policy.K, p.file.policy.u_bar.rows(), p.file.policy.x_bar.rows());
+      })
+      .def_property_readonly("u_min", [](const Policy& p) -> py::object {
+        return p.file.policy.u_min.size() ? py::cast(p.file.policy.u_min) : py::none();
+      })
+      .def_property_readonly("u_max", [](const Policy& p) -> py::object {
+        return p.file.policy.u_max.size() ? py::cast(p.file.policy.u_max) : py::none();
+      })
+      .def_property_readonly("horizon", [](const Policy& p) { return p.file.policy.horizon(); })
+      .def_property_readonly("dt", [](const Policy& p) { return p.file.dt; })
+      .def_property_readonly("system", [](const Policy& p) { return p.file.system; })
+      .def_property_readonly("state_names", [](const Policy& p) { return p.file.state_names; })
+      .def_property_readonly("control_names", [](const Policy& p) { return p.file.control_names; })
+      .def_property_readonly("round", [](const Policy& p) { return p.file.round; })
+      .def_property_readonly("predicted_cost", [](const Policy& p) { return p.file.predicted_cost; })
+      .def_property_readonly("expected_cost", [](const Policy& p) { return p.file.expected_cost; })
+      .def_property_readonly("data_files", [](const Policy& p) { return p.file.data_files; })
+      .def_property_readonly("has_model", [](const Policy& p) { return p.model != nullptr; },
+                             "whether the policy was planned on a fitted residual GP")
+      .def("write", [](const Policy& p, const std::filesystem::path& file) {
+             write_policy_file(file, p.file, p.model.get());
+           }, py::arg("file"), "Writes the policy file (HDF5, atomically), with /model when there is one.");
+
+  m.def("read_policy", [](const std::filesystem::path& file) { return Policy{read_policy_file(file), nullptr}; },
+        py::arg("file"), "Reads a policy file of `gpilqg plan` (its /model is not loaded).");
+
+  m.def("_solve", [](const py::object& config, const py::object& progress) { return solve(source_of(config), progress); },
+        py::arg("config"), py::arg("progress") = py::none());
+  m.def("_plan",
+        [](const py::object& config, const std::vector<std::filesystem::path>& data,
+           const std::optional<std::filesystem::path>& previous, const std::optional<std::filesystem::path>& out,
+           std::uint64_t seed, const py::object& progress) {
+          return plan(source_of(config), data, previous, out, seed, progress);
+        },
+        py::arg("config"), py::arg("data"), py::arg("previous"), py::arg("out"), py::arg("seed"), py::arg("progress"));
+  m.def("_run",
+        [](const std::string& system, const py::object& config, int seeds, std::uint64_t first_seed,
+           std::optional<int> iterations, const std::vector<std::string>& backends, const std::filesystem::path& out,
+           const py::object& progress) {
+          return run(system, source_of(config), seeds, first_seed, iterations, backends, out, progress);
+        },
+        py::arg("system"), py::arg("config"), py::arg("seeds"), py::arg("first_seed"), py::arg("iterations"),
+        py::arg("backends"), py::arg("out"), py::arg("progress"));
+  const diagnosis::DiagnoseRequest defaults;
+  m.def("diagnose", &diagnose, py::arg("system"), py::arg("data"), py::arg("model") = "",
+        py::arg("preset") = defaults.preset, py::arg("add") = std::vector<std::string>{},
+        py::arg("integrator") = defaults.integrator, py::arg("heldout") = defaults.heldout,
+        py::arg("gp_points") = defaults.gp_points, py::arg("gp_restarts") = defaults.gp_restarts,
+        py::arg("backend") = defaults.backend, py::arg("seed") = defaults.seed, R"(
+Compares the model with the measurements and names the missing physical effect: the same dict as
+`gpilqg diagnose --json` (DESIGN.md section 6), with the same options (model: a model file; add:
+["EFFECT", "EFFECT=VALUE", ...]). system: a registry name or gpilqg.Dynamics registered by name;
+data: a MeasurementSet or a file.)");
+}
 
 }  // namespace gpilqg::python

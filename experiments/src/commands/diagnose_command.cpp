@@ -20,6 +20,7 @@
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
 #include "gpilqg/experiments/diagnosis/diagnosis.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
@@ -35,21 +36,12 @@ namespace {
 constexpr const char* kPlotScript = "diagnose_plots.py";
 
 struct DiagnoseOptions {
-  std::string system;
+  diagnosis::DiagnoseRequest request;  ///< system, model, preset, add, integrator, heldout, GP settings, seed
   std::string data;
-  std::string model;
-  std::string preset = "sim";
-  std::vector<std::string> add;
   bool json = false;
   std::string out;
   std::string plots;
   std::string write_model;
-  std::string integrator = "rk4";
-  double heldout = 0.3;
-  int gp_points = 300;
-  int gp_restarts = 1;
-  std::string backend = "exact";
-  std::uint64_t seed = 1;
 };
 
 /// Checks, before any work, that plots can be drawn (exit 2 with the missing packages otherwise).
@@ -69,40 +61,11 @@ std::string plugin_option(const std::string& system) {
   return origin == "built-in" ? "" : " --plugin " + origin;
 }
 
-diagnosis::DiagnosisOptions make_options(const DiagnoseOptions& o) {
-  diagnosis::DiagnosisOptions d;
-  if (!o.model.empty()) {
-    d.model = diagnosis::read_model_file(o.model, o.system);
-  } else {
-    const auto preset = parse_preset(o.preset);
-    if (!preset) throw InputError("--preset '" + o.preset + "': expected 'sim' or 'real'");
-    d.model.system = o.system;
-    d.model.preset = *preset;
-  }
-  for (const std::string& text : o.add) d.add.push_back(diagnosis::parse_add_option(text, o.system));
-  const auto integrator = parse_integrator(o.integrator);
-  if (!integrator) throw InputError("--integrator '" + o.integrator + "': expected 'rk4' or 'euler'");
-  d.integrator = *integrator;
-  if (!(o.heldout > 0.0 && o.heldout < 1.0))
-    throw InputError(fmt::format("--heldout {}: expected a fraction of the episodes in (0, 1)", o.heldout));
-  if (o.gp_points < 10) throw InputError(fmt::format("--gp-points {}: expected at least 10", o.gp_points));
-  if (o.gp_restarts < 0) throw InputError(fmt::format("--gp-restarts {}: expected >= 0", o.gp_restarts));
-  try {
-    gp::make_backend(o.backend);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(std::string("--backend: ") + e.what());
-  }
-  d.heldout_fraction = o.heldout;
-  d.gp.points = o.gp_points;
-  d.gp.restarts = o.gp_restarts;
-  d.gp.backend = o.backend;
-  d.gp.seed = o.seed;
-  return d;
-}
-
-int run_diagnose(const DiagnoseOptions& o) {
-  const SystemSignature signature = system_signature(o.system);
-  const diagnosis::DiagnosisOptions options = make_options(o);
+int run_diagnose(const DiagnoseOptions& options_given) {
+  const DiagnoseOptions& o = options_given;
+  const diagnosis::DiagnoseRequest& r = o.request;
+  const SystemSignature signature = system_signature(r.system);
+  const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(r);
   if (!o.plots.empty()) check_plotting();
   const MeasurementSet data = read_measurements(o.data, signature);
   diagnosis::DiagnosisReport report;
@@ -119,8 +82,8 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (!o.write_model.empty())
     diagnosis::write_model_file(o.write_model, report.model_next,
                                 {fmt::format("written by gpilqg diagnose from {} (verdict: {})", o.data, report.verdict.status),
-                                 fmt::format("next: gpilqg diagnose{} --system {} --data {} --model {}", plugin_option(o.system),
-                                             o.system, o.data, o.write_model)});
+                                 fmt::format("next: gpilqg diagnose{} --system {} --data {} --model {}", plugin_option(r.system),
+                                             r.system, o.data, o.write_model)});
   if (!o.plots.empty()) {
     // The script's own line goes to stdout; with --json, stdout holds the JSON document only.
     std::cout.flush();
@@ -147,9 +110,9 @@ int run_diagnose(const DiagnoseOptions& o) {
   if (!h5.empty()) std::cout << "report: " << h5.string() << '\n';
   if (!o.plots.empty()) std::cout << "plots: " << o.plots << '\n';
   if (!o.write_model.empty()) std::cout << "model for the next round: " << o.write_model << '\n';
-  if (report.verdict.effect && o.add.empty())
-    std::cout << fmt::format("next: gpilqg diagnose{} --system {} --data {}{} --add {}\n", plugin_option(o.system),
-                             o.system, o.data, o.model.empty() ? "" : " --model " + o.model,
+  if (report.verdict.effect && r.add.empty())
+    std::cout << fmt::format("next: gpilqg diagnose{} --system {} --data {}{} --add {}\n", plugin_option(r.system),
+                             r.system, o.data, r.model_file.empty() ? "" : " --model " + r.model_file,
                              report.verdict.effect->effect);
   return kExitSuccess;
 }
@@ -161,21 +124,22 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   auto* cmd = app.add_subcommand("diagnose",
                                  "Compare a model with measurements, see where it fails, learn which physical effect is "
                                  "missing, add it and watch the error fall");
-  cmd->add_option("--system", o->system, kSystemHelp)->required();
+  diagnosis::DiagnoseRequest& r = o->request;
+  cmd->add_option("--system", r.system, kSystemHelp)->required();
   cmd->add_option("--data", o->data, "Measurement file (.csv, .h5)")->required();
-  cmd->add_option("--model", o->model, "Model file (TOML): preset, recalibrated parameters, effects");
-  cmd->add_option("--preset", o->preset, "Preset without --model: sim or real")->capture_default_str();
-  cmd->add_option("--add", o->add, "Add a library effect, EFFECT or EFFECT=VALUE (fitted without a value; repeatable)");
+  cmd->add_option("--model", r.model_file, "Model file (TOML): preset, recalibrated parameters, effects");
+  cmd->add_option("--preset", r.preset, "Preset without --model: sim or real")->capture_default_str();
+  cmd->add_option("--add", r.add, "Add a library effect, EFFECT or EFFECT=VALUE (fitted without a value; repeatable)");
   cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the report");
   cmd->add_option("--out", o->out, "Write the HDF5 report here");
   cmd->add_option("--plots", o->plots, "Write PNG plots into this folder (needs matplotlib and h5py)");
   cmd->add_option("--write-model", o->write_model, "Write the improved model (TOML) for the next diagnosis");
-  cmd->add_option("--integrator", o->integrator, "rk4 or euler")->capture_default_str();
-  cmd->add_option("--heldout", o->heldout, "Fraction of the episodes held out")->capture_default_str();
-  cmd->add_option("--gp-points", o->gp_points, "GP training points per state")->capture_default_str();
-  cmd->add_option("--gp-restarts", o->gp_restarts, "Random restarts of the GP fit")->capture_default_str();
-  cmd->add_option("--backend", o->backend, "GP backend (exact, fitc, ssgp)")->capture_default_str();
-  cmd->add_option("--seed", o->seed, "Seed of the GP subsample and restarts")->capture_default_str();
+  cmd->add_option("--integrator", r.integrator, "rk4 or euler")->capture_default_str();
+  cmd->add_option("--heldout", r.heldout, "Fraction of the episodes held out")->capture_default_str();
+  cmd->add_option("--gp-points", r.gp_points, "GP training points per state")->capture_default_str();
+  cmd->add_option("--gp-restarts", r.gp_restarts, "Random restarts of the GP fit")->capture_default_str();
+  cmd->add_option("--backend", r.backend, "GP backend (exact, fitc, ssgp)")->capture_default_str();
+  cmd->add_option("--seed", r.seed, "Seed of the GP subsample and restarts")->capture_default_str();
   cmd->callback([&action, o] { action = [o] { return run_diagnose(*o); }; });
 }
 

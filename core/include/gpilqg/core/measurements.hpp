@@ -97,6 +97,11 @@ void write_measurements_hdf5(const std::filesystem::path& file, const Measuremen
 /// Chooses the writer by extension like read_measurements.
 void write_measurements(const std::filesystem::path& file, const MeasurementSet& set);
 
+/// Checks a set built in memory as the writers do before writing: shapes against its system, finite
+/// values, distinct non-negative episode ids, times increasing at a constant step. Throws
+/// std::invalid_argument naming the episode and the sample.
+void check_measurement_set(const MeasurementSet& set);
+
 /// Range of one column over all episodes.
 struct ColumnSummary {
   std::string name;

@@ -14,6 +14,8 @@
 
 namespace gpilqg {
 
+class TomlFields;
+
 struct PlanConfig {
   SolveConfig problem;  ///< the simulator (the GP's mean function), its noise F, the task and the solver
   GpSettings gp;
@@ -21,5 +23,7 @@ struct PlanConfig {
 
 /// Reads and validates a plan config; throws InputError naming the file, line and field.
 PlanConfig read_plan_config(const std::filesystem::path& file);
+/// The same from a parsed config (e.g. TOML text); errors name the reader's source.
+PlanConfig read_plan_config(const TomlFields& fields);
 
 }  // namespace gpilqg

@@ -1,0 +1,31 @@
+#pragma once
+/// @file diagnose_request.hpp
+/// What `gpilqg diagnose` is asked, in the terms of its options: the command line and the Python
+/// package fill the same request, so both have the same defaults and the same error messages.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gpilqg/experiments/diagnosis/diagnosis.hpp"
+
+namespace gpilqg::diagnosis {
+
+struct DiagnoseRequest {
+  std::string system;
+  std::string model_file;        ///< a model file (TOML); empty: `preset`
+  std::string preset = "sim";
+  std::vector<std::string> add;  ///< EFFECT or EFFECT=VALUE
+  std::string integrator = "rk4";
+  double heldout = 0.3;          ///< fraction of the episodes held out
+  int gp_points = 300;           ///< GP training points per state
+  int gp_restarts = 1;
+  std::string backend = "exact";
+  std::uint64_t seed = 1;
+};
+
+/// The diagnosis options of a request. Throws InputError naming the option (`--preset`, `--add`,
+/// `--integrator`, `--heldout`, `--gp-points`, `--gp-restarts`, `--backend`) or the model file.
+DiagnosisOptions diagnosis_options(const DiagnoseRequest& request);
+
+}  // namespace gpilqg::diagnosis

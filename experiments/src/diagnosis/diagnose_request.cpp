@@ -1,0 +1,44 @@
+#include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
+
+#include <fmt/format.h>
+
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
+#include "gpilqg/gp/backend_registry.hpp"
+
+namespace gpilqg::diagnosis {
+
+DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
+  DiagnosisOptions d;
+  if (!o.model_file.empty()) {
+    d.model = read_model_file(o.model_file, o.system);
+  } else {
+    const auto preset = parse_preset(o.preset);
+    if (!preset) throw InputError("--preset '" + o.preset + "': expected 'sim' or 'real'");
+    d.model.system = o.system;
+    d.model.preset = *preset;
+  }
+  for (const std::string& text : o.add) d.add.push_back(parse_add_option(text, o.system));
+  const auto integrator = parse_integrator(o.integrator);
+  if (!integrator) throw InputError("--integrator '" + o.integrator + "': expected 'rk4' or 'euler'");
+  d.integrator = *integrator;
+  if (!(o.heldout > 0.0 && o.heldout < 1.0))
+    throw InputError(fmt::format("--heldout {}: expected a fraction of the episodes in (0, 1)", o.heldout));
+  if (o.gp_points < 10) throw InputError(fmt::format("--gp-points {}: expected at least 10", o.gp_points));
+  if (o.gp_restarts < 0) throw InputError(fmt::format("--gp-restarts {}: expected >= 0", o.gp_restarts));
+  try {
+    gp::make_backend(o.backend);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("--backend: ") + e.what());
+  }
+  d.heldout_fraction = o.heldout;
+  d.gp.points = o.gp_points;
+  d.gp.restarts = o.gp_restarts;
+  d.gp.backend = o.backend;
+  d.gp.seed = o.seed;
+  return d;
+}
+
+}  // namespace gpilqg::diagnosis
