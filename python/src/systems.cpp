@@ -10,6 +10,7 @@
 
 #include "bindings.hpp"
 #include "conversions.hpp"
+#include "gpilqg/core/effect_builders.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/plugin.hpp"
 #include "gpilqg/core/system_registry.hpp"
@@ -209,10 +210,15 @@ noise: dict with actuator_additive (m,), actuator_multiplicative (m,), state (n,
             return hold(made);
           };
           complete_system_entry(entry);
+          // What diagnosis can fit on any system: its parameters recalibrated, and the actuator gain.
+          for (const Parameter& parameter : entry.parameters)
+            entry.effects.push_back(recalibration_entry("param:" + parameter.name, parameter, false, false));
+          entry.effects.push_back(actuator_gain_entry());
           SystemRegistry::instance().add(std::move(entry));
         },
         py::arg("name"), py::arg("builder"), py::arg("description") = "", R"(
-Registers a system by name so that configs, solve, diagnose, plan and run can use it.
+Registers a system by name so that configs, solve, diagnose, plan and run can use it. Diagnosis can
+fit its parameters (effects "param:<name>", from parameters()) and an actuator gain.
 builder(preset: str, parameters: dict) -> a new gpilqg.Dynamics (a Python subclass, or any system);
 it must raise for a parameter name it does not know. A name can be registered once per process.)");
 

@@ -1,0 +1,187 @@
+"""diagnose, solve, plan and run from Python are the commands' own code: the same numbers as the
+command line, progress lines, Ctrl-C within one iteration, and Python-defined systems in them."""
+
+import _thread
+import json
+import threading
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+import gpilqg
+from conftest import SOURCE_DIR, cli
+
+PLAN = {
+    "system": {"name": "cartpole", "preset": "sim", "integrator": "rk4", "substeps": 10, "dt": 0.05},
+    "noise": {"actuator_multiplicative": [0.02]},
+    "problem": {"horizon": 15, "x0": [0.0, 0.0, 0.3, 0.0], "goal": [0.0, 0.0, 0.0, 0.0],
+                "Q": [1.0, 1.0, 1.0, 1.0], "R": [0.1], "Qf": [10.0, 10.0, 10.0, 10.0],
+                "u_min": [-25.0], "u_max": [25.0]},
+    "solver": {"max_iterations": 30},
+    "gp": {"exact_points": 40, "restarts": 0, "max_evaluations": 40},
+}
+
+
+def write_toml(path, config):
+    from gpilqg._config import to_toml
+    path.write_text(to_toml(config))
+    return path
+
+
+def test_solve_equals_the_command_line(tmp_path):
+    config = {k: PLAN[k] for k in ("system", "noise", "problem")}
+    config["solver"] = {"algorithm": "ilqg", "max_iterations": 100}
+    status, out, err = cli("solve", write_toml(tmp_path / "solve.toml", config), "--json")
+    assert status == 0, err
+    expected = json.loads(out)
+    r = gpilqg.solve(config)
+    assert r["cost"] == expected["cost"]
+    assert r["iterations"] == expected["iterations"]
+    assert r["termination"] == expected["termination"]
+    np.testing.assert_array_equal(r["u"], np.array(expected["u"]))
+    assert r["x"].shape == (16, 4) and r["u"].shape == (15, 1)
+    p = r["policy"]
+    assert p.K.shape == (15, 1, 4) and p.x_bar.shape == (16, 4)
+    assert p(0, r["x"][0]) == pytest.approx(r["u"][0], abs=1e-12)
+
+
+def test_solve_reports_progress_and_a_raising_callback_stops_it():
+    lines = []
+    gpilqg.solve({**PLAN, "solver": {"algorithm": "ilqg"}, "gp": None} if False else
+                 {k: PLAN[k] for k in ("system", "noise", "problem")}, progress=lines.append)
+    assert lines and lines[0].startswith("iteration 1: cost")
+
+    def stop(line):
+        if line.startswith("iteration 3"):
+            raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        gpilqg.solve({k: PLAN[k] for k in ("system", "noise", "problem")}, progress=stop)
+
+
+def test_plan_equals_the_command_line_and_its_policy_acts(tmp_path):
+    config = write_toml(tmp_path / "plan.toml", PLAN)
+    assert cli("plan", config, "--out", tmp_path / "p0.h5")[0] == 0
+    status, _, err = cli("rollout", "--system", "cartpole", "--policy", tmp_path / "p0.h5", "--episodes", "2",
+                         "--exploration", "2", "--observation-noise", "0.001", "--out", tmp_path / "d0.h5")
+    assert status == 0, err
+    status, _, err = cli("plan", config, "--data", tmp_path / "d0.h5", "--previous", tmp_path / "p0.h5",
+                         "--seed", "3", "--out", tmp_path / "p1_cli.h5")
+    assert status == 0, err
+    policy = gpilqg.plan(PLAN, data=[tmp_path / "d0.h5"], previous=tmp_path / "p0.h5", seed=3,
+                         out=tmp_path / "p1_python.h5")
+    assert policy.round == 1 and policy.has_model
+    with h5py.File(tmp_path / "p1_cli.h5") as a, h5py.File(tmp_path / "p1_python.h5") as b:
+        for name in ("x_bar", "u_bar", "K"):
+            np.testing.assert_array_equal(a["policy"][name][()], b["policy"][name][()])
+        np.testing.assert_array_equal(a["policy"]["K"][()], policy.K)
+        assert "model" in b
+    rng = np.random.default_rng(1)
+    for _ in range(100):
+        t = int(rng.integers(0, 15))
+        x = policy.x_bar[t] + rng.normal(size=4)
+        u = np.clip(policy.u_bar[t] + policy.K[t] @ (x - policy.x_bar[t]), policy.u_min, policy.u_max)
+        np.testing.assert_allclose(policy(t, x), u, rtol=1e-12, atol=1e-12)
+    with pytest.raises(IndexError):
+        policy(15, np.zeros(4))
+
+
+def test_plan_errors_are_input_errors_with_the_commands_messages(tmp_path):
+    with pytest.raises(gpilqg.InputError, match="solver.algorithm"):
+        gpilqg.plan({**PLAN, "solver": {"algorithm": "ilqr"}})
+    with pytest.raises(gpilqg.InputError, match="gp.points"):
+        gpilqg.plan({**PLAN, "gp": {"points": 3}})
+
+
+RUN = {
+    "noise": {"actuator_multiplicative": [0.02], "observation": [0.001] * 4},
+    "loop": {"iterations": 2, "rollouts": 1, "exploration": [2.0], "policy_tolerance": 0.0, "evaluation_rollouts": 1},
+    "gp": {"exact_points": 40, "restarts": 0, "max_evaluations": 40},
+    "solver": {"max_iterations": 30},
+    "pddp": {"enabled": False},
+    "tasks": [{"name": "first", "x0": [0.0, 0.0, 0.3, 0.0], "goal": [0.0, 0.0, 0.0, 0.0], "horizon": 15,
+               "Q": [1.0] * 4, "R": [0.1], "Qf": [10.0] * 4, "track_line": False, "transfer": False}],
+}
+
+
+def test_run_writes_the_commands_result_file(tmp_path):
+    status, _, err = cli("run", "cartpole", "--config", write_toml(tmp_path / "run.toml", RUN), "--seeds", "1",
+                         "--out", tmp_path / "cli.h5", "--no-plots")
+    assert status == 0, err
+    lines = []
+    path = gpilqg.run("cartpole", RUN, out=tmp_path / "python.h5", progress=lines.append)
+    assert path == str(tmp_path / "python.h5")
+    assert any("gp_ilqg iteration 2/2" in line for line in lines)
+    with h5py.File(tmp_path / "cli.h5") as a, h5py.File(path) as b:
+        for k in range(3):
+            np.testing.assert_array_equal(a["first/gp_ilqg/iter_%d/u" % k][()], b["first/gp_ilqg/iter_%d/u" % k][()])
+        np.testing.assert_array_equal(a["first/gp_ilqg/cost"][()], b["first/gp_ilqg/cost"][()])
+
+
+def interrupt_after(seconds):
+    """Ctrl-C in `seconds`, as the terminal would send it; returns the time it was sent at."""
+    sent = {}
+
+    def fire():
+        sent["at"] = time.monotonic()
+        _thread.interrupt_main()
+
+    threading.Timer(seconds, fire).start()
+    return sent
+
+
+def test_ctrl_c_stops_a_run_within_one_iteration(tmp_path):
+    lines = []
+    long_run = {**RUN, "loop": {**RUN["loop"], "iterations": 40}}
+    started = time.monotonic()
+    sent = interrupt_after(1.0)
+    with pytest.raises(KeyboardInterrupt):
+        gpilqg.run("cartpole", long_run, out=tmp_path / "stopped.h5", progress=lines.append)
+    stopped = time.monotonic()
+    # The slowest iteration seen before the stop bounds how long the stop may take.
+    iterations = max(1, len(lines))
+    per_iteration = (sent["at"] - started) / iterations
+    assert stopped - sent["at"] <= max(2.0 * per_iteration, 0.5), (stopped - sent["at"], per_iteration)
+    assert not (tmp_path / "stopped.h5").exists()
+
+
+def test_ctrl_c_stops_a_solve_between_iterations(python_cartpole):
+    config = {"system": {"name": python_cartpole, "preset": "sim", "integrator": "rk4", "substeps": 10, "dt": 0.05},
+              "problem": {"horizon": 60, "x0": [0.0, 0.0, 0.0, 0.0], "goal": [0.0, 0.0, np.pi, 0.0],
+                          "Q": [0.0] * 4, "R": [0.1], "Qf": [100.0, 100.0, 1000.0, 100.0]},
+              "solver": {"algorithm": "ilqr", "max_iterations": 100000, "tolerance": 0.0, "gradient_tolerance": 0.0}}
+    lines = []
+    sent = interrupt_after(1.0)
+    with pytest.raises(KeyboardInterrupt):
+        gpilqg.solve(config, progress=lines.append)
+    assert time.monotonic() - sent["at"] < 5.0
+    assert lines, "no iteration finished before the interrupt"
+
+
+def test_diagnose_equals_the_command_lines_json():
+    data = SOURCE_DIR / "data" / "cartpole_hidden_friction.csv"
+    status, out, err = cli("diagnose", "--system", "cartpole", "--data", data, "--json")
+    assert status == 0, err
+    expected = json.loads(out)
+    report = gpilqg.diagnose("cartpole", data)
+    assert report["verdict"] == expected["verdict"]
+    assert set(report) == set(expected)
+    from_set = gpilqg.diagnose("cartpole", gpilqg.read_measurements(data, "cartpole"), add=["cart_coulomb_friction"])
+    assert from_set["verdict"]["status"] in ("consistent", "explained", "unexplained")
+    with pytest.raises(gpilqg.InputError, match="--heldout"):
+        gpilqg.diagnose("cartpole", data, heldout=1.5)
+
+
+def test_diagnose_a_python_system_finds_its_missing_parameter(tmp_path, python_cartpole):
+    # Data of the C++ cart-pole's real preset (pole 1.3 m); the Python cart-pole's sim preset has 1 m.
+    status, _, err = cli("simulate", "--system", "cartpole", "--preset", "real", "--episodes", "6", "--steps", "150",
+                         "--actuator-noise", "0.05", "--seed", "3", "--out", tmp_path / "real.csv")
+    assert status == 0, err
+    python = gpilqg.diagnose(python_cartpole, tmp_path / "real.csv")
+    cpp = gpilqg.diagnose("cartpole", tmp_path / "real.csv")
+    assert python["verdict"]["effect"] == "param:pole_length" == cpp["verdict"]["effect"]
+    assert python["verdict"]["parameters"]["pole_length"] == pytest.approx(1.3, rel=0.02)
+    assert python["verdict"]["parameters"]["pole_length"] == pytest.approx(
+        cpp["verdict"]["parameters"]["pole_length"], rel=1e-6)
