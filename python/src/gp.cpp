@@ -226,7 +226,7 @@ Raises ValueError (the library's message) for an unknown backend or a bad settin
 
   cls.def(
       "fit",
-      [](py::object self_object, const py::handle& X, const py::handle& y, const py::object& theta) {
+      [](py::object self_object, const py::object& X, const py::object& y, const py::object& theta) {
         return fit(self_object.cast<GaussianProcess&>(), self_object, X, y, theta);
       },
       py::arg("X"), py::arg("y"), py::arg("theta") = py::none(), R"doc(
@@ -243,7 +243,9 @@ theta : array of shape (P,), optional
     [log l (D); log sf; log sn; extras]: FITC's pseudo-inputs (M, D) or SSGP's spectral points
     (m, D), flattened column-major (``Z.ravel(order="F")``); their number is read from P.
 
-Returns self. The GIL is released during the fit. Raises ValueError (the library's message) for
+The model is conditioned on the points the backend selects (exact: a uniform subsample of
+``exact_points`` drawn with ``seed``; ``X_train_`` shows them). Returns self. The GIL is released
+during the fit (Ctrl-C takes effect when it returns). Raises ValueError (the library's message) for
 degenerate data (non-finite entries, constant targets, N < D) or a wrongly sized theta,
 gpilqg.InputError for wrong shapes, RuntimeError when the covariance cannot be factorised even with
 jitter.
@@ -251,7 +253,7 @@ jitter.
 
   cls.def(
       "predict",
-      [](const GaussianProcess& self, const py::handle& X, bool return_std, bool return_grad) {
+      [](const GaussianProcess& self, const py::object& X, bool return_std, bool return_grad) {
         return predict(self, X, return_std, return_grad);
       },
       py::arg("X"), py::arg("return_std") = false, py::arg("return_grad") = false, R"doc(
@@ -260,7 +262,7 @@ Latent predictive mean, and optionally standard deviation and input gradients.
 Parameters
 ----------
 X : array of shape (N, D)
-    Test inputs, one per row.
+    Test inputs, one per row (read in place when Fortran-ordered float64, else converted once).
 return_std : bool
     Also return the latent standard deviation (without the observation noise).
 return_grad : bool
