@@ -12,7 +12,8 @@ namespace py = pybind11;
 
 void bind_systems(py::module_& m);    ///< systems.cpp: systems, step models, Python-defined dynamics, plugins
 void bind_data(py::module_& m);       ///< data.cpp: measurement sets
-void bind_gp(py::module_& m);         ///< gp.cpp: the GP backends as estimators, the residual model
+void bind_gp(py::module_& m);         ///< gp.cpp: the GP backends as estimators
+void bind_residual_model(py::module_& m);  ///< residual_model.cpp: simulator + GP residual
 void bind_workflows(py::module_& m);  ///< workflows.cpp: diagnose, solve, plan, run, policies
 
 }  // namespace gpilqg::python

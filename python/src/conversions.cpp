@@ -24,12 +24,13 @@ bool LongCall::checkpoint(const std::string& line) {
   py::gil_scoped_acquire acquire;
   try {
     if (!progress_.is_none() && !line.empty()) progress_(line);
-  } catch (py::error_already_set& e) {
-    e.restore();  // the callback's exception is the call's result
+  } catch (py::error_already_set& e) {  // the callback's exception is the call's result
+    pending_ = std::make_shared<py::error_already_set>(std::move(e));
     interrupted_ = true;
     return false;
   }
   if (PyErr_CheckSignals() != 0) {  // a signal handler raised (KeyboardInterrupt after Ctrl-C)
+    pending_ = std::make_shared<py::error_already_set>();
     interrupted_ = true;
     return false;
   }
@@ -41,7 +42,7 @@ void LongCall::throwing_checkpoint(const std::string& line) {
 }
 
 void LongCall::raise_if_interrupted() {
-  if (interrupted_ && PyErr_Occurred() != nullptr) throw py::error_already_set();
+  if (pending_) throw py::error_already_set(*pending_);
 }
 
 }  // namespace gpilqg::python

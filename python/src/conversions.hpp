@@ -5,6 +5,7 @@
 /// callback and stop on Ctrl-C.
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -65,7 +66,10 @@ class LongCall {
   /// With the GIL held: throws py::error_already_set for the exception a checkpoint left pending.
   void raise_if_interrupted();
   py::object progress_;
-  bool interrupted_ = false;  ///< a checkpoint left a Python exception set (the thread's error indicator)
+  bool interrupted_ = false;
+  /// The exception that stopped the call, taken out of Python's error indicator so that the library
+  /// may still call into Python (a Python system) while it winds down; raised when the call returns.
+  std::shared_ptr<py::error_already_set> pending_;
 };
 
 }  // namespace gpilqg::python

@@ -14,5 +14,6 @@ PYBIND11_MODULE(_gpilqg, m) {
   gp::bind_systems(m);
   gp::bind_data(m);
   gp::bind_gp(m);
+  gp::bind_residual_model(m);
   gp::bind_workflows(m);
 }
