@@ -16,24 +16,30 @@ packages=(
   cmake make g++ pkg-config
   libeigen3-dev libsuitesparse-dev libnlopt-cxx-dev libhdf5-dev libbenchmark-dev libgtest-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev python3-h5py python3-matplotlib
-  libmujoco-dev libmatio-dev
+  libmujoco-dev
+  pybind11-dev python3-pybind11 python3-pytest python3-sklearn python3-pandas libmatio-dev
 )
+sudo_cmd=""
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if ((${#missing[@]})); then
   echo "== installing: ${missing[*]}"
-  sudo=""
-  if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
 jobs="$(nproc)"
 echo "== configuring and building (build/, Release, $jobs jobs)"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DGPILQG_BUILD_TESTS=ON -DGPILQG_BUILD_BENCH=ON
 cmake --build build -j"$jobs"
+
+# The Python package (and the program and libraries) into /usr/local, where Debian's /usr/bin/python3
+# finds `import gpilqg` (docs/python.md).
+echo "== installing into /usr/local (the gpilqg program, libraries and Python package)"
+$sudo_cmd cmake --install build > /dev/null
 
 if [ "$mode" = run ]; then
   exec bash scripts/main_job.sh build/experiments/gpilqg

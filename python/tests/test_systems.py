@@ -116,3 +116,24 @@ def test_a_registered_python_system_solves_like_the_cpp_one(python_cartpole):
 def test_register_system_refuses_a_second_registration(python_cartpole):
     with pytest.raises(ValueError, match="python_cartpole"):
         gpilqg.register_system(python_cartpole, lambda preset, parameters: PythonCartPole())
+
+
+def test_a_plugins_systems_are_systems_of_the_package():
+    import os
+    plugin = os.environ.get("GPILQG_ACROBOT_PLUGIN")
+    if not plugin:
+        pytest.skip("GPILQG_ACROBOT_PLUGIN is set by ctest (the example plugin built with the tests)")
+    if "acrobot" not in gpilqg.systems():
+        assert gpilqg.load_plugin(plugin) == ["acrobot"]
+    acrobot = gpilqg.system("acrobot")
+    assert acrobot.state_dim == 4 and acrobot.control_dim == 1
+    assert acrobot.xdot(np.zeros(4), np.zeros(1)).shape == (4,)
+
+
+def test_a_mujoco_model_file_is_a_system():
+    from conftest import SOURCE_DIR
+    arm = gpilqg.system(str(SOURCE_DIR / "data" / "two_link_arm.xml"))
+    assert arm.state_names == ["shoulder", "elbow", "shoulder_dot", "elbow_dot"]
+    step = gpilqg.StepModel(arm, dt=0.05)
+    x_next, A, B = step.jacobians(np.zeros(4), np.ones(2))
+    assert x_next.shape == (4,) and A.shape == (4, 4) and B.shape == (4, 2)
