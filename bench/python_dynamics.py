@@ -22,12 +22,9 @@ class AnalyticPythonCartPole(PythonCartPole):
     """PythonCartPole with Jacobians from the C++ cart-pole's formulas (no finite differences)."""
 
     def jacobians(self, x, u):
-        mc, mp, l, g = (self.p[k] for k in ("cart_mass", "pole_mass", "pole_length", "gravity"))
+        mp, l, g = (self.p[k] for k in ("pole_mass", "pole_length", "gravity"))
         s, c = np.sin(x[2]), np.cos(x[2])
-        det = mp * l * l * (mc + mp * s * s)
-        M_inv = np.array([[mp * l * l, -mp * l * c], [-mp * l * c, mc + mp]]) / det
-        h = np.array([u[0] + mp * l * s * x[3] ** 2, -mp * g * l * s])
-        q_ddot = M_inv @ h
+        M_inv, q_ddot = self.accelerations(x, u)
         dM = np.array([[0.0, -mp * l * s], [-mp * l * s, 0.0]])
         d_theta = M_inv @ (np.array([mp * l * c * x[3] ** 2, -mp * g * l * c]) - dM @ q_ddot)
         d_theta_dot = M_inv @ np.array([2.0 * mp * l * s * x[3], 0.0])

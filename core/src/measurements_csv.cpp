@@ -16,6 +16,7 @@
 #include <string_view>
 
 #include "gpilqg/core/measurements.hpp"
+#include "csv_text.hpp"
 #include "measurements_internal.hpp"
 
 namespace gpilqg {
@@ -56,35 +57,8 @@ std::string read_whole_file(const std::filesystem::path& file) {
 
 bool is_blank(std::string_view line) { return line.find_first_not_of(" \t") == std::string_view::npos; }
 
-std::vector<std::string_view> split_fields(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    if (comma == std::string_view::npos) {
-      fields.push_back(line.substr(start));
-      return fields;
-    }
-    fields.push_back(line.substr(start, comma - start));
-    start = comma + 1;
-  }
-}
-
-/// The text split into lines without their "\n" or "\r\n"; a final newline does not start a line.
-std::vector<std::string_view> split_lines(std::string_view text) {
-  std::vector<std::string_view> lines;
-  std::size_t start = 0;
-  while (start < text.size()) {
-    std::size_t end = text.find('\n', start);
-    const std::size_t next = end == std::string_view::npos ? text.size() : end + 1;
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(start, end - start);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    lines.push_back(line);
-    start = next;
-  }
-  return lines;
-}
+using csv_text::split_fields;
+using csv_text::split_lines;
 
 /// Reads the rows of one file into episodes, checking each row as it comes so that the first
 /// problem in file order is the one reported.

@@ -15,6 +15,7 @@
 
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/raw_log.hpp"
+#include "csv_text.hpp"
 
 namespace gpilqg {
 
@@ -35,29 +36,16 @@ std::string_view trim(std::string_view s) {
   return s.substr(first, last - first + 1);
 }
 
+/// The fields of a line, trimmed of spaces and tabs.
 std::vector<std::string_view> split_fields(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    fields.push_back(trim(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
-    if (comma == std::string_view::npos) return fields;
-    start = comma + 1;
-  }
+  std::vector<std::string_view> fields = csv_text::split_fields(line);
+  for (std::string_view& field : fields) field = trim(field);
+  return fields;
 }
 
+/// The lines of the text, without blank lines at its end.
 std::vector<std::string_view> split_lines(std::string_view text) {
-  std::vector<std::string_view> lines;
-  std::size_t start = 0;
-  while (start < text.size()) {
-    std::size_t end = text.find('\n', start);
-    const std::size_t next = end == std::string_view::npos ? text.size() : end + 1;
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(start, end - start);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    lines.push_back(line);
-    start = next;
-  }
+  std::vector<std::string_view> lines = csv_text::split_lines(text);
   while (!lines.empty() && trim(lines.back()).empty()) lines.pop_back();
   return lines;
 }

@@ -32,13 +32,17 @@ class PythonCartPole(gpilqg.Dynamics):
     def parameters(self):
         return dict(self.p)
 
-    def f(self, x, u):
+    def accelerations(self, x, u):
+        """(M^-1 (2, 2), q_ddot (2,)) at (x, u)."""
         mc, mp, l, g = (self.p[k] for k in ("cart_mass", "pole_mass", "pole_length", "gravity"))
         s, c = np.sin(x[2]), np.cos(x[2])
         det = mp * l * l * (mc + mp * s * s)
         M_inv = np.array([[mp * l * l, -mp * l * c], [-mp * l * c, mc + mp]]) / det
         h = np.array([u[0] + mp * l * s * x[3] ** 2, -mp * g * l * s])
-        q_ddot = M_inv @ h
+        return M_inv, M_inv @ h
+
+    def f(self, x, u):
+        _, q_ddot = self.accelerations(x, u)
         return np.array([x[1], q_ddot[0], x[3], q_ddot[1]])
 
 
