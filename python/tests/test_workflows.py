@@ -190,3 +190,18 @@ def test_diagnose_a_python_system_finds_its_missing_parameter(tmp_path, python_c
     assert python["verdict"]["parameters"]["pole_length"] == pytest.approx(1.3, rel=0.02)
     assert python["verdict"]["parameters"]["pole_length"] == pytest.approx(
         cpp["verdict"]["parameters"]["pole_length"], rel=1e-6)
+
+
+def test_diagnose_reports_progress_and_ctrl_c_stops_it_between_effects():
+    data = SOURCE_DIR / "data" / "cartpole_hidden_friction.csv"
+    lines = []
+
+    def progress(line):
+        lines.append(line)
+        if line.startswith("effect 3/"):
+            _thread.interrupt_main()
+
+    with pytest.raises(KeyboardInterrupt):
+        gpilqg.diagnose("cartpole", data, progress=progress)
+    assert lines[0] == "residual GP of the model fitted"
+    assert lines[-1].startswith("effect 3/"), lines

@@ -127,6 +127,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   const auto before_step = make_step_model(o.model, o.integrator, R.dt, o.substeps);
   const Matrix residual_before = residual_of(data, one_step_predictions(*before_step, data));
   ResidualGp gp_before = fit_residual_gp(before_step, data, residual_before, o.gp);
+  if (o.progress) o.progress("residual GP of the model fitted");
 
   // Effects to add: given values, or fitted on the training episodes against the model so far.
   R.model = o.model;
@@ -192,7 +193,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
 
   // 3. Which.
   const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual};
-  if (o.rank) R.ranking = rank_effects(context, o.alias_threshold);
+  if (o.rank) R.ranking = rank_effects(context, o.alias_threshold, o.progress);
   R.verdict = decide(R, o);
 
   // 4. Add: the four models on the held-out episodes.

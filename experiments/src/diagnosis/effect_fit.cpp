@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+
+#include <fmt/format.h>
 #include <stdexcept>
 
 #include <Eigen/Dense>
@@ -299,10 +301,17 @@ bool same_physics(const SystemEntry& entry, const std::string& a, const std::str
 
 }  // namespace
 
-std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold) {
+std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold,
+                                       const std::function<void(const std::string&)>& progress) {
   const SystemEntryPtr system = find_system(context.model.system);
   std::vector<EffectFit> fits;
-  for (const LibraryEffect& effect : effect_library(context.model.system)) fits.push_back(fit_effect(effect, context));
+  const std::vector<LibraryEffect>& library = effect_library(context.model.system);
+  for (const LibraryEffect& effect : library) {
+    fits.push_back(fit_effect(effect, context));
+    if (progress)
+      progress(fmt::format("effect {}/{} fitted: {} explains {:.1f}%", fits.size(), library.size(), fits.back().effect,
+                           100.0 * fits.back().explained));
+  }
   std::stable_sort(fits.begin(), fits.end(),
                    [](const EffectFit& a, const EffectFit& b) { return a.explained > b.explained; });
   std::vector<bool> used(fits.size(), false);

@@ -26,6 +26,7 @@
 ///    still soak up some of the residual; it cannot match the GP.
 ///  - "unexplained" otherwise: the residual has structure no effect of the library accounts for.
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -63,6 +64,8 @@ struct DiagnosisOptions {
   double min_z = 3.0;                     ///< ... this significance ...
   double relative_to_gp = 0.5;            ///< ... and this share of what the GP explains
   bool rank = true;                       ///< false: skip the ranking (faster; verdict from the GP only)
+  /// Optional: one line after the residual GP and after every fitted effect; it may throw to stop.
+  std::function<void(const std::string&)> progress;
   /// Throws std::invalid_argument naming the field.
   void validate() const;
 };

@@ -28,6 +28,7 @@
 /// uncentred correlation that governs least-squares identifiability) cannot be told apart on these
 /// data; they are reported as one group under the best of them.
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,8 @@ struct RankedEffect {
 /// Fits every effect of the library and ranks the alias groups by held-out explained fraction
 /// (greedy grouping: the best remaining effect takes every remaining effect whose regressor correlation
 /// with it is >= alias_threshold).
-std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold = 0.95);
+/// `progress` (optional) receives one line per fitted effect and may throw to stop the ranking.
+std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold = 0.95,
+                                       const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace gpilqg::diagnosis
