@@ -6,7 +6,7 @@
 //   derivative passes: one per iteration plus the final one at the returned trajectory;
 //   backward passes:   one per iteration plus the rejected ones (backward_failures) plus the final gain pass;
 //   forward passes:    the initial rollout plus every line-search trial.
-// "One iteration" (issue #5) = one derivative pass + one backward pass + one forward pass.
+// "One iteration" = one derivative pass + one backward pass + one forward pass.
 //
 // The solver's timers are wall-clock. On a shared machine wall-clock time overstates the work, so a
 // caller can also pass the CPU time of each solve (measure_cpu_seconds); the CPU figures of the passes

@@ -9,7 +9,7 @@
 //  - kin40k (8 inputs): the 10,000 training points, and all 40,000 (training + test inputs pooled,
 //    targets likewise) as a timing case, support from the data-driven start with 8 neighbours (in 8-D
 //    the fill-in of wider supports makes the factor nearly dense; see README).
-// The data file is found through $GPILQG_SHARED_DIR or ../shared beside the source tree; without it
+// The data file is found through $GPILQG_DATA_DIR or the repository's data/; without it
 // the kin40k cases are skipped. One iteration per case (they take seconds); no flags needed:
 //   build/bench/gpilqg_gp_compact_bench
 
@@ -45,9 +45,9 @@ gp::TrainingSet synthetic(int n) {
 }
 
 std::filesystem::path kin40k_file() {
-  const char* dir = std::getenv("GPILQG_SHARED_DIR");
-  const std::filesystem::path shared = dir != nullptr ? dir : GPILQG_BENCH_SHARED_DIR;
-  return shared / "data" / "gp-benchmarks" / "kin40k.h5";
+  const char* dir = std::getenv("GPILQG_DATA_DIR");
+  const std::filesystem::path data = dir != nullptr ? dir : GPILQG_BENCH_DATA_DIR;
+  return data / "gp-benchmarks" / "kin40k.h5";
 }
 
 RowMajor read(const H5::H5File& file, const char* name) {
@@ -80,7 +80,7 @@ gp::CompactBackend backend(int source) {
 
 bool available(benchmark::State& state, int source) {
   if (source == 0 || std::filesystem::exists(kin40k_file())) return true;
-  state.SkipWithError("kin40k.h5 not found (set GPILQG_SHARED_DIR)");
+  state.SkipWithError("kin40k.h5 not found (set GPILQG_DATA_DIR)");
   return false;
 }
 

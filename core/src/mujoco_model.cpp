@@ -66,7 +66,7 @@ std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
     const int type = m->jnt_type[j];
     if (type == mjJNT_FREE || type == mjJNT_BALL)
       throw std::invalid_argument(fmt::format(
-          "{}: joint {} ('{}') is a {} joint; gpilqg supports hinge and slide joints only (DESIGN.md section 10)", path,
+          "{}: joint {} ('{}') is a {} joint; gpilqg supports hinge and slide joints only (docs/own-system.md)", path,
           j, name.empty() ? "unnamed" : name, type == mjJNT_FREE ? "free" : "ball"));
     if (name.empty())
       throw std::invalid_argument(fmt::format(

@@ -2,7 +2,7 @@
 /// @file shared_prediction.hpp
 /// Prediction of several exact GPs conditioned on the same training inputs X (N x D), as the residual
 /// model's outputs are (one GP per state, one shared subsample), sharing what depends only on X and
-/// the query z (issue #3 point 4):
+/// the query z:
 ///
 ///  - the squared differences (x_id - z_d)^2 (N x D) are formed once per query for all n outputs, and
 ///    output a's cross-covariance is k_a = sf_a^2 exp(-1/2 sum_d w_ad (x_id - z_d)^2) from them;

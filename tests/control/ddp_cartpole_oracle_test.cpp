@@ -1,4 +1,4 @@
-// The cart-pole swing-up of shared/reference/ilqr_cartpole (Tassa's iLQG.m in Octave, cross-checked by
+// The cart-pole swing-up of tests/reference/ilqr_cartpole (Tassa's iLQG.m in Octave, cross-checked by
 // a second iLQR to 1e-13): final cost to 1e-8 relative and the same final state, unconstrained
 // (case C, J = 0.645046921446) and with |u| <= 2.5 (case E, J = 0.677802315918).
 
@@ -51,7 +51,7 @@ TEST_P(CartPoleOracle, ReachesTheReferenceOptimumAndFinalState) {
   EXPECT_NEAR(result.nominal_cost, c.reference_cost, 1e-8 * c.reference_cost);
   EXPECT_DOUBLE_EQ(result.nominal_cost, result.expected_cost);  // no noise: the merit is the cost
 
-  const auto dir = test::shared_dir() / "reference" / "ilqr_cartpole" / c.folder;
+  const auto dir = test::reference_dir() / "ilqr_cartpole" / c.folder;
   const Matrix x_ref = test::read_numeric_csv(dir / "x.csv");
   const Matrix u_ref = test::read_numeric_csv(dir / "u.csv");
   EXPECT_TRUE(test::matrices_near(result.trajectory.x.col(100), Vector(x_ref.row(100).transpose()), 1e-5))

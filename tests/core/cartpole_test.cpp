@@ -1,4 +1,4 @@
-// Cart-pole: the reference step of shared/reference/ilqr_cartpole (Octave oracle), analytic Jacobians
+// Cart-pole: the reference step of tests/reference/ilqr_cartpole (Octave oracle), analytic Jacobians
 // against central differences, the presets and parameter validation.
 
 #include <cmath>
@@ -20,7 +20,7 @@ constexpr double kStep = 1e-6;
 constexpr double kFdTolerance = 1e-7;
 
 TEST(CartPole, EulerStepMatchesReferenceOracle) {
-  // shared/reference/ilqr_cartpole/README.md, "Unit checks" (Tassa's iLQG.m in Octave, Euler dt = 0.05).
+  // tests/reference/ilqr_cartpole/README.md, "Unit checks" (Tassa's iLQG.m in Octave, Euler dt = 0.05).
   auto model = IntegratedStepModel(std::make_shared<CartPole>(), Integrator::Euler, 0.05);
   Vector x(4), u(1);
   x << 0.3, -0.2, 2.0, 0.7;

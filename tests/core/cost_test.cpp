@@ -1,5 +1,5 @@
 // Quadratic and tracking costs: derivatives against central differences, the reference problem's
-// zero-control cost (500 pi^2, shared/reference/ilqr_cartpole/README.md), and validation.
+// zero-control cost (500 pi^2, tests/reference/ilqr_cartpole/README.md), and validation.
 
 #include <numbers>
 

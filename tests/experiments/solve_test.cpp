@@ -15,7 +15,7 @@ std::string config_path(const char* name) { return (test::source_dir() / "experi
 
 TEST(SolveCommand, ReachesTheReferenceOptimaFromTheCommandLine) {
   struct Case { const char* file; double cost; double x_final_theta; };
-  // shared/reference/ilqr_cartpole: summary.csv, cases C and E.
+  // tests/reference/ilqr_cartpole: summary.csv, cases C and E.
   for (const Case c : {Case{"cartpole_swingup.toml", 0.645046921446, 3.14042815352604},
                        Case{"cartpole_swingup_box.toml", 0.677802315918, 3.14039027}}) {
     const auto r = test::run_cli("solve '" + config_path(c.file) + "' --json");

@@ -1,5 +1,5 @@
 /// The full exact GP (all 7,168 points, no subsample) with the published fixed hyperparameters on
-/// pumadyn-32nm reproduces the reference scores of shared/data/gp-benchmarks/README.md to 1e-5.
+/// pumadyn-32nm reproduces the reference scores of data/gp-benchmarks/README.md to 1e-5.
 
 #include <gtest/gtest.h>
 
@@ -32,7 +32,7 @@ double read_attribute(const H5::Group& group, const std::string& name) {
 }
 
 TEST(BenchmarkData, FullExactGpReproducesPumadynScores) {
-  const auto path = shared_dir() / "data" / "gp-benchmarks" / "pumadyn32nm.h5";
+  const auto path = data_dir() / "gp-benchmarks" / "pumadyn32nm.h5";
   const H5::H5File file(path.c_str(), H5F_ACC_RDONLY);
   TrainingSet train{read_dataset(file, "X_train"), read_dataset(file, "y_train").col(0)};
   const Matrix test_inputs = read_dataset(file, "X_test");

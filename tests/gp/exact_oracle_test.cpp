@@ -1,5 +1,5 @@
 /// The exact GP against independent golden numbers: GPML 4.2 (Octave) and scikit-learn / NumPy, from
-/// shared/reference/gp_oracle (README there: provenance and tolerances).
+/// tests/reference/gp_oracle (README there: provenance and tolerances).
 
 #include <gtest/gtest.h>
 

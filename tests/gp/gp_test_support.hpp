@@ -1,6 +1,6 @@
 #pragma once
 /// @file gp_test_support.hpp
-/// Shared pieces of the GP tests: the gp_oracle reference data (shared/reference/gp_oracle) and its
+/// Shared pieces of the GP tests: the gp_oracle reference data (tests/reference/gp_oracle) and its
 /// prior mean m(x) = sum_d sin(x_d), the JSON golden numbers, and the list of backends for typed tests.
 
 #include <fstream>
@@ -21,9 +21,10 @@ namespace gpilqg::gp::test {
 
 using ::gpilqg::test::matrices_near;
 using ::gpilqg::test::read_numeric_csv;
-using ::gpilqg::test::shared_dir;
+using ::gpilqg::test::data_dir;
+using ::gpilqg::test::reference_dir;
 
-inline std::filesystem::path oracle_dir() { return shared_dir() / "reference" / "gp_oracle"; }
+inline std::filesystem::path oracle_dir() { return reference_dir() / "gp_oracle"; }
 
 /// The oracle's stand-in simulator: m(x) = sum_d sin(x_d), dm/dx_d = cos(x_d).
 inline double sum_of_sines(const VectorCRef& x, Vector* gradient) {

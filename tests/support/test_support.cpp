@@ -10,7 +10,8 @@
 
 namespace gpilqg::test {
 
-std::filesystem::path shared_dir() { return GPILQG_SHARED_DIR; }
+std::filesystem::path reference_dir() { return source_dir() / "tests" / "reference"; }
+std::filesystem::path data_dir() { return source_dir() / "data"; }
 std::filesystem::path source_dir() { return GPILQG_SOURCE_DIR; }
 
 std::filesystem::path temporary_dir(const std::string& label) {

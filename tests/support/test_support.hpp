@@ -13,14 +13,16 @@
 
 namespace gpilqg::test {
 
-/// ../shared beside the repository (reference numbers and benchmark data).
-std::filesystem::path shared_dir();
+/// tests/reference: independent reference numbers, each folder with a README of its provenance.
+std::filesystem::path reference_dir();
+/// data/: sample measurement sets and the GP benchmark sets.
+std::filesystem::path data_dir();
 /// The repository root.
 std::filesystem::path source_dir();
 /// A fresh empty temporary folder for one test, removed by the caller or left for inspection.
 std::filesystem::path temporary_dir(const std::string& label);
 
-/// Reads a headerless numeric CSV (as in shared/reference) into a matrix.
+/// Reads a headerless numeric CSV (as in tests/reference) into a matrix.
 Matrix read_numeric_csv(const std::filesystem::path& file);
 
 /// Passes when |actual - expected| <= abs_tol + rel_tol * |expected| elementwise and the shapes agree;

@@ -10,7 +10,7 @@
 ///   M = [ mc + mp      mp l c ]      h = [ u + mp l s theta_dot^2 ]
 ///       [ mp l c       mp l^2 ]          [ -mp g l s             ]
 ///
-/// whose solution is the form in shared/reference/ilqr_cartpole/README.md:
+/// whose solution is the form in tests/reference/ilqr_cartpole/README.md:
 ///   x_ddot     = (u + mp s (l theta_dot^2 + g c)) / (mc + mp s^2)
 ///   theta_ddot = (-u c - mp l theta_dot^2 c s - (mc + mp) g s) / (l (mc + mp s^2))
 /// Jacobians: d q_ddot / d z = M^-1 (dh/dz - dM/dz q_ddot) for z in (q, q_dot, u).

@@ -5,7 +5,7 @@
 /// fit time, prediction time and the test scores SMSE, MNLP, MSLL (metrics.hpp, GPML book section 2.5).
 ///
 /// Data (read_profile_data):
-///  - the benchmark format (shared/data/gp-benchmarks): datasets X_train (N x D), y_train (N), X_test
+///  - the benchmark format (data/gp-benchmarks): datasets X_train (N x D), y_train (N), X_test
 ///    (M x D), y_test (M), optional group /reference_hyperparameters (dataset log_lengthscales (D),
 ///    attributes log_signal_std, log_noise_std; ARD squared exponential);
 ///  - a measurement set (DESIGN.md section 4, CSV or HDF5 with /episodes; needs the system): inputs

@@ -42,12 +42,15 @@ struct RunTask {
   bool transfer = false;    ///< starts from the data (and learned model) of the previous task
 };
 
+/// Every field is read from the config: the embedded defaults of the system (the only source of
+/// default values, experiments/configs/run_<system>.toml) merged with the user's file. The
+/// initial values below are placeholders, never defaults.
 struct RunConfig {
   // [system]
   std::string system;
-  double dt = 0.05;
+  double dt = 0.0;
   Integrator integrator = Integrator::RK4;
-  int substeps = 10;
+  int substeps = 0;
   // [world]
   std::string world_model;                         ///< another model file with the same joints and actuators
   std::map<std::string, double> world_parameters;  ///< parameter overrides of the world
@@ -59,11 +62,11 @@ struct RunConfig {
   // [[tasks]]
   std::vector<RunTask> tasks;
   // [loop]
-  int iterations = 5;
-  int rollouts = 3;
+  int iterations = 0;
+  int rollouts = 0;
   Vector exploration_std;
-  double policy_tolerance = 0.02;
-  int evaluation_rollouts = 5;
+  double policy_tolerance = 0.0;
+  int evaluation_rollouts = 0;
   // [gp]
   GpSettings gp;
   // [solver]
@@ -75,11 +78,11 @@ struct RunConfig {
   bool mpc = false;
   MpcOptions mpc_options;
   // [pddp]
-  bool pddp = true;
-  int pddp_max_iterations = 40;
-  std::string pddp_backend = "exact";  ///< PDDP's GPs (sized by backend_settings): one with exact moment matching
-  bool pddp_own = true;
-  int pddp_own_initial_rollouts = 3;
+  bool pddp = false;
+  int pddp_max_iterations = 0;
+  std::string pddp_backend;  ///< PDDP's GPs (sized by gp.backend_settings): one with exact moment matching
+  bool pddp_own = false;
+  int pddp_own_initial_rollouts = 0;
   Vector pddp_own_amplitude;
 
   /// The full effective config as TOML text (defaults merged with the user's file): what the result

@@ -10,7 +10,7 @@
 ///
 /// without the 1/2. Matching exponents, r^2 / Lambda_dd = r^2 / (2 l_d^2), so the two are the same kernel
 /// with Lambda_dd = 2 l_d^2, i.e. l_d = sqrt(Lambda_dd / 2) = 1 / sqrt(2 W_dd) for W = Lambda^-1
-/// (as shared/reference/gp_oracle/README.md writes it).
+/// (as tests/reference/gp_oracle/README.md writes it).
 ///
 /// Derivatives used by the backends (r_d = a_d - b_d):
 ///   dk/d log l_d = k r_d^2 / l_d^2,   dk/d log sf = 2 k,   dk/da_d = -k r_d / l_d^2.

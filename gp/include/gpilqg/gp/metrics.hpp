@@ -1,7 +1,7 @@
 #pragma once
 /// @file metrics.hpp
 /// Standard scores of probabilistic regression (GPML book section 2.5), as used for the benchmark data
-/// (shared/data/gp-benchmarks/README.md) and by `gpilqg profile`.
+/// (data/gp-benchmarks/README.md) and by `gpilqg profile`.
 ///
 ///   SMSE = mean((y - mu)^2) / var(y_test)                       (var divides by n)
 ///   MNLP = mean(0.5 log(2 pi s2) + (y - mu)^2 / (2 s2))          (s2 includes the noise)

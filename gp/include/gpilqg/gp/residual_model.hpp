@@ -83,7 +83,7 @@ class ResidualModel final : public StepModel {
   /// Wraps already-fitted GPs, one per state: outputs[i] has input_dim n + m. Throws
   /// std::invalid_argument for a null simulator, a wrong number of outputs or a wrong input dimension.
   ///
-  /// Shared prediction (issue #3 point 4): when every output is an exact GP on the same training
+  /// Shared prediction: when every output is an exact GP on the same training
   /// inputs X (what fit produces: one subsample for all outputs), the outputs share what depends only
   /// on X and the query z: the squared differences (x_id - z_d)^2 are formed once per query for all
   /// outputs, and the cross-covariances k_a(X, z) once per (x, u) for both step and uncertainty (the DDP
