@@ -56,10 +56,9 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   const SolveConfig& c = request.config.problem;
   const GpSettings& gp_settings = request.config.gp;
   const SystemSignature signature = system_signature(c.system);
-  const std::shared_ptr<const StepModel> simulator =
-      make_step_model(make_system(c.system, c.preset, {}, c.noise), c.integrator, c.dt, c.substeps);
+  const std::shared_ptr<const StepModel> simulator = make_solve_model(c);
   const int m = simulator->control_dim();
-  const QuadraticCost cost(c.dt, c.Q.asDiagonal(), c.R.asDiagonal(), c.Qf.asDiagonal(), c.goal);
+  const QuadraticCost cost = make_solve_cost(c);
 
   DdpTask task;
   task.cost = &cost;

@@ -89,11 +89,18 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   return c;
 }
 
+std::shared_ptr<const StepModel> make_solve_model(const SolveConfig& c) {
+  return make_step_model(make_system(c.system, c.preset, {}, c.noise), c.integrator, c.dt, c.substeps);
+}
+
+QuadraticCost make_solve_cost(const SolveConfig& c) {
+  return QuadraticCost(c.dt, c.Q.asDiagonal(), c.R.asDiagonal(), c.Qf.asDiagonal(), c.goal);
+}
+
 DdpResult solve_config(const SolveConfig& c) {
-  auto dynamics = make_system(c.system, c.preset, {}, c.noise);
-  const auto step_model = make_step_model(dynamics, c.integrator, c.dt, c.substeps);
+  const auto step_model = make_solve_model(c);
   const StepModel& model = *step_model;
-  const QuadraticCost cost(c.dt, c.Q.asDiagonal(), c.R.asDiagonal(), c.Qf.asDiagonal(), c.goal);
+  const QuadraticCost cost = make_solve_cost(c);
   DdpProblem problem;
   problem.model = step_model.get();
   problem.cost = &cost;

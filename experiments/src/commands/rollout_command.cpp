@@ -104,7 +104,7 @@ int run_rollout(const RolloutOptions& o) {
     if (task.horizon != setup.horizon)
       throw InputError(fmt::format("--cost {}: [problem] horizon is {}; expected the policy's {}", o.cost_config,
                                    task.horizon, setup.horizon));
-    cost = std::make_unique<QuadraticCost>(task.dt, task.Q.asDiagonal(), task.R.asDiagonal(), task.Qf.asDiagonal(), task.goal);
+    cost = std::make_unique<QuadraticCost>(make_solve_cost(task));
   }
   std::vector<double> costs;
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "gpilqg/control/ddp_solver.hpp"
+#include "gpilqg/core/cost.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/noise.hpp"
 #include "gpilqg/core/systems.hpp"
@@ -46,6 +47,12 @@ SolveConfig read_solve_config(const std::filesystem::path& file);
 /// `default_algorithm`.
 SolveConfig read_solve_config(const TomlFields& fields, const std::vector<std::string>& extra_sections,
                               const std::string& default_algorithm);
+
+/// The config's simulator: [system] (its preset, integrator, sub-steps) with [noise], at step dt.
+std::shared_ptr<const StepModel> make_solve_model(const SolveConfig& config);
+
+/// The config's cost: dt (0.5 e'Qe + 0.5 u'Ru) per step and 0.5 e'Qf e at the end, e = x - goal.
+QuadraticCost make_solve_cost(const SolveConfig& config);
 
 /// Builds the model and cost of the config and solves it.
 DdpResult solve_config(const SolveConfig& config);
