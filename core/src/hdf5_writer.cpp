@@ -1,15 +1,18 @@
 #include "gpilqg/core/hdf5_writer.hpp"
 
+#include <exception>
 #include <stdexcept>
 
 #include <H5Cpp.h>
 
+#include "gpilqg/core/hdf5_memory_file.hpp"
 #include "hdf5_common.hpp"
 
 namespace gpilqg {
 
 struct Hdf5Writer::Impl {
-  H5::H5File file;
+  H5::H5File file;  ///< in memory until close() (hdf5_memory_file.hpp)
+  int uncaught_exceptions = std::uncaught_exceptions();
 
   /// The group at `path` ("/" or "/a/b"), created with its parents when missing.
   H5::Group group(const std::string& path) {
@@ -58,16 +61,29 @@ using hdf5_detail::guarded;
 Hdf5Writer::Hdf5Writer(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()), file_(file) {
   guarded(file, "/", "creating", [&] {
     H5::Exception::dontPrint();
-    impl_->file = H5::H5File(file.string(), H5F_ACC_TRUNC);
+    impl_->file = create_hdf5_in_memory(file);
   });
 }
 
-Hdf5Writer::~Hdf5Writer() = default;
+Hdf5Writer::~Hdf5Writer() {
+  // Like std::ofstream, a writer that was not closed writes its file now, unless it is being
+  // destroyed by an exception (then the half-built file is dropped); errors cannot be reported here,
+  // which is why every writer of the project calls close().
+  if (!impl_ || std::uncaught_exceptions() > impl_->uncaught_exceptions) return;
+  try {
+    std::error_code ignored;
+    std::filesystem::remove(file_, ignored);
+    save_hdf5_image(impl_->file, file_);
+  } catch (...) {
+  }
+}
 
 void Hdf5Writer::close() {
   if (!impl_) throw std::runtime_error(file_.string() + ": already closed");
-  guarded(file_, "/", "closing", [&] { impl_->file.close(); });
-  impl_.reset();
+  const std::unique_ptr<Impl> impl = std::move(impl_);
+  std::error_code ignored;
+  std::filesystem::remove(file_, ignored);  // "creates or truncates"
+  guarded(file_, "/", "closing", [&] { save_hdf5_image(impl->file, file_); });
 }
 
 void Hdf5Writer::write_matrix(const std::string& path, const MatrixCRef& values) {

@@ -166,15 +166,6 @@ void check_writable(const MeasurementSet& set) {
   }
 }
 
-void write_via_temporary(const std::filesystem::path& file,
-                         const std::function<void(const std::filesystem::path& temporary)>& write) {
-  try {
-    write_atomically(file, write);
-  } catch (const AtomicWriteError& e) {
-    throw DataError(file, "", e.problem());
-  }
-}
-
 }  // namespace measurements_detail
 
 namespace {

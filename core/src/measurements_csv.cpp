@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "csv_text.hpp"
 #include "measurements_internal.hpp"
@@ -255,14 +256,7 @@ void write_measurements_csv(const std::filesystem::path& file, const Measurement
       out.push_back('\n');
     }
   }
-  measurements_detail::write_via_temporary(file, [&](const std::filesystem::path& temporary) {
-    std::ofstream stream(temporary, std::ios::binary | std::ios::trunc);
-    if (!stream)
-      throw DataError(file, "", "cannot create the temporary file " + temporary.string(), "a writable folder");
-    stream.write(out.data(), static_cast<std::streamsize>(out.size()));
-    stream.close();
-    if (!stream) throw DataError(file, "", "writing " + temporary.string() + " failed", "a writable folder");
-  });
+  write_file_atomically(file, std::string_view(out.data(), out.size()));
 }
 
 }  // namespace gpilqg

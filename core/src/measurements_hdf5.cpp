@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "gpilqg/core/hdf5_memory_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "measurements_internal.hpp"
 
@@ -316,9 +317,8 @@ MeasurementSet read_measurements_hdf5(const std::filesystem::path& file, const S
 void write_measurements_hdf5(const std::filesystem::path& file, const MeasurementSet& set) {
   measurements_detail::check_writable(set);
   H5::Exception::dontPrint();
-  measurements_detail::write_via_temporary(file, [&](const std::filesystem::path& temporary) {
-    guarded(file, "", "writing " + temporary.string(), "a writable folder", [&] {
-      H5::H5File h5(temporary.c_str(), H5F_ACC_TRUNC);
+  guarded(file, "", "writing the file", "a set HDF5 can store", [&] {
+    write_hdf5_atomically(file, [&](H5::H5File& h5) {
       H5::Group root = h5.openGroup("/");
       write_string(root, "system", set.system.name);
       write_strings(root, "state_names", names_of(set.system.states));
@@ -330,7 +330,6 @@ void write_measurements_hdf5(const std::filesystem::path& file, const Measuremen
         write_array(group, "x", e.x, false);
         write_array(group, "u", e.u, false);
       }
-      h5.close();
     });
   });
 }

@@ -53,11 +53,4 @@ std::string format_number(double value);
 /// file that the readers would reject.
 void check_writable(const MeasurementSet& set);
 
-/// Writes `file` through write_atomically (atomic_file.hpp): `write` fills a temporary file beside it,
-/// which is flushed and renamed onto `file`; on any exception the temporary file is removed, the
-/// previous `file` is left as it was and the exception propagates. A failure of the atomic-write
-/// machinery (e.g. `file` is a folder) is a DataError naming `file`.
-void write_via_temporary(const std::filesystem::path& file,
-                         const std::function<void(const std::filesystem::path& temporary)>& write);
-
 }  // namespace gpilqg::measurements_detail

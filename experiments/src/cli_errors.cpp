@@ -2,6 +2,7 @@
 
 #include <ostream>
 
+#include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 
 namespace gpilqg {
@@ -18,6 +19,12 @@ int run_reporting_errors(const std::function<int()>& command, std::ostream& err)
   } catch (const std::invalid_argument& e) {
     err << "error: " << e.what() << '\n';
     return kExitBadInput;
+  } catch (const AtomicWriteError& e) {
+    err << "error: " << e.what() << '\n';
+    return kExitInternalFailure;
+  } catch (const FileWriteError& e) {
+    err << "error: " << e.what() << '\n';
+    return kExitInternalFailure;
   } catch (const std::exception& e) {
     err << "internal error: " << e.what() << '\n';
     return kExitInternalFailure;

@@ -6,6 +6,7 @@
 /// the command line is parsed and before the command runs; a plugin that cannot be used is bad input
 /// (exit 2, plugin.hpp).
 
+#include <algorithm>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -15,6 +16,38 @@
 #include "commands/commands.hpp"
 #include "gpilqg/core/plugin.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+
+namespace {
+
+/// The first word of the command line that is neither an option nor the value of --plugin: what
+/// the user meant as the command's name; empty when there is none.
+std::string first_word(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "--plugin") {
+      ++i;
+      continue;
+    }
+    if (!word.empty() && word[0] != '-') return word;
+  }
+  return "";
+}
+
+/// The names of the commands, e.g. "data, solve, simulate".
+std::vector<std::string> command_names(CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; }))
+    names.push_back(command->get_name());
+  return names;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const auto& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"gpilqg: data-driven robust optimal control (GP-corrected simulators, Robust-iLQG)",
@@ -44,7 +77,14 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "error: " << e.what() << "\n(run with --help for usage)\n";
+    const std::string word = first_word(argc, argv);
+    const std::vector<std::string> names = command_names(app);
+    const bool known = std::find(names.begin(), names.end(), word) != names.end();
+    if (app.get_subcommands().empty() && !known)
+      std::cerr << "error: " << (word.empty() ? "no command given" : "unknown command '" + word + "'")
+                << "; expected one of: " << joined(names) << "\n(run with --help for usage)\n";
+    else
+      std::cerr << "error: " << e.what() << "\n(run with --help for usage)\n";
     return gpilqg::kExitBadInput;
   }
   if (!action) {

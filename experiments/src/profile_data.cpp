@@ -137,7 +137,9 @@ ProfileData read_measurement_profile(const std::filesystem::path& file, const Pr
     }
     targets = x_next_minus_x;
   }
-  const int k = std::max(options.test_every, 2);
+  if (options.test_every < 2)
+    throw std::invalid_argument(fmt::format("test_every is {}; expected >= 2 (every k-th sample is a test sample)", options.test_every));
+  const int k = options.test_every;
   std::vector<int> train_rows, test_rows;
   for (int t = 0; t < residual.size(); ++t) (t % k == 0 ? test_rows : train_rows).push_back(t);
   if (train_rows.size() < 2 || test_rows.empty())

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/hdf5_memory_file.hpp"
 #include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/core/version.hpp"
 #include "gpilqg/experiments/profile.hpp"
@@ -123,9 +124,8 @@ std::string format_profile(const ProfileReport& report) {
 
 void write_profile_hdf5(const std::filesystem::path& file, const ProfileReport& report) {
   H5::Exception::dontPrint();
-  write_atomically(file, [&](const std::filesystem::path& temporary) {
-    try {
-      H5::H5File h5(temporary.c_str(), H5F_ACC_EXCL);
+  try {
+    write_hdf5_atomically(file, [&](H5::H5File& h5) {
       H5::Group root = h5.openGroup("/");
       write_int_attribute(root, "schema_version", 1);
       write_string_attribute(root, "gpilqg_version", kVersionString);
@@ -138,9 +138,10 @@ void write_profile_hdf5(const std::filesystem::path& file, const ProfileReport& 
       write_int_attribute(root, "input_dim", report.data.train.input_dim());
       H5::Group rows = h5.createGroup("rows");
       const auto& r = report.rows;
-      const double nan = std::numeric_limits<double>::quiet_NaN();
+      // Rows that were skipped or failed measured nothing: their numbers are 0 and their status says
+      // why (no NaN in a result file).
       auto value = [&](double ProfileRow::*field) {
-        return [field, nan](const ProfileRow& row) { return scored(row) ? row.*field : nan; };
+        return [field](const ProfileRow& row) { return scored(row) && std::isfinite(row.*field) ? row.*field : 0.0; };
       };
       write_strings(rows, "backend", r, [](const ProfileRow& row) { return row.backend; });
       write_strings(rows, "status", r, [](const ProfileRow& row) { return row.status; });
@@ -153,10 +154,10 @@ void write_profile_hdf5(const std::filesystem::path& file, const ProfileReport& 
       write_column(rows, "msll", r, value(&ProfileRow::msll));
       write_column(rows, "nlml", r, value(&ProfileRow::nlml));
       write_column(rows, "evaluations", r, [](const ProfileRow& row) { return static_cast<double>(row.evaluations); });
-    } catch (const H5::Exception& e) {
-      throw std::runtime_error(file.string() + ": writing the profile failed (HDF5: " + e.getDetailMsg() + ")");
-    }
-  });
+    });
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(file.string() + ": writing the profile failed (HDF5: " + e.getDetailMsg() + ")");
+  }
 }
 
 void plot_profile(const std::filesystem::path& h5, const std::filesystem::path& directory) {

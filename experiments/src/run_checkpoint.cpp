@@ -40,15 +40,39 @@ std::filesystem::path RunCheckpoint::folder_for(const std::filesystem::path& res
   return std::filesystem::path(result_file.string() + ".checkpoint");
 }
 
+namespace {
+
+/// True when `folder` holds no finished file: nothing, or only temporaries of interrupted writes
+/// (a checkpoint whose manifest was never written, e.g. after a failed or killed start).
+bool holds_no_finished_file(const std::filesystem::path& folder) {
+  std::error_code error;
+  for (std::filesystem::directory_iterator it(folder, error), end; !error && it != end; it.increment(error))
+    if (!is_atomic_temporary(it->path())) return false;
+  return !error;
+}
+
+}  // namespace
+
 RunCheckpoint RunCheckpoint::create(const std::filesystem::path& folder, const RunConfig& config, const RunOptions& options) {
+  std::error_code error;
+  if (std::filesystem::is_directory(folder, error) && holds_no_finished_file(folder)) std::filesystem::remove_all(folder, error);
   if (std::filesystem::exists(folder))
     throw std::invalid_argument(fmt::format("{}: a checkpoint of an interrupted run is in the way; continue that run with "
                                          "--resume, or delete the folder to start over",
                                          folder.string()));
-  std::error_code error;
   std::filesystem::create_directories(folder, error);
   if (error) throw std::runtime_error(fmt::format("{}: cannot create the checkpoint folder ({})", folder.string(), error.message()));
   const Identity id = identity_of(config, options);
+  // A checkpoint without its manifest could be neither resumed nor replaced: when the manifest
+  // cannot be written, the folder goes too.
+  struct RemoveUnlessKept {
+    const std::filesystem::path& folder;
+    bool keep = false;
+    ~RemoveUnlessKept() {
+      std::error_code ignored;
+      if (!keep) std::filesystem::remove_all(folder, ignored);
+    }
+  } cleanup{folder};
   write_atomically(folder / kManifest, [&](const std::filesystem::path& temporary) {
     Hdf5Writer h5(temporary);
     h5.attribute("/", "format_version", kFormatVersion);
@@ -59,6 +83,7 @@ RunCheckpoint RunCheckpoint::create(const std::filesystem::path& folder, const R
     h5.attribute("/", "backends", id.backends.empty() ? std::vector<std::string>{""} : id.backends);
     h5.close();
   });
+  cleanup.keep = true;
   return RunCheckpoint(folder);
 }
 

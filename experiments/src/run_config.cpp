@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
@@ -31,8 +32,7 @@ std::vector<RunTask> read_tasks(const TomlFields& f, const toml::table& root, in
       if (earlier.name == t.name) f.fail(p + ".name", fmt::format("'{}' is used by two tasks", t.name));
     t.x0 = f.vector(p + ".x0", n);
     t.goal = f.vector(p + ".goal", n);
-    t.horizon = static_cast<int>(f.integer(p + ".horizon"));
-    if (t.horizon < 2) f.fail(p + ".horizon", "must be >= 2");
+    t.horizon = f.integer_in(p + ".horizon", 2, limits::kMaxHorizon);
     t.Q = f.vector(p + ".Q", n);
     t.R = f.vector(p + ".R", m);
     t.Qf = f.vector(p + ".Qf", n);
@@ -67,12 +67,6 @@ bool boolean(const TomlFields& f, const toml::table& root, const std::string& pa
   if (node == nullptr) f.fail(path, "missing; expected true or false");
   if (!node->is_boolean()) f.fail(path, "is not a boolean; expected true or false");
   return node->as_boolean()->get();
-}
-
-int positive_integer(const TomlFields& f, const std::string& path, int minimum) {
-  const long value = f.integer(path);
-  if (value < minimum) f.fail(path, fmt::format("is {}; expected >= {}", value, minimum));
-  return static_cast<int>(value);
 }
 
 Vector non_negative(const TomlFields& f, const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) {
@@ -120,7 +114,7 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
   if (c.dt <= 0.0) f.fail("system.dt", "must be > 0");
   if (!f.own_integrator(c.system, "system.integrator", "system.substeps")) {
     c.integrator = f.integrator("system.integrator");
-    c.substeps = positive_integer(f, "system.substeps", 1);
+    c.substeps = f.integer_in("system.substeps", 1, limits::kMaxSubsteps);
   }
 
   read_world(f, root, c, signature);
@@ -137,16 +131,16 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
 
   c.tasks = read_tasks(f, root, n, m);
 
-  c.iterations = positive_integer(f, "loop.iterations", 1);
-  c.rollouts = positive_integer(f, "loop.rollouts", 1);
+  c.iterations = f.integer_in("loop.iterations", 1, limits::kMaxLoopIterations);
+  c.rollouts = f.integer_in("loop.rollouts", 1, limits::kMaxRollouts);
   c.exploration_std = non_negative(f, "loop.exploration", m);
   c.policy_tolerance = f.number("loop.policy_tolerance");
   if (c.policy_tolerance < 0.0) f.fail("loop.policy_tolerance", "must be >= 0");
-  c.evaluation_rollouts = positive_integer(f, "loop.evaluation_rollouts", 1);
+  c.evaluation_rollouts = f.integer_in("loop.evaluation_rollouts", 1, limits::kMaxRollouts);
 
   c.gp = read_gp_settings(f, GpSettings{});  // every field is in the merged defaults
 
-  c.solver.max_iterations = positive_integer(f, "solver.max_iterations", 1);
+  c.solver.max_iterations = f.integer_in("solver.max_iterations", 1, limits::kMaxSolverIterations);
   c.solver.cost_tolerance = f.number("solver.tolerance");
   c.solver.gradient_tolerance = f.number("solver.gradient_tolerance");
   const std::string gp_algorithm = f.string("solver.gp_algorithm");
@@ -161,13 +155,13 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
 
   c.mpc = boolean(f, root, "mpc.enabled");
   if (c.mpc) {
-    c.mpc_options.horizon = positive_integer(f, "mpc.horizon", 1);
-    c.mpc_options.first_solve_iterations = positive_integer(f, "mpc.first_solve_iterations", 1);
-    c.mpc_options.iterations_per_step = positive_integer(f, "mpc.iterations_per_step", 1);
+    c.mpc_options.horizon = f.integer_in("mpc.horizon", 1, limits::kMaxHorizon);
+    c.mpc_options.first_solve_iterations = f.integer_in("mpc.first_solve_iterations", 1, limits::kMaxSolverIterations);
+    c.mpc_options.iterations_per_step = f.integer_in("mpc.iterations_per_step", 1, limits::kMaxSolverIterations);
   }
 
   c.pddp = boolean(f, root, "pddp.enabled");
-  c.pddp_max_iterations = positive_integer(f, "pddp.max_iterations", 1);
+  c.pddp_max_iterations = f.integer_in("pddp.max_iterations", 1, limits::kMaxSolverIterations);
   c.pddp_backend = f.string("pddp.backend");
   try {
     gp::require_moment_matching(c.pddp_backend, "");
@@ -175,8 +169,12 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
     f.fail("pddp.backend", e.what());
   }
   c.pddp_own = boolean(f, root, "pddp.own");
-  c.pddp_own_initial_rollouts = positive_integer(f, "pddp.own_initial_rollouts", 1);
+  c.pddp_own_initial_rollouts = f.integer_in("pddp.own_initial_rollouts", 1, limits::kMaxRollouts);
   c.pddp_own_amplitude = non_negative(f, "pddp.own_amplitude", m);
+
+  for (std::size_t i = 0; i < c.tasks.size(); ++i)
+    if (const auto problem = limits::trajectory_memory_problem(c.tasks[i].horizon, n, m, c.pddp))
+      f.fail(fmt::format("tasks[{}].horizon", i), *problem);
 
   std::ostringstream text;
   text << toml::toml_formatter{root};

@@ -2,19 +2,12 @@
 
 #include <fmt/format.h>
 
-#include <limits>
 
+#include "gpilqg/core/limits.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
 
 namespace gpilqg {
-
-namespace {
-// Beyond these a solve cannot fit in memory (T x (n^2 + n m) doubles per buffer) or in any sensible
-// time: a clear error instead of std::bad_alloc or an int that wraps around.
-constexpr int kMaxHorizon = 1'000'000;
-constexpr int kMaxSubsteps = 10'000;
-}  // namespace
 
 SolveConfig read_solve_config(const std::filesystem::path& file) {
   const toml::table root = TomlFields::parse(file);
@@ -45,7 +38,7 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   else f.fail("system.preset", fmt::format("'{}'; expected \"sim\" or \"real\"", preset));
   if (!f.own_integrator(c.system, "system.integrator", "system.substeps")) {
     c.integrator = f.integrator("system.integrator", "euler");
-    c.substeps = f.integer_in("system.substeps", 1, kMaxSubsteps, 1);
+    c.substeps = f.integer_in("system.substeps", 1, limits::kMaxSubsteps, 1);
   }
   c.dt = f.number("system.dt");
   if (c.dt <= 0.0) f.fail("system.dt", "must be > 0");
@@ -56,7 +49,8 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   for (const char* field : {"noise.actuator_additive", "noise.actuator_multiplicative", "noise.state"})
     if (f.has(field) && (f.vector(field, -1).array() < 0.0).any()) f.fail(field, "has negative entries; expected standard deviations >= 0");
 
-  c.horizon = f.integer_in("problem.horizon", 1, kMaxHorizon);
+  c.horizon = f.integer_in("problem.horizon", 1, limits::kMaxHorizon);
+  if (const auto problem = limits::trajectory_memory_problem(c.horizon, n, m, false)) f.fail("problem.horizon", *problem);
   c.x0 = f.vector("problem.x0", n);
   c.goal = f.vector("problem.goal", n);
   c.Q = f.vector("problem.Q", n);
@@ -74,7 +68,7 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   if (auto v = parse_variant(algorithm)) c.solver.variant = *v;
   else f.fail("solver.algorithm", fmt::format("'{}'; expected \"ilqr\", \"ilqg\" or \"robust_ilqg\"", algorithm));
   c.solver.max_iterations =
-      f.integer_in("solver.max_iterations", 1, std::numeric_limits<int>::max(), c.solver.max_iterations);
+      f.integer_in("solver.max_iterations", 1, limits::kMaxSolverIterations, c.solver.max_iterations);
   c.solver.cost_tolerance = f.number("solver.tolerance", c.solver.cost_tolerance);
   c.solver.gradient_tolerance = f.number("solver.gradient_tolerance", c.solver.gradient_tolerance);
   c.solver.max_seconds = f.number("solver.max_seconds", c.solver.max_seconds);

@@ -1,6 +1,7 @@
 #include "gpilqg/gp/gp_io.hpp"
 
 #include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/hdf5_memory_file.hpp"
 
 #include <H5Cpp.h>
 
@@ -98,20 +99,10 @@ void write_fitted_gp(H5::H5File& h5, const std::string& group_path, const Fitted
 void edit_atomically(const std::filesystem::path& file, const std::string& object, const std::string& what,
                      const std::function<void(H5::H5File&)>& edit) {
   H5::Exception::dontPrint();
-  try {
-    update_atomically(file, [&](const std::filesystem::path& temporary) {
-      guarded(file, object, what, [&] {
-        const bool exists = std::filesystem::exists(temporary);
-        H5::H5File h5(temporary.c_str(), exists ? H5F_ACC_RDWR : H5F_ACC_EXCL);
-        edit(h5);
-        h5.flush(H5F_SCOPE_GLOBAL);
-        h5.close();
-        return 0;
-      });
-    });
-  } catch (const AtomicWriteError& e) {
-    throw std::runtime_error(where(file, object) + ": " + what + " failed: " + e.problem());
-  }
+  guarded(file, object, what, [&] {
+    update_hdf5_atomically(file, edit);
+    return 0;
+  });
 }
 
 }  // namespace

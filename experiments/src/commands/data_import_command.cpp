@@ -3,6 +3,7 @@
 /// Bad maps and logs exit 2 with the file and the line, field, column or dataset at fault.
 
 #include "data_import_command.hpp"
+#include "output_options.hpp"
 
 #include <iostream>
 #include <memory>
@@ -32,6 +33,7 @@ struct DataImportOptions {
 /// Reads the map first (its errors need no log), then the log; writes the set (by extension, .h5 /
 /// .hdf5 or .csv) and prints the report.
 int run_data_import(const DataImportOptions& options) {
+  check_output_file_option("--out", options.out);
   const SystemSignature signature = system_signature(options.system);
   const LogMap map = read_import_map(options.map);
   const RawLog log = read_raw_log(options.log);

@@ -16,6 +16,9 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "gpilqg/core/limits.hpp"
+#include "option_checks.hpp"
+#include "output_options.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
@@ -66,6 +69,9 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   const diagnosis::DiagnoseRequest& r = o.request;
   const SystemSignature signature = system_signature(r.system);
   const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(r);
+  check_output_file_option("--out", o.out);
+  check_output_folder_option("--plots", o.plots);
+  check_output_file_option("--write-model", o.write_model);
   if (!o.plots.empty()) check_plotting();
   const MeasurementSet data = read_measurements(o.data, signature);
   diagnosis::DiagnosisReport report;
@@ -136,10 +142,16 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--write-model", o->write_model, "Write the improved model (TOML) for the next diagnosis");
   cmd->add_option("--integrator", r.integrator, "rk4 or euler")->capture_default_str();
   cmd->add_option("--heldout", r.heldout, "Fraction of the episodes held out")->capture_default_str();
-  cmd->add_option("--gp-points", r.gp_points, "GP training points per state")->capture_default_str();
-  cmd->add_option("--gp-restarts", r.gp_restarts, "Random restarts of the GP fit")->capture_default_str();
+  cmd->add_option("--gp-points", r.gp_points, "GP training points per state")
+      ->capture_default_str()
+      ->check(integer_in(2, limits::kMaxExactPoints));
+  cmd->add_option("--gp-restarts", r.gp_restarts, "Random restarts of the GP fit")
+      ->capture_default_str()
+      ->check(integer_in(0, limits::kMaxRestarts));
   cmd->add_option("--backend", r.backend, "GP backend (exact, fitc, ssgp)")->capture_default_str();
-  cmd->add_option("--seed", r.seed, "Seed of the GP subsample and restarts")->capture_default_str();
+  cmd->add_option("--seed", r.seed, "Seed of the GP subsample and restarts")
+      ->capture_default_str()
+      ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
   cmd->callback([&action, o] { action = [o] { return run_diagnose(*o); }; });
 }
 

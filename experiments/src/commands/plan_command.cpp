@@ -9,6 +9,9 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "gpilqg/core/limits.hpp"
+#include "option_checks.hpp"
+#include "output_options.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/planning.hpp"
 
@@ -26,6 +29,7 @@ struct PlanOptions {
 };
 
 int run_plan(const PlanOptions& o) {
+  check_output_file_option("--out", o.out);
   PlanRequest request;
   request.config = read_plan_config(o.config);
   for (const auto& file : o.data) request.data_files.emplace_back(file);
@@ -83,7 +87,8 @@ void add_plan_command(CLI::App& app, CommandAction& action) {
                                              "of the GP, and the re-sample rule");
   cmd->add_option("--out", o->out, "The policy file to write (HDF5, DESIGN.md section 11)")->required();
   cmd->add_option("--seed", o->seed, "Seed of the GP fit; equal seeds give the policies of `gpilqg run` with that seed")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
   cmd->add_flag("--json", o->json, "Print the policy file's content and the solver's summary as one JSON document");
   cmd->callback([&action, o] { action = [o] { return run_plan(*o); }; });
 }

@@ -9,6 +9,9 @@
 #include <string>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
+#include "output_options.hpp"
+#include "gpilqg/core/limits.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/profile.hpp"
 
@@ -55,6 +58,8 @@ std::vector<int> parse_sizes(const std::string& list) {
       }
       if (used != entry.size() || entry.empty() || value < 1)
         throw InputError(fmt::format("--sizes '{}': entry '{}' is not a positive integer or 'all'", list, entry));
+      if (value > limits::kMaxSamples)
+        throw InputError(fmt::format("--sizes '{}': entry {} exceeds {} (the sample limit)", list, value, limits::kMaxSamples));
       sizes.push_back(value);
     }
     if (comma == std::string::npos) break;
@@ -64,6 +69,8 @@ std::vector<int> parse_sizes(const std::string& list) {
 }
 
 int run_profile_command(ProfileCommandOptions& o) {
+  check_output_file_option("--out", o.out);
+  check_output_folder_option("--plots", o.plots);
   if (o.target == "residual")
     o.data.target = ProfileTarget::Residual;
   else if (o.target == "increment")
@@ -128,34 +135,51 @@ void add_profile_command(CLI::App& app, CommandAction& action) {
   cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the table");
   cmd->add_option("--out", o->out, "Write the results to this HDF5 file (temporary file, then renamed)");
   cmd->add_option("--plots", o->plots, "Write profile_pareto.png (accuracy against time) into this folder");
-  cmd->add_option("--restarts", o->restarts, "Random restarts per fit")->capture_default_str();
-  cmd->add_option("--max-evaluations", o->max_evaluations, "NLML evaluations per start")->capture_default_str();
+  cmd->add_option("--restarts", o->restarts, "Random restarts per fit")
+      ->capture_default_str()
+      ->check(integer_in(0, limits::kMaxRestarts));
+  cmd->add_option("--max-evaluations", o->max_evaluations, "NLML evaluations per start")
+      ->capture_default_str()
+      ->check(integer_in(1, limits::kMaxEvaluations));
   cmd->add_option("--start", o->start,
                   "'data': fits start from data-driven values (and restarts); 'reference': also from the data "
                   "set's reference hyperparameters, tried first")
       ->capture_default_str();
-  cmd->add_option("--seed", o->seed, "Seed of the subsets and the restarts")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the subsets and the restarts")
+      ->capture_default_str()
+      ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
   cmd->add_option("--max-test", o->max_test, "Score on this many test points (a fixed random subset; 0: all)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(0, limits::kMaxSamples));
   cmd->add_option("--memory-budget-gb", o->memory_budget_gb,
                   "Skip exact-GP sizes whose dense N x N matrices (16 N^2 bytes fitted, 8 N^2 conditioned) exceed this")
-      ->capture_default_str();
-  cmd->add_option("--inducing", o->settings.inducing, "fitc: pseudo-inputs M")->capture_default_str();
-  cmd->add_option("--frequencies", o->settings.frequencies, "ssgp: spectral points m")->capture_default_str();
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e6, true));
+  cmd->add_option("--inducing", o->settings.inducing, "fitc: pseudo-inputs M")
+      ->capture_default_str()
+      ->check(integer_in(1, limits::kMaxInducing));
+  cmd->add_option("--frequencies", o->settings.frequencies, "ssgp: spectral points m")
+      ->capture_default_str()
+      ->check(integer_in(1, limits::kMaxFrequencies));
   cmd->add_option("--compact-neighbours", o->settings.compact_neighbours,
                   "compact: neighbours per point at the start of the fit")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(1, limits::kMaxNeighbours));
   cmd->add_option("--compact-max-neighbours", o->settings.compact_max_neighbours,
                   "compact: each support radius may grow by this / --compact-neighbours during the fit")
-      ->capture_default_str();
-  cmd->add_option("--threads", o->settings.threads, "Threads inside one fit")->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(1, limits::kMaxNeighbours));
+  cmd->add_option("--threads", o->settings.threads, "Threads inside one fit")
+      ->capture_default_str()
+      ->check(integer_in(1, limits::kMaxThreads));
   cmd->add_option("--system", o->data.system, std::string("Measurement sets: the system. ") + kSystemHelp);
   cmd->add_option("--output", o->data.output, "Measurement sets: the state whose target is learned (default: the first)");
   cmd->add_option("--target", o->target,
                   "Measurement sets: 'residual' (x' - simulator step, the 'sim' preset, RK4 or the model's own integrator) or 'increment' (x' - x)")
       ->capture_default_str();
   cmd->add_option("--test-every", o->data.test_every, "Measurement sets: every k-th sample is held out for testing")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(2, limits::kMaxSamples));
   cmd->callback([o, &action] { action = [o] { return run_profile_command(*o); }; });
 }
 

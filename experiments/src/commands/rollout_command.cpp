@@ -10,7 +10,9 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/core/cost.hpp"
@@ -19,6 +21,8 @@
 #include "gpilqg/experiments/policy_file.hpp"
 #include "gpilqg/experiments/run_setup.hpp"
 #include "gpilqg/experiments/task_actions.hpp"
+#include "option_checks.hpp"
+#include "output_options.hpp"
 #include "world_options.hpp"
 
 namespace gpilqg::cli {
@@ -58,6 +62,7 @@ Episode episode_of(const RealRollout& r, int id, double dt) {
 }
 
 int run_rollout(const RolloutOptions& o) {
+  check_output_file_option("--out", o.out);
   const PolicyFile policy = read_policy_file(o.policy);
   const SystemSignature signature = system_signature(o.world.system);
   if (policy.state_names != names_of(signature.states) || policy.control_names != names_of(signature.controls))
@@ -65,7 +70,6 @@ int run_rollout(const RolloutOptions& o) {
                                  o.policy, fmt::join(policy.state_names, ", "), fmt::join(policy.control_names, ", "),
                                  o.world.system, fmt::join(names_of(signature.states), ", "),
                                  fmt::join(names_of(signature.controls), ", ")));
-  if (o.episodes < 1) throw InputError(fmt::format("--episodes {}: expected >= 1", o.episodes));
   const int n = static_cast<int>(signature.states.size());
   const int m = static_cast<int>(signature.controls.size());
 
@@ -75,7 +79,6 @@ int run_rollout(const RolloutOptions& o) {
                                  o.world.system));
   const auto integrator = parse_integrator(o.integrator);
   if (!integrator) throw InputError("--integrator '" + o.integrator + "': expected 'euler' or 'rk4'");
-  if (o.substeps < 1) throw InputError(fmt::format("--substeps {}: expected >= 1", o.substeps));
   std::shared_ptr<const StepModel> world;
   try {
     world = make_step_model(dynamics, *integrator, policy.dt, o.substeps);
@@ -88,6 +91,9 @@ int run_rollout(const RolloutOptions& o) {
   setup.x0 = o.x0.empty() ? Vector(policy.policy.x_bar.col(0)) : Vector(Eigen::Map<const Vector>(o.x0.data(), static_cast<Eigen::Index>(o.x0.size())));
   if (setup.x0.size() != n) throw InputError(fmt::format("--x0: {} values; expected {} (one per state)", o.x0.size(), n));
   setup.horizon = policy.policy.horizon();
+  if (static_cast<double>(o.episodes) * (setup.horizon + 1) > static_cast<double>(limits::kMaxSamples))
+    throw InputError(fmt::format("--episodes {} of {} steps: more than {} samples (the sample limit)", o.episodes,
+                                 setup.horizon + 1, limits::kMaxSamples));
   setup.exploration_std = per_quantity(o.exploration, m, "--exploration", Vector());
   setup.observation_std = per_quantity(o.observation_noise, n, "--observation-noise", Vector());
   setup.u_min = policy.policy.u_min;
@@ -153,19 +159,26 @@ void add_rollout_command(CLI::App& app, CommandAction& action) {
   o->integrator_option = cmd->add_option("--integrator", o->integrator, "euler or rk4 (not for MuJoCo models)")
                              ->capture_default_str();
   o->substeps_option = cmd->add_option("--substeps", o->substeps, "Integrator sub-steps per policy step (not for "
-                                                                  "MuJoCo models)")->capture_default_str();
-  cmd->add_option("--episodes", o->episodes, "Number of episodes")->capture_default_str();
+                                                                  "MuJoCo models)")
+                           ->capture_default_str()
+                           ->check(integer_in(1, limits::kMaxSubsteps));
+  cmd->add_option("--episodes", o->episodes, "Number of episodes")
+      ->capture_default_str()
+      ->check(integer_in(1, limits::kMaxRollouts));
   cmd->add_option("--exploration", o->exploration,
                   "Std of Gaussian noise added to each control: one value, or one per control (comma-separated)")
       ->delimiter(',');
   cmd->add_option("--observation-noise", o->observation_noise,
                   "Std of the noise on each measured state: one value, or one per state (comma-separated)")
       ->delimiter(',');
-  cmd->add_option("--x0", o->x0, "Initial state, comma-separated (default: the policy's x_bar at t = 0)")->delimiter(',');
+  cmd->add_option("--x0", o->x0, "Initial state, comma-separated (default: the policy's x_bar at t = 0)")
+      ->delimiter(',')
+      ->check(number_in(-kDivergedStateMagnitude, kDivergedStateMagnitude));
   cmd->add_option("--cost", o->cost_config, "A `gpilqg plan` config: print each episode's task cost (of its true "
                                             "states and applied controls)");
   cmd->add_option("--seed", o->seed, "Random seed; with `gpilqg plan --seed` the same seed gives `gpilqg run`'s draws")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
   cmd->callback([&action, o] { action = [o] { return run_rollout(*o); }; });
 }
 

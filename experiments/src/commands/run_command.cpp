@@ -9,7 +9,10 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
+#include "output_options.hpp"
 #include "stop_signal.hpp"
+#include "gpilqg/core/limits.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/plot_script.hpp"
 #include "gpilqg/experiments/run_checkpoint.hpp"
@@ -59,12 +62,14 @@ void print_summary(const RunResults& results) {
 }
 
 int run_command(const RunArguments& a) {
+  const std::filesystem::path out = a.out.empty() ? std::filesystem::path("out") / ("run_" + a.system + ".h5") : std::filesystem::path(a.out);
+  check_output_file_option("--out", out);
+  if (!a.no_plots) check_output_folder_option("--plots", a.plots);
+  if (a.first_seed + static_cast<std::uint64_t>(a.seeds) - 1 > limits::kMaxSeed)
+    throw InputError(fmt::format("--first-seed {} --seeds {}: the last seed exceeds {} (the largest seed)", a.first_seed, a.seeds,
+                                 limits::kMaxSeed));
   RunConfig config = load_run_config(a.system, a.config.empty() ? std::nullopt : std::optional<std::filesystem::path>(a.config));
-  if (a.iterations >= 0) {
-    if (a.iterations < 1) throw InputError(fmt::format("--iterations {}: expected >= 1", a.iterations));
-    config.iterations = a.iterations;
-  }
-  if (a.seeds < 1) throw InputError(fmt::format("--seeds {}: expected >= 1", a.seeds));
+  if (a.iterations > 0) config.iterations = a.iterations;  // validated by its option check
   RunOptions options;
   options.seeds.clear();
   for (int s = 0; s < a.seeds; ++s) options.seeds.push_back(a.first_seed + static_cast<std::uint64_t>(s));
@@ -76,13 +81,13 @@ int run_command(const RunArguments& a) {
     }
   }
   options.progress = [](const std::string& line) { std::cerr << line << std::endl; };
-  const std::filesystem::path out = a.out.empty() ? std::filesystem::path("out") / ("run_" + a.system + ".h5") : std::filesystem::path(a.out);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
 
   // Every completed iteration goes to the checkpoint folder beside the result (run_checkpoint.hpp);
   // Ctrl-C stops at the next iteration boundary, leaving any previous result file as it was.
   const std::filesystem::path folder = RunCheckpoint::folder_for(out);
   RunCheckpoint checkpoint = a.resume ? RunCheckpoint::resume(folder, config, options) : RunCheckpoint::create(folder, config, options);
+  remove_stale_temporaries_in(folder);
   const StopSignalGuard stop_signal;
   checkpoint.set_stop_requested(&StopSignalGuard::stop_requested);
   options.journal = &checkpoint;
@@ -114,9 +119,11 @@ void add_run_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("SYSTEM", args->system, kSystemHelp)
       ->required();
   cmd->add_option("--config", args->config, "TOML file overriding the embedded defaults (experiments/configs/run_SYSTEM.toml)");
-  cmd->add_option("--seeds", args->seeds, "number of seeds (default 1)");
-  cmd->add_option("--first-seed", args->first_seed, "the first seed (default 1); seeds are consecutive");
-  cmd->add_option("--iterations", args->iterations, "cap on GP-ILQG iterations per task (overrides loop.iterations)");
+  cmd->add_option("--seeds", args->seeds, "number of seeds (default 1)")->check(integer_in(1, limits::kMaxSeeds));
+  cmd->add_option("--first-seed", args->first_seed, "the first seed (default 1); seeds are consecutive")
+      ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
+  cmd->add_option("--iterations", args->iterations, "cap on GP-ILQG iterations per task (overrides loop.iterations)")
+      ->check(integer_in(1, limits::kMaxLoopIterations));
   cmd->add_option("--backends", args->backends, "compare GP backends inside the loop, e.g. exact,fitc,ssgp");
   cmd->add_option("--out", args->out, "result file (default out/run_SYSTEM.h5)");
   cmd->add_option("--plots", args->plots, "folder for the PNG figures (default: beside the result)");

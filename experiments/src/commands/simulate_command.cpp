@@ -8,9 +8,12 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/synthetic_data.hpp"
+#include "option_checks.hpp"
+#include "output_options.hpp"
 #include "world_options.hpp"
 
 namespace gpilqg::cli {
@@ -28,6 +31,7 @@ struct SimulateOptions {
 };
 
 int run_simulate(const SimulateOptions& o) {
+  check_output_file_option("--out", o.out);
   const auto signature = system_signature(o.world.system);
   const int n = static_cast<int>(signature.states.size());
   const auto system = build_world(o.world);
@@ -38,6 +42,10 @@ int run_simulate(const SimulateOptions& o) {
   if (o.dt > 0.0) settings.dt = o.dt;
   if (o.observation_noise >= 0.0) settings.observation_std = Vector::Constant(n, o.observation_noise);
   settings.seed = o.seed;
+  if (static_cast<double>(settings.episodes) * settings.steps > static_cast<double>(limits::kMaxSamples))
+    throw InputError(fmt::format("--episodes {} x --steps {}: {} samples; expected at most {} (the sample limit)",
+                                 settings.episodes, settings.steps, static_cast<double>(settings.episodes) * settings.steps,
+                                 limits::kMaxSamples));
 
   SyntheticData data = simulate_measurements(system, settings);
   data.set.system = signature;
@@ -58,12 +66,17 @@ void add_simulate_command(CLI::App& app, CommandAction& action) {
   auto* cmd = app.add_subcommand(
       "simulate", "Write synthetic measurements: a system preset under random excitation, with noise");
   add_world_options(*cmd, options->world);
-  cmd->add_option("--episodes", options->episodes, "Number of episodes (default per system)");
-  cmd->add_option("--steps", options->steps, "Samples per episode (default per system)");
-  cmd->add_option("--dt", options->dt, "Sampling step in seconds (default 0.02)");
+  cmd->add_option("--episodes", options->episodes, "Number of episodes (default per system)")
+      ->check(integer_in(1, limits::kMaxRollouts));
+  cmd->add_option("--steps", options->steps, "Samples per episode (default per system)")
+      ->check(integer_in(2, limits::kMaxSamples));
+  cmd->add_option("--dt", options->dt, "Sampling step in seconds (default 0.02)")->check(positive_number());
   cmd->add_option("--observation-noise", options->observation_noise,
-                  "Std of Gaussian noise on each recorded state (default 1e-3)");
-  cmd->add_option("--seed", options->seed, "Random seed; the same seed gives the same file")->capture_default_str();
+                  "Std of Gaussian noise on each recorded state (default 1e-3)")
+      ->check(non_negative_number());
+  cmd->add_option("--seed", options->seed, "Random seed; the same seed gives the same file")
+      ->capture_default_str()
+      ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
   cmd->add_option("--out", options->out, "Output file (.csv, .h5 or .hdf5)")->required();
   cmd->callback([&action, options] { action = [options] { return run_simulate(*options); }; });
 }

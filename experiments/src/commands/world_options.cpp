@@ -1,5 +1,7 @@
 #include "world_options.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "gpilqg/core/effect_library.hpp"
@@ -35,9 +37,10 @@ std::map<std::string, double> parse_assignments(const std::vector<std::string>& 
       std::size_t used = 0;
       const double value = std::stod(item.substr(eq + 1), &used);
       if (used != item.size() - eq - 1) throw std::invalid_argument("trailing text");
+      if (!std::isfinite(value)) throw std::invalid_argument("not finite");
       out[item.substr(0, eq)] = value;
     } catch (const std::exception&) {
-      throw InputError(fmt::format("{} '{}': the value is not a number", option, item));
+      throw InputError(fmt::format("{} '{}': the value is not a finite number", option, item));
     }
   }
   return out;

@@ -126,12 +126,7 @@ std::string model_file_text(const ModelSpec& model, const std::vector<std::strin
 }
 
 void write_model_file(const std::filesystem::path& file, const ModelSpec& model, const std::vector<std::string>& comment) {
-  write_atomically(file, [&](const std::filesystem::path& temporary) {
-    std::ofstream out(temporary);
-    out << model_file_text(model, comment);
-    out.close();
-    if (!out) throw InputError(fmt::format("{}: cannot write the model file; expected a writable path", file.string()));
-  });
+  write_file_atomically(file, model_file_text(model, comment));
 }
 
 EffectRequest parse_add_option(const std::string& text, const std::string& system, const std::string& option) {

@@ -21,6 +21,8 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace gpilqg {
 
@@ -35,6 +37,21 @@ class AtomicWriteError : public std::runtime_error {
 
  private:
   std::filesystem::path target_;
+  std::string problem_;
+};
+
+/// A write(2), fsync(2) or close(2) that failed on a file being written (a full disk, a file-size
+/// limit, an I/O error). write_atomically turns it into an AtomicWriteError that names the target.
+class FileWriteError : public std::runtime_error {
+ public:
+  FileWriteError(const std::filesystem::path& file, const std::string& step, int error_number);
+  /// The errno of the failed call.
+  int error_number() const { return error_number_; }
+  /// "<step> failed (<strerror>)", without the file name.
+  const std::string& problem() const { return problem_; }
+
+ private:
+  int error_number_;
   std::string problem_;
 };
 
@@ -53,8 +70,28 @@ void write_atomically(const std::filesystem::path& target,
 void update_atomically(const std::filesystem::path& target,
                        const std::function<void(const std::filesystem::path& temporary)>& writer);
 
+/// Creates `file` (it must not exist) and writes `bytes` to it with every write(2) checked, then
+/// fsync(2) and close(2), both checked: the one place where result bytes meet the disk. Throws
+/// FileWriteError naming the failed step and the OS error; a partly written file is left for the
+/// caller (write_atomically removes its temporary).
+void write_new_file(const std::filesystem::path& file, std::string_view bytes);
+
+/// write_atomically with write_new_file: the whole of `bytes` replaces `target`, or nothing changes.
+void write_file_atomically(const std::filesystem::path& target, std::string_view bytes);
+
 /// A fresh temporary name beside `target`: "<target>.tmp-<pid>-<n>" with n counting up per process.
+/// When that name would exceed the file system's limit of 255 bytes per name, the target's name is
+/// shortened to its first bytes plus "~" and 8 hex digits of a hash of the whole name, so that a
+/// legal target name always has a legal temporary name.
 std::filesystem::path atomic_temporary_path(const std::filesystem::path& target);
+
+/// Temporary files of `target` (named as atomic_temporary_path names them) whose process no longer
+/// runs: the leftovers of an interrupted write (SIGKILL, power loss). Files of running processes,
+/// including this one, are not listed.
+std::vector<std::filesystem::path> stale_temporaries(const std::filesystem::path& target);
+
+/// The same for every atomic temporary in `folder` (e.g. a checkpoint folder).
+std::vector<std::filesystem::path> stale_temporaries_in(const std::filesystem::path& folder);
 
 /// True when `file`'s name has the form "<name>.tmp-<digits>-<digits>" (a leftover temporary of an
 /// interrupted atomic write), for clean-up tools.

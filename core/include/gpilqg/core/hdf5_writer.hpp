@@ -18,8 +18,11 @@ namespace gpilqg {
 
 class Hdf5Writer {
  public:
-  /// Creates (or truncates) `file`. Throws std::runtime_error naming the file when it cannot.
+  /// Starts the file `file` (replacing any file there when it is written). It is built in memory and
+  /// written to the disk by close() in one checked write (hdf5_memory_file.hpp); callers write to a
+  /// write_atomically temporary.
   explicit Hdf5Writer(const std::filesystem::path& file);
+  /// Writes the file when close() was not called, ignoring errors; dropped during stack unwinding.
   ~Hdf5Writer();
   Hdf5Writer(const Hdf5Writer&) = delete;
   Hdf5Writer& operator=(const Hdf5Writer&) = delete;
@@ -46,7 +49,8 @@ class Hdf5Writer {
   /// A soft link at `path` to the object `target` (h5py follows it transparently).
   void link(const std::string& path, const std::string& target);
 
-  /// Flushes and closes the file (also done by the destructor); later calls throw.
+  /// Writes the file to the disk and closes it; throws FileWriteError when the disk refuses (full,
+  /// file-size limit, I/O error). Later calls throw.
   void close();
 
  private:

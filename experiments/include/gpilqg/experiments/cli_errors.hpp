@@ -28,6 +28,8 @@ class InputError : public std::runtime_error {
 
 /// Runs `command` and turns exceptions into the exit-status contract, writing to `err`:
 /// DataError, InputError and std::invalid_argument -> "error: <message>", exit 2;
+/// a result file the disk refused (AtomicWriteError, FileWriteError: full disk, file-size limit,
+/// I/O error) -> "error: <file>: <problem>; the previous file is unchanged", exit 1;
 /// any other exception -> "internal error: <message>", exit 1.
 int run_reporting_errors(const std::function<int()>& command, std::ostream& err);
 

@@ -1,0 +1,23 @@
+#pragma once
+/// @file output_path.hpp
+/// Checks of a path that a command will write, made before any computation, so that a wrong
+/// `--out` costs nothing: a result file is replaced by an atomic rename (atomic_file.hpp), which
+/// needs a writable folder and must never replace a device, a FIFO or a folder.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace gpilqg {
+
+/// Why `file` cannot receive a result file, or nullopt when it can. It must be absent, a regular
+/// file or a symbolic link (the link is replaced, never written through); its name must fit the
+/// file system's limit (255 bytes); its folder, or the nearest existing ancestor when the folder
+/// will be created, must be a folder this process can write into.
+std::optional<std::string> output_file_problem(const std::filesystem::path& file);
+
+/// Why `folder` cannot receive output files (e.g. figures), or nullopt when it can: it must be a
+/// folder or absent, and it or its nearest existing ancestor must be writable.
+std::optional<std::string> output_folder_problem(const std::filesystem::path& folder);
+
+}  // namespace gpilqg

@@ -1,0 +1,72 @@
+/// Output paths checked before any work: kind of the existing entry, name length, writable folder.
+
+#include "gpilqg/core/output_path.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <system_error>
+
+namespace gpilqg {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kMaxFileNameBytes = 255;
+
+/// "a folder", "a FIFO", ... for an entry that is not a regular file or a link.
+const char* kind_of(fs::file_type type) {
+  switch (type) {
+    case fs::file_type::directory: return "a folder";
+    case fs::file_type::fifo: return "a FIFO (named pipe)";
+    case fs::file_type::socket: return "a socket";
+    case fs::file_type::character: return "a character device";
+    case fs::file_type::block: return "a block device";
+    default: return "not a regular file";
+  }
+}
+
+/// The folder that will hold `path`'s entry, or the nearest ancestor of it that exists; checked
+/// for being a folder this process may create files in (access(2) with W_OK | X_OK).
+std::optional<std::string> folder_problem(fs::path folder) {
+  std::error_code error;
+  folder = fs::absolute(folder.empty() ? fs::path(".") : folder, error);
+  if (error) return "cannot resolve the folder (" + error.message() + ")";
+  while (!fs::exists(fs::status(folder, error)) && folder.has_parent_path() && folder.parent_path() != folder)
+    folder = folder.parent_path();
+  const fs::file_status status = fs::status(folder, error);
+  if (error) return "cannot inspect the folder " + folder.string() + " (" + error.message() + ")";
+  if (status.type() != fs::file_type::directory)
+    return folder.string() + " is " + kind_of(status.type()) + "; expected a folder";
+  if (::access(folder.c_str(), W_OK | X_OK) != 0)
+    return "the folder " + folder.string() + " is not writable (" + std::strerror(errno) + ")";
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::string> output_file_problem(const fs::path& file) {
+  if (file.empty() || !file.has_filename()) return std::string("expected a file name, not a folder path");
+  if (file.filename().string().size() > kMaxFileNameBytes)
+    return "the file name has " + std::to_string(file.filename().string().size()) + " bytes; expected at most " +
+           std::to_string(kMaxFileNameBytes);
+  std::error_code error;
+  const fs::file_status own = fs::symlink_status(file, error);
+  if (error && error != std::errc::no_such_file_or_directory)
+    return "cannot inspect it (" + error.message() + ")";
+  if (fs::exists(own) && own.type() != fs::file_type::regular && own.type() != fs::file_type::symlink)
+    return std::string("is ") + kind_of(own.type()) + "; expected a regular file or a new file name";
+  return folder_problem(file.parent_path());
+}
+
+std::optional<std::string> output_folder_problem(const fs::path& folder) {
+  std::error_code error;
+  const fs::file_status status = fs::status(folder, error);
+  if (fs::exists(status) && status.type() != fs::file_type::directory)
+    return std::string("is ") + kind_of(status.type()) + "; expected a folder";
+  return folder_problem(folder);
+}
+
+}  // namespace gpilqg

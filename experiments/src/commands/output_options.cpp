@@ -1,0 +1,46 @@
+/// Output options checked before any work; leftovers of interrupted writes removed and named.
+
+#include "output_options.hpp"
+
+#include <iostream>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/output_path.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+
+namespace gpilqg::cli {
+
+namespace {
+
+void remove_and_name(const std::vector<std::filesystem::path>& stale) {
+  for (const auto& file : stale) {
+    std::error_code error;
+    if (std::filesystem::remove(file, error))
+      std::cerr << fmt::format("note: removed {}, a temporary file left by an interrupted write\n", file.string());
+    else
+      std::cerr << fmt::format("note: {} is a temporary file left by an interrupted write; it could not be removed ({})\n",
+                               file.string(), error.message());
+  }
+}
+
+}  // namespace
+
+void check_output_file_option(const std::string& option, const std::filesystem::path& file) {
+  if (file.empty()) return;
+  if (const auto problem = output_file_problem(file))
+    throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
+  remove_and_name(stale_temporaries(file));
+}
+
+void check_output_folder_option(const std::string& option, const std::filesystem::path& folder) {
+  if (folder.empty()) return;
+  if (const auto problem = output_folder_problem(folder))
+    throw InputError(fmt::format("{} {}: {}", option, folder.string(), *problem));
+}
+
+void remove_stale_temporaries_in(const std::filesystem::path& folder) { remove_and_name(stale_temporaries_in(folder)); }
+
+}  // namespace gpilqg::cli

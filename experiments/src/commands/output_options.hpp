@@ -1,0 +1,22 @@
+#pragma once
+/// @file output_options.hpp
+/// What every command does with its output options (--out, --plots, --write-model) before any
+/// computation: a path that cannot be written is bad input (InputError, exit 2) now rather than an
+/// error after minutes of work, and temporary files left beside the target by an interrupted earlier
+/// write (atomic_file.hpp) are removed and named on stderr.
+
+#include <filesystem>
+#include <string>
+
+namespace gpilqg::cli {
+
+/// Checks `file` with output_file_problem (output_path.hpp); an empty path (option not given) passes.
+void check_output_file_option(const std::string& option, const std::filesystem::path& file);
+
+/// Checks `folder` with output_folder_problem; an empty path passes.
+void check_output_folder_option(const std::string& option, const std::filesystem::path& folder);
+
+/// Removes the temporaries of interrupted writes in `folder` (stale_temporaries_in), naming them on stderr.
+void remove_stale_temporaries_in(const std::filesystem::path& folder);
+
+}  // namespace gpilqg::cli
