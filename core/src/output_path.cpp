@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 
 constexpr std::size_t kMaxFileNameBytes = 255;
 
-/// "a folder", "a FIFO", ... for an entry that is not a regular file or a link.
+/// "a folder", "a FIFO", "a regular file", ...: the kind of an entry, for messages.
 const char* kind_of(fs::file_type type) {
   switch (type) {
     case fs::file_type::directory: return "a folder";
@@ -24,7 +24,8 @@ const char* kind_of(fs::file_type type) {
     case fs::file_type::socket: return "a socket";
     case fs::file_type::character: return "a character device";
     case fs::file_type::block: return "a block device";
-    default: return "not a regular file";
+    case fs::file_type::regular: return "a regular file";
+    default: return "neither a file nor a folder";
   }
 }
 
@@ -54,7 +55,7 @@ std::optional<std::string> output_file_problem(const fs::path& file) {
            std::to_string(kMaxFileNameBytes);
   std::error_code error;
   const fs::file_status own = fs::symlink_status(file, error);
-  if (error && error != std::errc::no_such_file_or_directory)
+  if (error && error != std::errc::no_such_file_or_directory && error != std::errc::not_a_directory)
     return "cannot inspect it (" + error.message() + ")";
   if (fs::exists(own) && own.type() != fs::file_type::regular && own.type() != fs::file_type::symlink)
     return std::string("is ") + kind_of(own.type()) + "; expected a regular file or a new file name";

@@ -134,9 +134,10 @@ TEST(AtomicFile, MeasurementWritersLeaveThePreviousFileOnFailure) {
     EXPECT_THROW(write_measurements(file, bad), std::invalid_argument);
     EXPECT_EQ(contents(file), before) << name;
   }
-  // A folder in the way is a DataError naming the file (bad input, exit status 2 in the CLI).
+  // A folder in the way fails the rename: an AtomicWriteError naming the file (the CLI refuses such
+  // an --out before any work, output_path.hpp).
   std::filesystem::create_directory(dir / "taken.csv");
-  EXPECT_THROW(write_measurements(dir / "taken.csv", set), DataError);
+  EXPECT_THROW(write_measurements(dir / "taken.csv", set), AtomicWriteError);
   EXPECT_EQ(listing(dir), (std::vector<std::string>{"data.csv", "data.h5", "taken.csv"}));
 }
 

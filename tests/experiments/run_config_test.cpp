@@ -78,7 +78,14 @@ TEST(RunConfig, BadInputNamesFileLineAndField) {
   EXPECT_NE(error_of("cartpole", "[noise]\nobservation = [0.1, 0.1]\n").find("user.toml:line 2: field 'noise.observation': has 2 entries; expected 4"),
             std::string::npos);
   EXPECT_NE(error_of("cartpole", "[gp]\nbackend = \"gpflow\"\n").find("unknown GP backend 'gpflow'"), std::string::npos);
-  EXPECT_NE(error_of("cartpole", "[loop]\nrollouts = 0\n").find("field 'loop.rollouts': is 0; expected >= 1"),
+  EXPECT_NE(error_of("cartpole", "[loop]\nrollouts = 0\n").find("field 'loop.rollouts': is 0; expected an integer from 1 to 100000"),
+            std::string::npos);
+  // The documented limits (limits.hpp) hold before anything is allocated.
+  EXPECT_NE(error_of("cartpole", "[loop]\niterations = 1000000000\n").find("field 'loop.iterations': is 1000000000; expected an integer from 1 to 1000"),
+            std::string::npos);
+  EXPECT_NE(error_of("cartpole", "[gp]\nrestarts = 1000000000\n").find("field 'gp.restarts': is 1000000000; expected an integer from 0 to 1000"),
+            std::string::npos);
+  EXPECT_NE(error_of("cartpole", "[gp]\nfrequencies = 100000000\n").find("field 'gp.frequencies': is 100000000; expected an integer from 1 to 4096"),
             std::string::npos);
   EXPECT_NE(error_of("cartpole", "[system]\nname = \"quadrotor\"\n").find("but the command runs 'cartpole'"),
             std::string::npos);
