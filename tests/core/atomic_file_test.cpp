@@ -2,6 +2,11 @@
 /// previous file byte for byte and no temporary file behind; the measurement writers go through it.
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 
 #include <fstream>
 #include <iterator>
@@ -139,6 +144,67 @@ TEST(AtomicFile, MeasurementWritersLeaveThePreviousFileOnFailure) {
   std::filesystem::create_directory(dir / "taken.csv");
   EXPECT_THROW(write_measurements(dir / "taken.csv", set), AtomicWriteError);
   EXPECT_EQ(listing(dir), (std::vector<std::string>{"data.csv", "data.h5", "taken.csv"}));
+}
+
+TEST(AtomicFile, TemporaryNamesFitTheFileNameLimitAndStayRecognisable) {
+  const auto dir = test::temporary_dir("atomic_names");
+  for (const std::size_t length : {1u, 200u, 250u, 255u}) {
+    const std::filesystem::path target = dir / std::string(length, 'n');
+    const std::filesystem::path temporary = atomic_temporary_path(target);
+    EXPECT_LE(temporary.filename().string().size(), 255u) << length;
+    EXPECT_EQ(temporary.parent_path(), dir);
+    EXPECT_TRUE(is_atomic_temporary(temporary)) << temporary;
+    write_file_atomically(target, "contents");
+    EXPECT_EQ(contents(target), "contents") << length;
+  }
+  // Two long names that differ only at their end get different temporary names.
+  const std::string a = atomic_temporary_path(dir / (std::string(250, 'n') + "a")).filename().string();
+  const std::string b = atomic_temporary_path(dir / (std::string(250, 'n') + "b")).filename().string();
+  EXPECT_NE(a.substr(0, a.rfind(".tmp-")), b.substr(0, b.rfind(".tmp-")));
+}
+
+TEST(AtomicFile, StaleTemporariesAreThoseOfProcessesThatEnded) {
+  const auto dir = test::temporary_dir("atomic_stale");
+  const std::filesystem::path target = dir / "result.h5";
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);
+  auto named = [&](long pid) {
+    std::string name = atomic_temporary_path(target).filename().string();
+    return dir / (name.substr(0, name.rfind(".tmp-") + 5) + std::to_string(pid) + "-3");
+  };
+  for (const auto& file : {named(child), named(::getpid()), named(1), dir / "other.h5.tmp-1-1"}) std::ofstream(file) << "x";
+  EXPECT_EQ(stale_temporaries(target), std::vector<std::filesystem::path>{named(child)});
+  EXPECT_EQ(stale_temporaries_in(dir), std::vector<std::filesystem::path>{named(child)});
+}
+
+TEST(AtomicFile, AFileSizeLimitFailsTheWriteWithTheOsErrorAndKeepsThePreviousFile) {
+  // RLIMIT_FSIZE makes every write beyond the limit fail (EFBIG once SIGXFSZ is ignored): an
+  // injected write failure, in a child process so that the limit does not outlive the test.
+  const auto dir = test::temporary_dir("atomic_fsize");
+  const std::filesystem::path target = dir / "result.bin";
+  write_file_atomically(target, "previous");
+  const pid_t child = ::fork();
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{4096, 4096};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      write_file_atomically(target, std::string(100000, 'x'));
+    } catch (const AtomicWriteError& e) {
+      const std::string what = e.what();
+      const bool named = what.find(target.string() + ": not written: writing failed (File too large)") == 0 &&
+                         what.find("the previous file is unchanged") != std::string::npos;
+      ::_exit(named ? 0 : 2);
+    }
+    ::_exit(3);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "3: no error; 2: the message did not name the file and the OS error";
+  EXPECT_EQ(contents(target), "previous");
+  EXPECT_EQ(listing(dir), std::vector<std::string>{"result.bin"});
 }
 
 }  // namespace
