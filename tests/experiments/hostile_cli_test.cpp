@@ -50,31 +50,13 @@ std::vector<std::string> listing(const fs::path& folder) {
   return names;
 }
 
-constexpr const char* kPlanConfig = R"([system]
-name = "cartpole"
-preset = "sim"
-integrator = "rk4"
-substeps = 10
-dt = 0.05
-[problem]
-horizon = 15
-x0 = [0.0, 0.0, 0.3, 0.0]
-goal = [0.0, 0.0, 0.0, 0.0]
-Q = [1.0, 1.0, 1.0, 1.0]
-R = [0.1]
-Qf = [10.0, 10.0, 10.0, 10.0]
-u_init = [0.0]
-[solver]
-max_iterations = 30
-)";
-
 /// The inputs every writer below reads: a measurement file, a run and a plan config, a policy file.
 struct Inputs {
   fs::path data, run_config, plan_config, policy;
 };
 
 Inputs make_inputs(const fs::path& dir) {
-  Inputs in{dir / "data.csv", write(dir / "run.toml", test::kTinyRun), write(dir / "plan.toml", kPlanConfig),
+  Inputs in{dir / "data.csv", write(dir / "run.toml", test::kTinyRun), write(dir / "plan.toml", test::kTinyPlan),
             dir / "policy.h5"};
   EXPECT_EQ(test::run_cli("simulate --system cartpole --episodes 4 --steps 60 --out " + quote(in.data)).status, 0);
   EXPECT_EQ(test::run_cli("plan " + quote(in.plan_config) + " --out " + quote(in.policy)).status, 0);

@@ -16,6 +16,7 @@
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/policy_file.hpp"
 #include "test_support.hpp"
+#include "tiny_run_config.hpp"
 
 namespace gpilqg {
 namespace {
@@ -58,34 +59,6 @@ track_line = false
 transfer = false
 )";
 
-/// ... and the same problem as a `gpilqg plan` config (the cart-pole run defaults made explicit).
-constexpr const char* kPlanConfig = R"([system]
-name = "cartpole"
-preset = "sim"
-integrator = "rk4"
-substeps = 10
-dt = 0.05
-[noise]
-actuator_multiplicative = [0.02]
-[problem]
-horizon = 15
-x0 = [0.0, 0.0, 0.3, 0.0]
-goal = [0.0, 0.0, 0.0, 0.0]
-Q = [1.0, 1.0, 1.0, 1.0]
-R = [0.1]
-Qf = [10.0, 10.0, 10.0, 10.0]
-u_min = [-25.0]
-u_max = [25.0]
-u_init = [0.0]
-[solver]
-max_iterations = 30
-tolerance = 1e-6
-gradient_tolerance = 1e-4
-[gp]
-exact_points = 40
-restarts = 0
-max_evaluations = 40
-)";
 
 /// The rollout options of the run's world and loop: its noise, exploration and rollouts per round.
 constexpr const char* kRolloutOptions =
@@ -123,7 +96,7 @@ TEST(PlanCli, AScriptedLoopOfPlanAndRolloutGivesRunsGpIlqgPolicies) {
   const auto run = test::run_cli("run cartpole --config " + quote(write(dir / "run.toml", kRunConfig)) +
                                  " --seeds 1 --first-seed 7 --out " + quote(dir / "run.h5"));
   ASSERT_EQ(run.status, 0) << run.err;
-  scripted_loop(dir, write(dir / "plan.toml", kPlanConfig), 3, 7);
+  scripted_loop(dir, write(dir / "plan.toml", test::kTinyPlan), 3, 7);
   const Hdf5Reader results(dir / "run.h5");
   for (int k = 0; k <= 3; ++k) {
     SCOPED_TRACE(fmt::format("round {}", k));
@@ -148,7 +121,7 @@ TEST(PlanCli, AScriptedLoopOfPlanAndRolloutGivesRunsGpIlqgPolicies) {
 
 TEST(PlanCli, ThePolicyFileHasTheContractsLayoutAndJsonTheSameContent) {
   const fs::path dir = test::temporary_dir("plan_layout");
-  const fs::path config = write(dir / "plan.toml", kPlanConfig);
+  const fs::path config = write(dir / "plan.toml", test::kTinyPlan);
   scripted_loop(dir, config, 1, 3);
   const auto r = plan(config, "--seed 3 --data " + quote(dir / "d0.h5") + " --previous " + quote(dir / "p0.h5") +
                                   " --out " + quote(dir / "p1_json.h5") + " --json");
@@ -193,7 +166,7 @@ TEST(PlanCli, ThePolicyFileHasTheContractsLayoutAndJsonTheSameContent) {
 
 TEST(PlanCli, RolloutLogsTheMeasuredStatesAndAppliedControlsInCsvOrHdf5) {
   const fs::path dir = test::temporary_dir("rollout_log");
-  ASSERT_EQ(plan(write(dir / "plan.toml", kPlanConfig), "--out " + quote(dir / "p.h5")).status, 0);
+  ASSERT_EQ(plan(write(dir / "plan.toml", test::kTinyPlan), "--out " + quote(dir / "p.h5")).status, 0);
   const std::string common = " --system cartpole --policy " + quote(dir / "p.h5") + " --seed 5" + kRolloutOptions;
   for (const char* out : {"log.csv", "log.h5"}) {
     const auto r = test::run_cli("rollout" + common + " --out " + quote(dir / out));
@@ -284,7 +257,7 @@ void expect_bad_input(const test::CommandResult& r, const std::vector<std::strin
 
 TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   const fs::path dir = test::temporary_dir("plan_errors");
-  const fs::path config = write(dir / "plan.toml", kPlanConfig);
+  const fs::path config = write(dir / "plan.toml", test::kTinyPlan);
   ASSERT_EQ(plan(config, "--out " + quote(dir / "p0.h5")).status, 0);
   const std::string p0 = quote(dir / "p0.h5");
 
@@ -293,13 +266,13 @@ TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   ASSERT_EQ(test::run_cli("simulate --system cartpole --episodes 1 --steps 20 --dt 0.02 --out " + quote(dir / "fast.csv")).status, 0);
   expect_bad_input(plan(config, "--data " + quote(dir / "fast.csv") + " --out " + quote(dir / "x.h5")),
                    {"fast.csv", "episode 0", "0.05"});
-  std::string text = kPlanConfig;
+  std::string text = test::kTinyPlan;
   text.replace(text.find("max_iterations = 30"), 19, "max_iterations = 30\nalgorithm = \"ilqr\"");
   expect_bad_input(plan(write(dir / "ilqr.toml", text), "--out " + quote(dir / "x.h5")), {"ilqr.toml:line 21", "solver.algorithm"});
-  expect_bad_input(plan(write(dir / "gp.toml", std::string(kPlanConfig) + "points = 3\n"), "--out " + quote(dir / "x.h5")),
+  expect_bad_input(plan(write(dir / "gp.toml", std::string(test::kTinyPlan) + "points = 3\n"), "--out " + quote(dir / "x.h5")),
                    {"gp.toml:line 27", "gp.points"});
   // A previous round of another horizon.
-  text = kPlanConfig;
+  text = test::kTinyPlan;
   text.replace(text.find("horizon = 15"), 12, "horizon = 12");
   expect_bad_input(plan(write(dir / "short.toml", text), "--previous " + p0 + " --out " + quote(dir / "x.h5")),
                    {"p0.h5", "horizon", "15", "12"});
