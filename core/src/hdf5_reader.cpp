@@ -2,10 +2,14 @@
 
 #include <algorithm>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 
 #include <H5Cpp.h>
 
+#include "gpilqg/core/dataset_size.hpp"
+#include "gpilqg/core/input_file.hpp"
+#include "gpilqg/core/measurements.hpp"
 #include "hdf5_common.hpp"
 
 namespace gpilqg {
@@ -14,6 +18,7 @@ using hdf5_detail::guarded;
 
 struct Hdf5Reader::Impl {
   H5::H5File file;
+  std::uintmax_t file_bytes = 0;  // what declared sizes are checked against (dataset_size.hpp)
 
   /// Opens the attribute holder at `path`: a group, or a dataset.
   H5::H5Object& object(const std::string& path, H5::Group& group_holder, H5::DataSet& dataset_holder) {
@@ -32,6 +37,19 @@ std::string join(const std::string& group, const std::string& name) {
   return group == "/" ? "/" + name : group + "/" + name;
 }
 
+/// Throws DataError at `object` when the dataset or attribute `id` declares more values than the file
+/// can hold or than kMaxDatasetValues, before anything is allocated for it.
+void check_declared_size(const std::filesystem::path& file, const std::string& object, hid_t id, std::uintmax_t file_bytes) {
+  std::optional<std::string> problem;
+  try {
+    problem = hdf5_size_problem(id, file_bytes);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(file.string() + ": '" + object + "': " + e.what());
+  }
+  if (problem)
+    throw DataError(file, object, *problem, "a dataset that fits the file and at most " + std::to_string(kMaxDatasetValues) + " values");
+}
+
 std::string shape_text(const std::vector<std::uint64_t>& dims) {
   if (dims.empty()) return "a scalar";
   std::string text = "(";
@@ -43,7 +61,7 @@ std::string shape_text(const std::vector<std::uint64_t>& dims) {
 
 Hdf5Reader::Hdf5Reader(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()), file_(file) {
   H5::Exception::dontPrint();
-  if (!std::filesystem::exists(file)) throw std::runtime_error(file.string() + ": no such file");
+  impl_->file_bytes = check_input_file(file, kMaxDataFileBytes, "an HDF5 file");
   guarded(file, "/", "opening", [&] { impl_->file = H5::H5File(file.string(), H5F_ACC_RDONLY); });
 }
 
@@ -101,6 +119,7 @@ std::vector<double> Hdf5Reader::read_array(const std::string& path) const {
     const H5::DataSet set = impl_->file.openDataSet(path);
     if (set.getTypeClass() != H5T_FLOAT && set.getTypeClass() != H5T_INTEGER)
       throw std::runtime_error(file_.string() + ": dataset '" + path + "' is not numeric");
+    check_declared_size(file_, path, set.getId(), impl_->file_bytes);
     const auto count = static_cast<std::size_t>(set.getSpace().getSimpleExtentNpoints());
     std::vector<double> values(count);
     if (count > 0) set.read(values.data(), H5::PredType::NATIVE_DOUBLE);
@@ -151,6 +170,7 @@ std::string Hdf5Reader::string_attribute(const std::string& object, const std::s
     const H5::Attribute a = impl_->object(object, g, d).openAttribute(name);
     if (a.getTypeClass() != H5T_STRING)
       throw std::runtime_error(file_.string() + ": attribute '" + object + "@" + name + "' is not a string");
+    check_declared_size(file_, object + "@" + name, a.getId(), impl_->file_bytes);
     std::string value;
     a.read(a.getStrType(), value);
     return value;
@@ -177,6 +197,7 @@ std::vector<double> Hdf5Reader::number_list_attribute(const std::string& object,
     const H5::Attribute a = impl_->object(object, g, d).openAttribute(name);
     if (a.getTypeClass() != H5T_FLOAT && a.getTypeClass() != H5T_INTEGER)
       throw std::runtime_error(file_.string() + ": attribute '" + object + "@" + name + "' is not numeric");
+    check_declared_size(file_, object + "@" + name, a.getId(), impl_->file_bytes);
     std::vector<double> values(static_cast<std::size_t>(a.getSpace().getSimpleExtentNpoints()));
     if (!values.empty()) a.read(H5::PredType::NATIVE_DOUBLE, values.data());
     return values;
@@ -192,6 +213,7 @@ std::vector<std::string> Hdf5Reader::string_list_attribute(const std::string& ob
     if (!type.isVariableStr())
       throw std::runtime_error(file_.string() + ": attribute '" + object + "@" + name +
                                "' is not a list of variable-length strings");
+    check_declared_size(file_, object + "@" + name, a.getId(), impl_->file_bytes);
     const auto count = static_cast<std::size_t>(a.getSpace().getSimpleExtentNpoints());
     std::vector<char*> raw(count, nullptr);
     if (count > 0) a.read(type, raw.data());

@@ -8,17 +8,21 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string_view>
+#include <unordered_set>
 
 #include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "csv_text.hpp"
 #include "measurements_internal.hpp"
+#include "name_list.hpp"
 
 namespace gpilqg {
 
@@ -30,24 +34,11 @@ using measurements_detail::join;
 std::string line_location(long line) { return fmt::format("line {}", line); }
 
 /// The field as it appears in the file, quoted and shortened for an error message.
-std::string quote_field(std::string_view field) {
-  constexpr std::size_t kMax = 40;
-  if (field.size() > kMax) return fmt::format("'{}...'", field.substr(0, kMax));
-  return fmt::format("'{}'", field);
-}
+std::string quote_field(std::string_view field) { return name_list::quoted(field); }
 
-std::string quoted_list(const std::vector<std::string>& names) {
-  std::vector<std::string> q;
-  for (const auto& name : names) q.push_back(quote_field(name));
-  return join(q);
-}
-
+/// The whole file, after check_input_file (a regular file of at most kMaxDataFileBytes).
 std::string read_whole_file(const std::filesystem::path& file) {
-  std::error_code error;
-  if (!std::filesystem::exists(file, error))
-    throw DataError(file, "", "no such file", "an existing measurement file");
-  if (std::filesystem::is_directory(file, error))
-    throw DataError(file, "", "is a directory", "a measurement file");
+  check_input_file(file, kMaxDataFileBytes, "a measurement file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw DataError(file, "", "cannot open the file for reading", "a readable measurement file");
   std::ostringstream contents;
@@ -104,35 +95,37 @@ class CsvReader {
   }
 
  private:
+  /// Compares the header with the expected columns in time linear in its width (hash sets), and
+  /// names at most name_list::kMaxListedNames columns of each kind, so that a header of any width
+  /// gives a short message.
   void check_header(std::string_view line) const {
-    std::vector<std::string> found;
-    for (std::string_view field : split_fields(line)) found.emplace_back(field);
-    if (found == columns_) return;
+    const std::vector<std::string_view> found = split_fields(line);
+    if (std::equal(found.begin(), found.end(), columns_.begin(), columns_.end())) return;
+    const std::unordered_set<std::string_view> known(columns_.begin(), columns_.end());
+    std::unordered_set<std::string_view> seen, reported;
+    std::vector<std::string> unknown, repeated, missing;
+    for (const std::string_view name : found) {
+      const bool first = seen.insert(name).second;
+      if (!known.contains(name)) {
+        if (first) unknown.emplace_back(name);
+      } else if (!first && reported.insert(name).second) {
+        repeated.emplace_back(name);
+      }
+    }
+    for (const std::string& name : columns_)
+      if (!seen.contains(name)) missing.push_back(name);
     const std::string expected = join(columns_, ",");
-    auto sorted_found = found, sorted_expected = columns_;
-    std::sort(sorted_found.begin(), sorted_found.end());
-    std::sort(sorted_expected.begin(), sorted_expected.end());
-    if (sorted_found == sorted_expected)
+    if (missing.empty() && unknown.empty() && repeated.empty())  // the same names (as many): another order
       throw DataError(file_, line_location(1),
                       "the header has the right column names for system '" + system_.name +
-                          "' but in a different order: found " + join(found, ","),
+                          "' but in a different order: found " + std::string(line),
                       "the order " + expected + " (episode, t, the states in order, the controls in order)");
-    std::vector<std::string> missing, unknown, repeated;
-    for (const std::string& name : columns_)
-      if (std::find(found.begin(), found.end(), name) == found.end()) missing.push_back(name);
-    for (std::size_t i = 0; i < found.size(); ++i) {
-      const bool known = std::find(columns_.begin(), columns_.end(), found[i]) != columns_.end();
-      const bool first = std::find(found.begin(), found.begin() + static_cast<long>(i), found[i]) ==
-                         found.begin() + static_cast<long>(i);
-      if (!known && first) unknown.push_back(found[i]);
-      if (known && !first && std::find(repeated.begin(), repeated.end(), found[i]) == repeated.end())
-        repeated.push_back(found[i]);
-    }
     std::string problem = "the header columns do not match system '" + system_.name + "':";
-    if (!missing.empty()) problem += " missing " + quoted_list(missing) + ";";
-    if (!unknown.empty()) problem += " unknown " + quoted_list(unknown) + ";";
-    if (!repeated.empty()) problem += " repeated " + quoted_list(repeated) + ";";
-    problem += " found " + join(found, ",");
+    if (!missing.empty()) problem += " missing " + name_list::quoted_list(missing) + ";";
+    if (!unknown.empty()) problem += " unknown " + name_list::quoted_list(unknown) + ";";
+    if (!repeated.empty()) problem += " repeated " + name_list::quoted_list(repeated) + ";";
+    problem += found.size() > name_list::kMaxListedNames ? fmt::format(" found {} columns: ", found.size()) : " found ";
+    problem += name_list::plain_list(found, ",");
     throw DataError(file_, line_location(1), problem, "the columns " + expected);
   }
 

@@ -17,23 +17,31 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <map>
+#include <optional>
 
+#include "gpilqg/core/dataset_size.hpp"
 #include "gpilqg/core/hdf5_memory_file.hpp"
+#include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "measurements_internal.hpp"
+#include "name_list.hpp"
 
 namespace gpilqg {
 
 namespace {
 
-using measurements_detail::join;
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
+/// "['a', 'b']": the names of the system, all of them.
 std::string quoted_list(const std::vector<std::string>& names) {
-  std::vector<std::string> q;
-  for (const auto& name : names) q.push_back("'" + name + "'");
-  return "[" + join(q) + "]";
+  std::string text;
+  for (const auto& name : names) text += (text.empty() ? "'" : ", '") + name + "'";
+  return "[" + text + "]";
 }
+
+/// "['a', 'b', ... and N more]": names found in the file, bounded whatever it holds (name_list.hpp).
+std::string found_list(const std::vector<std::string>& names) { return "[" + name_list::quoted_list(names) + "]"; }
 
 std::string attribute_location(const std::string& name) { return "attribute '" + name + "'"; }
 
@@ -80,17 +88,24 @@ class Hdf5Reader {
 
  private:
   void open() {
-    std::error_code error;
-    if (!std::filesystem::exists(file_, error))
-      throw DataError(file_, "", "no such file", "an existing measurement file");
-    if (std::filesystem::is_directory(file_, error))
-      throw DataError(file_, "", "is a directory", "a measurement file");
+    file_size_ = check_input_file(file_, kMaxDataFileBytes, "a measurement file");
     const bool is_hdf5 = guarded(file_, "", "opening the file", "a readable HDF5 file",
                                  [&] { return H5::H5File::isHdf5(file_.c_str()); });
     if (!is_hdf5) throw DataError(file_, "", "not an HDF5 file", "an HDF5 file (a CSV file must end in .csv)");
-    file_size_ = std::filesystem::file_size(file_, error);
     h5_ = guarded(file_, "", "opening the file", "a readable HDF5 file",
                   [&] { return H5::H5File(file_.c_str(), H5F_ACC_RDONLY); });
+  }
+
+  /// Refuses a dataset or attribute that declares more values than the file can hold or than
+  /// kMaxDatasetValues, before anything is allocated for it.
+  void check_declared_size(hid_t object, const std::string& location, const std::string& expected) const {
+    std::optional<std::string> problem;
+    try {
+      problem = hdf5_size_problem(object, file_size_);
+    } catch (const std::runtime_error& e) {
+      problem = e.what();
+    }
+    if (problem) throw DataError(file_, location, *problem, expected);
   }
 
   /// The strings of an attribute (scalar when `scalar`, else a 1-D array), variable- or fixed-length.
@@ -110,6 +125,7 @@ class Hdf5Reader {
       if (!scalar && rank != 1)
         throw DataError(file_, location, fmt::format("has rank {}, not a 1-D array of strings", rank),
                         expected);
+      check_declared_size(attribute.getId(), location, expected);
       const auto count = static_cast<std::size_t>(space.getSimpleExtentNpoints());
       if (scalar && count != 1)
         throw DataError(file_, location, "holds no value (an empty dataspace), not a single string", expected);
@@ -159,7 +175,7 @@ class Hdf5Reader {
     std::sort(sorted_expected.begin(), sorted_expected.end());
     const std::string problem = sorted_found == sorted_expected
                                     ? "has the right names in a different order: " + quoted_list(found)
-                                    : "is " + quoted_list(found);
+                                    : "is " + found_list(found);
     throw DataError(file_, attribute_location(attribute), problem, expectation);
   }
 
@@ -172,6 +188,7 @@ class Hdf5Reader {
       throw DataError(file_, "/episodes", "is not a group", expected);
     const H5::Group episodes = h5_.openGroup("episodes");
     std::vector<std::pair<long, std::string>> names;
+    std::map<long, std::string> seen_ids;  // k -> the first group name of episode k
     for (hsize_t i = 0; i < episodes.getNumObjs(); ++i) {
       const std::string name = episodes.getObjnameByIdx(i);
       const std::string location = "/episodes/" + name;
@@ -179,11 +196,10 @@ class Hdf5Reader {
       if (!id) throw DataError(file_, location, "the name is not a non-negative integer", expected);
       if (episodes.childObjType(name) != H5O_TYPE_GROUP)
         throw DataError(file_, location, "is not a group", expected);
-      for (const auto& [other_id, other_name] : names)
-        if (other_id == *id)
-          throw DataError(file_, location,
-                          "names episode " + std::to_string(*id) + " like /episodes/" + other_name,
-                          "one group per episode number");
+      if (const auto [seen, added] = seen_ids.emplace(*id, name); !added)
+        throw DataError(file_, location,
+                        "names episode " + std::to_string(*id) + " like /episodes/" + seen->second,
+                        "one group per episode number");
       names.emplace_back(*id, name);
     }
     if (names.empty()) throw DataError(file_, "/episodes", "holds no episodes", expected);
@@ -216,14 +232,8 @@ class Hdf5Reader {
         if (rank > 2) shape = fmt::format("rank {}", rank);
         throw DataError(file_, location, "has " + shape, expected);
       }
-      // A damaged file can declare any extent: refuse more values than its bytes could hold (deflate
-      // expands at most about 1032:1) instead of failing in the allocation with std::bad_alloc.
-      const double declared = static_cast<double>(dims[0]) * static_cast<double>(rank == 2 ? dims[1] : 1);
-      const double capacity = 1100.0 * static_cast<double>(std::max<std::uintmax_t>(file_size_, 1u << 20)) / 8.0;
-      if (declared > capacity)
-        throw DataError(file_, location,
-                        fmt::format("declares {} values, more than a file of {} bytes can hold", declared, file_size_),
-                        expected);
+      // A damaged file can declare any extent: refused before the allocation (dataset_size.hpp).
+      check_declared_size(data.getId(), location, expected);
       RowMajor values(found_rows, cols < 0 ? 1 : cols);
       if (values.size() > 0) data.read(values.data(), H5::PredType::NATIVE_DOUBLE);
       return values;

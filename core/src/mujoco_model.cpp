@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/input_file.hpp"
+
 namespace gpilqg {
 namespace {
 
@@ -51,9 +53,7 @@ MujocoModel::~MujocoModel() { mj_deleteModel(m_); }
 
 std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
   route_warnings_to_stderr();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw std::invalid_argument(fmt::format("{}: no such model file; expected a MuJoCo model (MJCF .xml or URDF)", path));
+  check_input_file_as<std::invalid_argument>(path, kMaxConfigFileBytes, "a MuJoCo model (MJCF .xml or URDF)");
   char error[1024] = "";
   mjModel* m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
   if (m == nullptr)

@@ -7,7 +7,9 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
+#include "name_list.hpp"
 
 namespace gpilqg {
 
@@ -27,9 +29,10 @@ const LogColumn* RawLog::find(const std::string& name) const {
 }
 
 std::string RawLog::column_names() const {
-  std::string list;
-  for (const LogColumn& column : columns) list += (list.empty() ? "'" : ", '") + column.name + "'";
-  return list;
+  std::vector<std::string_view> names;
+  names.reserve(columns.size());
+  for (const LogColumn& column : columns) names.push_back(column.name);
+  return name_list::quoted_list(names);
 }
 
 std::string RawLog::location(const std::string& name) const {
@@ -50,8 +53,7 @@ RawLog read_raw_log(const std::filesystem::path& file) {
   std::string extension = file.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  std::error_code error;
-  if (!std::filesystem::exists(file, error)) throw DataError(file, "", "no such file", "an existing log file");
+  check_input_file(file, kMaxDataFileBytes, "a log file");
   RawLog log;
   if (extension == ".csv") log = read_raw_log_csv(file);
   else if (extension == ".mat") log = read_raw_log_mat(file);

@@ -13,15 +13,18 @@
 #include <sstream>
 #include <string_view>
 
+#include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/raw_log.hpp"
 #include "csv_text.hpp"
+#include "name_list.hpp"
 
 namespace gpilqg {
 
 namespace {
 
 std::string read_text(const std::filesystem::path& file) {
+  check_input_file(file, kMaxDataFileBytes, "a log file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw DataError(file, "", "cannot open the file for reading", "a readable log file");
   std::ostringstream contents;
@@ -75,7 +78,7 @@ RawLog read_raw_log_csv(const std::filesystem::path& file) {
     if (name.empty())
       throw DataError(file, "line 1", fmt::format("column {} has no name", log.columns.size() + 1), "a name for every column");
     if (!seen.insert(std::string(name)).second)
-      throw DataError(file, "line 1", fmt::format("column '{}' appears twice", name), "distinct column names");
+      throw DataError(file, "line 1", fmt::format("column {} appears twice", name_list::quoted(name)), "distinct column names");
     log.columns.push_back({std::string(name), {}, ""});
   }
   const std::size_t width = log.columns.size();

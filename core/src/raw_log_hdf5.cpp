@@ -1,5 +1,6 @@
 /// Raw HDF5 logs: every numeric dataset that is a vector (N, N x 1 or 1 x N) is a column named by its
-/// path without the leading '/'. Datasets of other shapes or types are kept as unusable columns.
+/// path without the leading '/'. Datasets of other shapes or types are kept as unusable columns; a
+/// dataset declaring more values than the file can hold is an error (Hdf5Reader, dataset_size.hpp).
 
 #include <fmt/format.h>
 
@@ -20,6 +21,8 @@ RawLog read_raw_log_hdf5(const std::filesystem::path& file) {
   std::unique_ptr<Hdf5Reader> reader;
   try {
     reader = std::make_unique<Hdf5Reader>(file);
+  } catch (const DataError&) {
+    throw;  // not a readable regular file of at most kMaxDataFileBytes: already names the file
   } catch (const std::runtime_error& e) {
     throw DataError(file, "", fmt::format("cannot open it as HDF5 ({})", e.what()), "an HDF5 file of 1-D datasets");
   }
@@ -40,6 +43,8 @@ RawLog read_raw_log_hdf5(const std::filesystem::path& file) {
     if (column.unusable.empty()) {
       try {
         column.values = reader->read_array(path);
+      } catch (const DataError&) {
+        throw;  // declares more values than the file can hold: the file is damaged
       } catch (const std::runtime_error& e) {
         column.unusable = fmt::format("not numeric ({})", e.what());
       }

@@ -10,6 +10,7 @@
 
 #include <matio.h>
 
+#include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/raw_log.hpp"
 
@@ -78,6 +79,7 @@ LogColumn column_of(const matvar_t& var, const std::string& name) {
 }  // namespace
 
 RawLog read_raw_log_mat(const std::filesystem::path& file) {
+  check_input_file(file, kMaxDataFileBytes, "a log file");
   const MatFile mat(Mat_Open(file.string().c_str(), MAT_ACC_RDONLY));
   if (!mat) throw DataError(file, "", "matio cannot open it as a MAT file", "a MATLAB .mat file (v4, v5 or v7.3)");
   RawLog log;

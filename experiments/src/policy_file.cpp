@@ -8,6 +8,7 @@
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_reader.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
+#include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/gp/gp_io.hpp"
@@ -98,7 +99,7 @@ void write_policy_file(const std::filesystem::path& file, const PolicyFile& p, c
 }
 
 PolicyFile read_policy_file(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) throw InputError(file.string() + ": no such policy file");
+  check_input_file_as<InputError>(file, kMaxDataFileBytes, "a policy file of `gpilqg plan`");
   return as_input_error(file, [&] {
     const Hdf5Reader h5(file);
     const std::string g = kPolicy;

@@ -7,7 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
+#include "gpilqg/core/dataset_size.hpp"
+#include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/systems.hpp"
@@ -25,8 +28,32 @@ using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::Ro
   throw InputError(fmt::format("{}:{}: {}", file.string(), object, problem));
 }
 
+/// An open benchmark file: the HDF5 file, its path and its size in bytes (what declared dataset sizes
+/// are checked against, dataset_size.hpp).
+struct BenchmarkFile {
+  const H5::H5File& h5;
+  const std::filesystem::path& file;
+  std::uintmax_t bytes = 0;
+};
+
+/// Refuses a dataset or attribute that declares more values than the file can hold or than
+/// kMaxDatasetValues, before anything is allocated for it.
+void check_declared_size(const BenchmarkFile& in, const std::string& object, hid_t id) {
+  std::optional<std::string> problem;
+  try {
+    problem = hdf5_size_problem(id, in.bytes);
+  } catch (const std::runtime_error& e) {
+    fail(in.file, object, e.what());
+  }
+  if (problem)
+    fail(in.file, object,
+         fmt::format("{}; expected a dataset that fits the file and at most {} values", *problem, kMaxDatasetValues));
+}
+
 /// A float dataset of rank `rank` (1 or 2) as a matrix (a vector as one column).
-Matrix read_dataset(const H5::H5File& h5, const std::filesystem::path& file, const std::string& name, int rank) {
+Matrix read_dataset(const BenchmarkFile& in, const std::string& name, int rank) {
+  const H5::H5File& h5 = in.h5;
+  const std::filesystem::path& file = in.file;
   if (!h5.nameExists(name)) fail(file, "/" + name, "missing dataset; expected the benchmark format (X_train, y_train, X_test, y_test)");
   try {
     const H5::DataSet data = h5.openDataSet(name);
@@ -34,6 +61,7 @@ Matrix read_dataset(const H5::H5File& h5, const std::filesystem::path& file, con
     const H5::DataSpace space = data.getSpace();
     if (space.getSimpleExtentNdims() != rank)
       fail(file, "/" + name, fmt::format("has rank {}; expected {}", space.getSimpleExtentNdims(), rank));
+    check_declared_size(in, "/" + name, data.getId());
     hsize_t dims[2] = {0, 1};
     space.getSimpleExtentDims(dims);
     RowMajor values(static_cast<Eigen::Index>(dims[0]), static_cast<Eigen::Index>(rank == 2 ? dims[1] : 1));
@@ -51,25 +79,32 @@ Matrix read_dataset(const H5::H5File& h5, const std::filesystem::path& file, con
 double read_double_attribute(const H5::Group& group, const std::filesystem::path& file, const std::string& object,
                              const std::string& name) {
   if (!group.attrExists(name)) fail(file, object + " attribute '" + name + "'", "missing");
+  const H5::Attribute attribute = group.openAttribute(name);
+  if (attribute.getSpace().getSimpleExtentNpoints() != 1)
+    fail(file, object + " attribute '" + name + "'",
+         fmt::format("holds {} values; expected a single number", attribute.getSpace().getSimpleExtentNpoints()));
   double value = 0.0;
-  group.openAttribute(name).read(H5::PredType::NATIVE_DOUBLE, &value);
+  attribute.read(H5::PredType::NATIVE_DOUBLE, &value);
   if (!std::isfinite(value)) fail(file, object + " attribute '" + name + "'", "is not finite");
   return value;
 }
 
-ProfileData read_benchmark(const H5::H5File& h5, const std::filesystem::path& file) {
+ProfileData read_benchmark(const BenchmarkFile& in) {
+  const H5::H5File& h5 = in.h5;
+  const std::filesystem::path& file = in.file;
   ProfileData data;
   data.format = "benchmark";
   data.target = "y_train";
   data.name = file.stem().string();
   if (h5.attrExists("name")) {
     const H5::Attribute a = h5.openAttribute("name");
+    check_declared_size(in, "/ attribute 'name'", a.getId());
     a.read(a.getStrType(), data.name);
   }
-  data.train.inputs = read_dataset(h5, file, "X_train", 2);
-  data.train.targets = read_dataset(h5, file, "y_train", 1).col(0);
-  data.test_inputs = read_dataset(h5, file, "X_test", 2);
-  data.test_targets = read_dataset(h5, file, "y_test", 1).col(0);
+  data.train.inputs = read_dataset(in, "X_train", 2);
+  data.train.targets = read_dataset(in, "y_train", 1).col(0);
+  data.test_inputs = read_dataset(in, "X_test", 2);
+  data.test_targets = read_dataset(in, "y_test", 1).col(0);
   const auto n = data.train.inputs.rows(), d = data.train.inputs.cols();
   if (data.train.targets.size() != n)
     fail(file, "/y_train", fmt::format("has {} entries; expected {} (the rows of X_train)", data.train.targets.size(), n));
@@ -83,7 +118,7 @@ ProfileData read_benchmark(const H5::H5File& h5, const std::filesystem::path& fi
     const std::string object = "/reference_hyperparameters";
     const H5::Group group = h5.openGroup("reference_hyperparameters");
     gp::Hyperparameters h;
-    h.log_lengthscales = read_dataset(h5, file, "reference_hyperparameters/log_lengthscales", 1).col(0);
+    h.log_lengthscales = read_dataset(in, "reference_hyperparameters/log_lengthscales", 1).col(0);
     if (h.log_lengthscales.size() != d)
       fail(file, object + "/log_lengthscales", fmt::format("has {} entries; expected D = {}", h.log_lengthscales.size(), d));
     h.log_signal_std = read_double_attribute(group, file, object, "log_signal_std");
@@ -171,7 +206,8 @@ bool has_extension(const std::filesystem::path& file, std::initializer_list<cons
 }  // namespace
 
 ProfileData read_profile_data(const std::filesystem::path& file, const ProfileDataOptions& options) {
-  if (!std::filesystem::exists(file)) throw InputError(file.string() + ": no such file");
+  const std::uintmax_t bytes =
+      check_input_file_as<InputError>(file, kMaxDataFileBytes, "a benchmark set or a measurement set");
   if (has_extension(file, {".csv"})) return read_measurement_profile(file, options);
   if (!has_extension(file, {".h5", ".hdf5"}))
     throw InputError(file.string() + ": unknown extension; expected .h5 / .hdf5 (benchmark or measurements) or .csv");
@@ -180,7 +216,7 @@ ProfileData read_profile_data(const std::filesystem::path& file, const ProfileDa
   try {
     const H5::H5File h5(file.c_str(), H5F_ACC_RDONLY);
     benchmark = h5.nameExists("X_train");
-    if (benchmark) return read_benchmark(h5, file);
+    if (benchmark) return read_benchmark(BenchmarkFile{h5, file, bytes});
     if (!h5.nameExists("episodes"))
       fail(file, "/", "neither X_train (benchmark format) nor /episodes (measurement set) is present");
   } catch (const H5::Exception& e) {

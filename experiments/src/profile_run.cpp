@@ -32,6 +32,12 @@ std::vector<int> nested_subset(int size, int count, std::uint64_t seed) {
   return order;
 }
 
+/// A backend's refusal of the data (std::invalid_argument, e.g. constant targets) as bad input naming
+/// the file, the backend and the training set size: "<file>: backend 'exact', N = 60: <reason>".
+InputError data_error(const std::filesystem::path& file, const ProfileRow& row, const std::invalid_argument& e) {
+  return InputError(fmt::format("{}: backend '{}', N = {}: {}", file.string(), row.backend, row.size, e.what()));
+}
+
 /// Predicts the test set and scores it into `row`.
 void score(const gp::FittedGp& model, const Matrix& test_inputs, const Vector& test_targets,
            const Vector& training_targets, ProfileRow& row) {
@@ -129,6 +135,8 @@ ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& 
         } catch (const std::runtime_error& e) {
           row.status = "failed";
           row.reason = e.what();
+        } catch (const std::invalid_argument& e) {
+          throw data_error(file, row, e);
         }
       }
       emit(row);
@@ -158,6 +166,8 @@ ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& 
       } catch (const std::runtime_error& e) {  // e.g. conditioning failed even with jitter
         row.status = "failed";
         row.reason = e.what();
+      } catch (const std::invalid_argument& e) {  // e.g. constant targets
+        throw data_error(file, row, e);
       }
       emit(row);
     }

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -211,8 +212,7 @@ RunConfig parse_run_config(const std::string& system, const std::string& overrid
 
 RunConfig load_run_config(const std::string& system, const std::optional<std::filesystem::path>& override_file) {
   if (!override_file) return parse_run_config(system, "", "");
-  if (!std::filesystem::exists(*override_file))
-    throw InputError(fmt::format("{}: no such file; expected a TOML config", override_file->string()));
+  check_input_file_as<InputError>(*override_file, kMaxConfigFileBytes, "a TOML config");
   std::ifstream in(*override_file);
   std::stringstream text;
   text << in.rdbuf();

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
@@ -12,7 +13,7 @@
 namespace gpilqg {
 
 toml::table TomlFields::parse(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: no such file; expected a TOML config", file.string()));
+  check_input_file_as<InputError>(file, kMaxConfigFileBytes, "a TOML config");
   try {
     return toml::parse_file(file.string());
   } catch (const toml::parse_error& e) {

@@ -1,12 +1,16 @@
 #include "gpilqg/gp/gp_io.hpp"
 
 #include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/dataset_size.hpp"
 #include "gpilqg/core/hdf5_memory_file.hpp"
+#include "gpilqg/core/input_file.hpp"
+#include "gpilqg/core/measurements.hpp"
 
 #include <H5Cpp.h>
 
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -55,9 +59,61 @@ void write_dataset(H5::Group& group, const std::string& name, const RowMajor& va
   if (values.size() > 0) data.write(values.data(), H5::PredType::NATIVE_DOUBLE);
 }
 
-std::string normalised(const std::string& group) {
-  if (group.empty() || group == "/") throw std::invalid_argument("save/load_fitted_gp: expected a group name below /");
+std::string normalised(const std::filesystem::path& file, const std::string& group) {
+  if (group.empty() || group == "/")
+    throw std::invalid_argument(file.string() + ": group '" + group + "': expected a group name below /");
   return group.front() == '/' ? group : "/" + group;
+}
+
+/// What a saved GP file must be before it is opened (input_file.hpp); returns its size in bytes.
+std::uintmax_t check_gp_file(const std::filesystem::path& file) {
+  return check_input_file(file, kMaxDataFileBytes, "an HDF5 file holding a saved GP");
+}
+
+/// Refuses a dataset or attribute that declares more values than the file can hold or than
+/// kMaxDatasetValues (dataset_size.hpp), before anything is allocated for it.
+void check_declared_size(const std::filesystem::path& file, const std::string& object, hid_t id,
+                         std::uintmax_t file_bytes) {
+  std::optional<std::string> problem;
+  try {
+    problem = hdf5_size_problem(id, file_bytes);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(where(file, object) + ": " + e.what());
+  }
+  if (problem)
+    throw DataError(file, object, *problem,
+                    "a dataset that fits the file and at most " + std::to_string(kMaxDatasetValues) + " values");
+}
+
+/// Reads a scalar attribute (exactly one value) as `type` into `value`; an attribute of another size
+/// would overflow `value`.
+template <class T>
+void read_scalar_attribute(const std::filesystem::path& file, const H5::Group& group, const std::string& object,
+                           const std::string& name, const H5::PredType& type, T& value) {
+  const H5::Attribute a = group.openAttribute(name);
+  if (a.getSpace().getSimpleExtentNpoints() != 1)
+    throw DataError(file, object + " attribute '" + name + "'",
+                    "holds " + std::to_string(a.getSpace().getSimpleExtentNpoints()) + " values", "a single number");
+  a.read(type, &value);
+}
+
+/// Runs `load`, making every error it throws start with "<file>:<object>: " (a backend's message
+/// about the data it is conditioned on does not know the file).
+template <class Load>
+auto naming_the_file(const std::filesystem::path& file, const std::string& object, Load&& load) -> decltype(load()) {
+  const auto prefixed = [&](const std::exception& e) {
+    const std::string what = e.what();
+    return what.rfind(file.string(), 0) == 0 ? what : where(file, object) + ": " + what;
+  };
+  try {
+    return load();
+  } catch (const DataError&) {
+    throw;
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(prefixed(e));
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(prefixed(e));
+  }
 }
 
 }  // namespace
@@ -108,21 +164,21 @@ void edit_atomically(const std::filesystem::path& file, const std::string& objec
 }  // namespace
 
 void save_fitted_gp(const std::filesystem::path& file, const std::string& group_name, const FittedGp& model) {
-  const std::string group_path = normalised(group_name);
+  const std::string group_path = normalised(file, group_name);
   edit_atomically(file, group_path, "writing the fitted GP",
                   [&](H5::H5File& h5) { write_fitted_gp(h5, group_path, model); });
 }
 
 std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, const std::string& group_name,
                                          const GpBackend& backend) {
-  const std::string group_path = normalised(group_name);
+  const std::string group_path = normalised(file, group_name);
   H5::Exception::dontPrint();
-  if (!std::filesystem::exists(file)) throw std::runtime_error(file.string() + ": no such file");
+  const std::uintmax_t file_bytes = check_gp_file(file);
   auto fail = [&](const std::string& object, const std::string& problem) -> std::runtime_error {
     return std::runtime_error(where(file, object) + ": " + problem);
   };
   H5::H5File h5 = guarded(file, "/", "opening", [&] { return H5::H5File(file.c_str(), H5F_ACC_RDONLY); });
-  if (!guarded(file, group_path, "looking up", [&] { return h5.nameExists(group_path); }))
+  if (!guarded(file, group_path, "looking up", [&] { return path_exists(h5, group_path); }))
     throw fail(group_path, "no such group; expected a saved GP");
   const H5::Group group = guarded(file, group_path, "opening", [&] { return h5.openGroup(group_path); });
 
@@ -131,16 +187,17 @@ std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, cons
     if (!attribute_exists(name)) throw fail(group_path + " attribute '" + name + "'", "missing");
   const std::string stored_backend = guarded(file, group_path + " attribute 'backend'", "reading", [&] {
     const H5::Attribute a = group.openAttribute("backend");
+    check_declared_size(file, group_path + " attribute 'backend'", a.getId(), file_bytes);
     std::string value;
     a.read(a.getStrType(), value);
     return value;
   });
   if (stored_backend != backend.name())
     throw fail(group_path + " attribute 'backend'",
-               "is '" + stored_backend + "'; expected '" + std::string(backend.name()) + "' (the backend given)");
+               "is '" + stored_backend.substr(0, 40) + "'; expected '" + std::string(backend.name()) + "' (the backend given)");
   const int input_dim = guarded(file, group_path + " attribute 'input_dim'", "reading", [&] {
     int value = 0;
-    group.openAttribute("input_dim").read(H5::PredType::NATIVE_INT, &value);
+    read_scalar_attribute(file, group, group_path, "input_dim", H5::PredType::NATIVE_INT, value);
     return value;
   });
 
@@ -153,6 +210,7 @@ std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, cons
       if (space.getSimpleExtentNdims() != rank)
         throw fail(object, "has rank " + std::to_string(space.getSimpleExtentNdims()) + "; expected " +
                                std::to_string(rank));
+      check_declared_size(file, object, data.getId(), file_bytes);
       hsize_t dims[2] = {0, 1};
       space.getSimpleExtentDims(dims);
       RowMajor values(static_cast<Eigen::Index>(dims[0]), static_cast<Eigen::Index>(rank == 2 ? dims[1] : 1));
@@ -170,11 +228,11 @@ std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, cons
   if (data.targets.size() != data.inputs.rows())
     throw fail(group_path + "/targets", "has " + std::to_string(data.targets.size()) + " entries; expected " +
                                             std::to_string(data.inputs.rows()) + " (one per input row)");
-  return backend.condition(std::move(data), parameters.col(0));
+  return naming_the_file(file, group_path, [&] { return backend.condition(std::move(data), parameters.col(0)); });
 }
 
 void save_residual_model(const std::filesystem::path& file, const std::string& group_name, const ResidualModel& model) {
-  const std::string group_path = normalised(group_name);
+  const std::string group_path = normalised(file, group_name);
   edit_atomically(file, group_path, "writing the residual model", [&](H5::H5File& h5) {
     for (int i = 0; i < model.state_dim(); ++i)
       write_fitted_gp(h5, group_path + "/" + std::to_string(i), model.output(i));
@@ -190,9 +248,9 @@ void save_residual_model(const std::filesystem::path& file, const std::string& g
 
 ResidualModel load_residual_model(const std::filesystem::path& file, const std::string& group_name,
                                   ResidualModel::SimulatorPtr simulator, const GpBackend& backend) {
-  if (!simulator) throw std::invalid_argument("load_residual_model: null simulator");
-  const std::string group_path = normalised(group_name);
-  if (!std::filesystem::exists(file)) throw std::runtime_error(file.string() + ": no such file");
+  if (!simulator) throw std::invalid_argument(file.string() + ": load_residual_model: null simulator");
+  const std::string group_path = normalised(file, group_name);
+  check_gp_file(file);
   H5::Exception::dontPrint();
   struct Stored {
     int state_dim = 0, control_dim = 0;
@@ -200,15 +258,15 @@ ResidualModel load_residual_model(const std::filesystem::path& file, const std::
   };
   const Stored stored = guarded(file, group_path, "reading the residual model's attributes", [&] {
     const H5::H5File h5(file.c_str(), H5F_ACC_RDONLY);
-    if (!h5.nameExists(group_path)) throw std::runtime_error(where(file, group_path) + ": no such group");
+    if (!path_exists(h5, group_path)) throw std::runtime_error(where(file, group_path) + ": no such group");
     const H5::Group group = h5.openGroup(group_path);
     Stored s;
     for (const char* name : {"state_dim", "control_dim", "dt"})
       if (!group.attrExists(name))
         throw std::runtime_error(where(file, group_path + " attribute '" + name + "'") + ": missing");
-    group.openAttribute("state_dim").read(H5::PredType::NATIVE_INT, &s.state_dim);
-    group.openAttribute("control_dim").read(H5::PredType::NATIVE_INT, &s.control_dim);
-    group.openAttribute("dt").read(H5::PredType::NATIVE_DOUBLE, &s.dt);
+    read_scalar_attribute(file, group, group_path, "state_dim", H5::PredType::NATIVE_INT, s.state_dim);
+    read_scalar_attribute(file, group, group_path, "control_dim", H5::PredType::NATIVE_INT, s.control_dim);
+    read_scalar_attribute(file, group, group_path, "dt", H5::PredType::NATIVE_DOUBLE, s.dt);
     return s;
   });
   if (stored.state_dim != simulator->state_dim() || stored.control_dim != simulator->control_dim() ||
@@ -220,7 +278,7 @@ ResidualModel load_residual_model(const std::filesystem::path& file, const std::
   std::vector<std::unique_ptr<FittedGp>> outputs;
   for (int i = 0; i < stored.state_dim; ++i)
     outputs.push_back(load_fitted_gp(file, group_path + "/" + std::to_string(i), backend));
-  return ResidualModel(std::move(simulator), std::move(outputs));
+  return naming_the_file(file, group_path, [&] { return ResidualModel(std::move(simulator), std::move(outputs)); });
 }
 
 }  // namespace gpilqg::gp

@@ -83,7 +83,7 @@ TEST(Hdf5Reader, ErrorsNameTheFileTheObjectAndWhatWasExpected) {
   EXPECT_NE(message([&] { h5.read_vector("/missing"); }).find(f + ": reading the shape of dataset '/missing' failed"),
             std::string::npos);
   EXPECT_NE(message([&] { h5.string_attribute("/", "none"); }).find("'/@none'"), std::string::npos);
-  EXPECT_EQ(message([&] { Hdf5Reader(dir / "absent.h5"); }), (dir / "absent.h5").string() + ": no such file");
+  EXPECT_EQ(message([&] { Hdf5Reader(dir / "absent.h5"); }), (dir / "absent.h5").string() + ": no such file; expected an HDF5 file");
   std::ofstream(dir / "text.h5") << "not hdf5";
   EXPECT_NE(message([&] { Hdf5Reader(dir / "text.h5"); }).find("opening '/' failed"), std::string::npos);
   std::filesystem::remove_all(dir);

@@ -243,9 +243,9 @@ TEST(MeasurementsCsv, ErrorCarriesFileAndLocation) {
 TEST(Measurements, MissingFileAndUnknownExtensionAreDataErrors) {
   const auto dir = test::temporary_dir("measurements");
   EXPECT_EQ(data_error_of([&] { read_measurements(dir / "absent.csv", cartpole()); }),
-            (dir / "absent.csv").string() + ": no such file; expected an existing measurement file");
+            (dir / "absent.csv").string() + ": no such file; expected a measurement file");
   EXPECT_EQ(data_error_of([&] { read_measurements(dir / "absent.h5", cartpole()); }),
-            (dir / "absent.h5").string() + ": no such file; expected an existing measurement file");
+            (dir / "absent.h5").string() + ": no such file; expected a measurement file");
   const auto text = write_text(dir / "data.txt", kHeader + kRow0a + kRow0b);
   const std::string error = data_error_of([&] { read_measurements(text, cartpole()); });
   EXPECT_NE(

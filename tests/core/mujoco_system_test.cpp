@@ -260,7 +260,7 @@ TEST(MujocoSystem, BadModelsAreRefusedWithWhatIsWrong) {
                                                                "</body></worldbody></mujoco>\n"));
   EXPECT_NE(parse.find("model.xml: MuJoCo cannot load the model"), std::string::npos) << parse;
   EXPECT_NE(parse.find("line 4"), std::string::npos) << parse;
-  EXPECT_NE(load_error("/nonexistent/model.xml").find("no such model file"), std::string::npos);
+  EXPECT_NE(load_error("/nonexistent/model.xml").find("/nonexistent/model.xml: no such file; expected a MuJoCo model"), std::string::npos);
   const auto arm = MujocoSystem::load(arm_path());
   try {
     make_step_model(arm, Integrator::Euler, 0.025);

@@ -207,5 +207,40 @@ TEST(Profile, BadInputExitsTwoNamingTheFileAndDataset) {
   expect_error("profile " + quote(dir / "absent.h5") + " --backends exact", "absent.h5: no such file");
 }
 
+/// A benchmark file of a few KB whose X_train declares `rows` x 3 values it never writes.
+fs::path declaring_benchmark(const fs::path& file, hsize_t rows) {
+  H5::H5File h5(file.c_str(), H5F_ACC_TRUNC);
+  const hsize_t dims[2] = {rows, 3};
+  h5.createDataSet("X_train", H5::PredType::IEEE_F64LE, H5::DataSpace(2, dims));
+  return file;
+}
+
+TEST(Profile, ADeclaredDatasetSizeIsRefusedBeforeAllocating) {
+  const fs::path dir = test::temporary_dir("profile_declared");
+  for (const hsize_t rows : {hsize_t{1} << 27, hsize_t{1} << 31}) {
+    const fs::path file = declaring_benchmark(dir / "declares.h5", rows);
+    const auto result = test::run_cli("profile " + quote(file) + " --backends exact");
+    EXPECT_EQ(result.status, 2) << result.err;
+    const std::string expected = "error: " + file.string() + ":/X_train: declares " + std::to_string(rows * 3) +
+                                 " values, more than a file of " + std::to_string(fs::file_size(file)) +
+                                 " bytes can hold; expected a dataset that fits the file and at most 268435456 values\n";
+    EXPECT_EQ(result.err, expected);
+    EXPECT_EQ(result.err.find("bad_alloc"), std::string::npos);
+    EXPECT_TRUE(result.out.empty());
+  }
+}
+
+TEST(Profile, ABackendsRefusalOfTheDataNamesTheFile) {
+  const fs::path dir = test::temporary_dir("profile_constant");
+  Benchmark b = make_benchmark();
+  b.train.targets.setConstant(0.25);
+  const fs::path file = write_benchmark(dir / "constant.h5", b);
+  const auto result = test::run_cli("profile " + quote(file) + " --backends exact");
+  EXPECT_EQ(result.status, 2) << result.err;
+  EXPECT_EQ(result.err, "error: " + file.string() +
+                            ": backend 'exact_reference', N = 60: ExactGpBackend::condition: all 60 targets equal 0.25; "
+                            "expected targets that vary (a constant has nothing to regress)\n");
+}
+
 }  // namespace
 }  // namespace gpilqg

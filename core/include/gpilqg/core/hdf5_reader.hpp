@@ -4,7 +4,10 @@
 /// values converted to double whatever their stored numeric type, 2-D datasets read in row-major order
 /// into an Eigen matrix of the same shape (so what Hdf5Writer::write_matrix wrote comes back equal bit
 /// for bit). Every failure throws std::runtime_error naming the file, the object and what was expected;
-/// the HDF5 C++ API stays inside core.
+/// the HDF5 C++ API stays inside core. Bad input files throw DataError (measurements.hpp, a
+/// std::runtime_error): a path that is not a readable regular file of at most kMaxDataFileBytes
+/// (input_file.hpp), and a dataset or attribute declaring more values than the file can hold or than
+/// kMaxDatasetValues (dataset_size.hpp), refused before anything is allocated for it.
 
 #include <cstdint>
 #include <filesystem>
@@ -18,7 +21,8 @@ namespace gpilqg {
 
 class Hdf5Reader {
  public:
-  /// Opens `file` read-only. Throws std::runtime_error naming the file when it is missing or not HDF5.
+  /// Opens `file` read-only. Throws DataError when it is not a readable regular file of at most
+  /// kMaxDataFileBytes (check_input_file), std::runtime_error naming the file when it is not HDF5.
   explicit Hdf5Reader(const std::filesystem::path& file);
   ~Hdf5Reader();
   Hdf5Reader(const Hdf5Reader&) = delete;

@@ -82,7 +82,10 @@ MeasurementSet parse_measurements_csv(std::string_view text, const std::filesyst
 MeasurementSet read_measurements_hdf5(const std::filesystem::path& file, const SystemSignature& system);
 
 /// Chooses the reader by extension (case-insensitive): .csv, or .h5 / .hdf5; any other extension
-/// is a DataError.
+/// is a DataError. Both readers first require a readable regular file of at most kMaxDataFileBytes
+/// (check_input_file, input_file.hpp: a FIFO, a device, a directory, a loop of symbolic links, a
+/// missing or larger file is a DataError naming it, before anything is opened), and the HDF5 reader
+/// refuses datasets that declare more values than the file can hold (dataset_size.hpp).
 MeasurementSet read_measurements(const std::filesystem::path& file, const SystemSignature& system);
 
 /// Writes CSV with every number in its shortest round-trip form, so reading it back gives the same

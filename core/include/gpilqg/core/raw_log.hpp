@@ -38,7 +38,8 @@ struct RawLog {
 
   /// The column called `name` (for HDF5 a leading '/' is ignored), or nullptr.
   const LogColumn* find(const std::string& name) const;
-  /// The names of every column, comma-separated, for "expected one of ..." messages.
+  /// The names of the columns, quoted and comma-separated, for "expected one of ..." messages: at
+  /// most the first 10, then "... and N more", so that a log of any width gives a short message.
   std::string column_names() const;
   /// Where sample `row` (0-based) of column `name` is in the file, for an error message:
   /// "line 12, column 'timestamp'" (CSV, header = line 1), "variable 'timestamp', element 11" (MAT),
@@ -49,9 +50,12 @@ struct RawLog {
 };
 
 /// Reads `file` by its extension (case-insensitive): .csv, .mat, .h5 / .hdf5. Throws DataError
-/// (measurements.hpp) naming the file, and the line or variable or dataset, for: a missing or
-/// unreadable file, another extension, an empty CSV, a CSV row whose field count differs from the
-/// header's, a duplicate column name, and a log without any usable column.
+/// (measurements.hpp) naming the file, and the line or variable or dataset, for: a path that is not a
+/// readable regular file of at most kMaxDataFileBytes (check_input_file, input_file.hpp: missing, a
+/// directory, a FIFO, a device, a loop of symbolic links, too large), another extension, an empty CSV,
+/// a CSV row whose field count differs from the header's, a duplicate column name, an HDF5 dataset
+/// declaring more values than the file can hold (dataset_size.hpp), and a log without any usable
+/// column. The per-format readers below make the same file check.
 RawLog read_raw_log(const std::filesystem::path& file);
 
 RawLog read_raw_log_csv(const std::filesystem::path& file);

@@ -58,7 +58,9 @@ struct ProfileData {
 /// Reads either format (chosen by content: X_train present -> benchmark; /episodes or .csv ->
 /// measurements). Throws InputError or DataError naming the file and the dataset, attribute or field:
 /// missing or mis-shaped datasets, non-finite values, a measurement set without `system`, an unknown
-/// output name, or too few samples.
+/// output name, or too few samples; a path that is not a readable regular file of at most
+/// kMaxDataFileBytes (input_file.hpp); a dataset declaring more values than the file can hold or than
+/// kMaxDatasetValues (dataset_size.hpp), refused before anything is allocated.
 ProfileData read_profile_data(const std::filesystem::path& file, const ProfileDataOptions& options);
 
 struct ProfileOptions {
@@ -98,7 +100,8 @@ struct ProfileReport {
   std::vector<ProfileRow> rows;
 };
 
-/// Runs everything; `progress` (may be empty) gets one line per finished row.
+/// Runs everything; `progress` (may be empty) gets one line per finished row. A backend that refuses
+/// the data (std::invalid_argument, e.g. constant targets) is an InputError starting with `file`.
 ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options,
                           const std::function<void(const ProfileRow&)>& progress = {});
 

@@ -95,7 +95,8 @@ struct RunConfig {
 const std::string& default_run_config_text(const std::string& system);
 
 /// The defaults of `system`, overridden by `override_file` when given. Throws InputError naming the
-/// file, line and field for unknown keys, wrong types or sizes and invalid values.
+/// file, line and field for unknown keys, wrong types or sizes and invalid values, and naming the file
+/// when it is not a readable regular file of at most kMaxConfigFileBytes (input_file.hpp).
 RunConfig load_run_config(const std::string& system, const std::optional<std::filesystem::path>& override_file);
 
 /// The same from TOML text (`source` names it in errors), for tests and the resume path.

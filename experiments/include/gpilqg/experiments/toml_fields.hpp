@@ -23,7 +23,9 @@ std::string toml_key(const std::string& key);
 
 class TomlFields {
  public:
-  /// Parses `file`; a syntax error becomes an InputError "<file>:line N: <what>".
+  /// Parses `file`; a syntax error becomes an InputError "<file>:line N: <what>". First the file must be
+  /// a readable regular file of at most kMaxConfigFileBytes (check_input_file_as, input_file.hpp), else
+  /// an InputError "<file>: <problem>; expected a TOML config" (no such file, a FIFO, too large, ...).
   static toml::table parse(const std::filesystem::path& file);
   /// Parses TOML text; `source` names it in errors (and in the nodes' source regions).
   static toml::table parse_text(const std::string& text, const std::string& source);

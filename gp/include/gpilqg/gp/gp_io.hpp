@@ -28,8 +28,14 @@ namespace gpilqg::gp {
 void save_fitted_gp(const std::filesystem::path& file, const std::string& group, const FittedGp& model);
 
 /// Reads group `group` of `file` and conditions `backend` on it. Throws std::runtime_error naming the
-/// file and the object for a missing file, group, attribute or dataset, wrong shapes, or a backend
-/// name that differs from backend.name().
+/// file and the object for a missing group, attribute or dataset, wrong shapes, or a backend name that
+/// differs from backend.name(). Bad input files throw DataError (core measurements.hpp, a
+/// std::runtime_error): a path that is not a readable regular file of at most kMaxDataFileBytes
+/// (input_file.hpp: missing, a directory, a FIFO, a device, a loop of symbolic links, too large), a
+/// dataset or attribute declaring more values than the file can hold or than kMaxDatasetValues
+/// (dataset_size.hpp, checked before anything is allocated), a scalar attribute holding several
+/// values. Every error, including the backend's about the data it is conditioned on
+/// (std::invalid_argument stays std::invalid_argument), starts with "<file>:".
 std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, const std::string& group,
                                          const GpBackend& backend);
 
@@ -40,7 +46,8 @@ void save_residual_model(const std::filesystem::path& file, const std::string& g
 
 /// Reads what save_residual_model wrote and rebuilds the model around `simulator` with `backend`.
 /// Throws std::runtime_error naming the file and object when a GP is missing or the stored
-/// dimensions or dt (1e-6 relative) differ from the simulator's.
+/// dimensions or dt (1e-6 relative) differ from the simulator's; bad input files as load_fitted_gp.
+/// Every error starts with "<file>:".
 ResidualModel load_residual_model(const std::filesystem::path& file, const std::string& group,
                                   ResidualModel::SimulatorPtr simulator, const GpBackend& backend);
 
