@@ -282,7 +282,8 @@ bool Engine::backward(double lambda) {
     for (int j = 0; j < m; ++j) {
       double g = w.grad(j);
       if (limited && ((u_t(j) <= w.lower(j) && g > 0.0) || (u_t(j) >= w.upper(j) && g < 0.0))) g = 0.0;
-      gradient_norm_ = std::max(gradient_norm_, std::abs(g));
+      // A NaN entry counts as infinitely large (std::max would skip it): never "small".
+      gradient_norm_ = std::max(gradient_norm_, std::isnan(g) ? std::numeric_limits<double>::infinity() : std::abs(g));
     }
 
     auto k = w.policy.k.col(t);
@@ -460,7 +461,10 @@ DdpResult Engine::run(const Matrix& initial_controls) {
       record.cost = new_merit;
       summary.trace.push_back(record);
       if (record.actual_reduction <= opt_.cost_tolerance * std::max(std::abs(merit), 1e-12)) {
-        summary.termination = DdpTermination::CostChange;
+        // Converged only at a stationary point (ddp_summary.hpp): a tiny accepted step with a huge
+        // or non-finite gradient is a stall of the line search, not a minimum.
+        const bool at_minimum = stationary(gradient_norm_, w.policy.u_bar.cwiseAbs().maxCoeff(), new_merit);
+        summary.termination = at_minimum ? DdpTermination::CostChange : DdpTermination::Stalled;
         stop = true;
       }
       merit = new_merit;

@@ -1,5 +1,7 @@
 #include "gpilqg/control/ddp_summary.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace gpilqg {
@@ -13,12 +15,18 @@ std::string_view to_string(DdpTermination termination) {
     case DdpTermination::RegularizationLimit: return "regularization_limit";
     case DdpTermination::InitialRolloutDiverged: return "initial_rollout_diverged";
     case DdpTermination::Cancelled: return "cancelled";
+    case DdpTermination::Stalled: return "stalled";
   }
   return "?";
 }
 
 bool converged(DdpTermination termination) {
   return termination == DdpTermination::CostChange || termination == DdpTermination::GradientNorm;
+}
+
+bool stationary(double gradient_norm, double control_scale, double cost) {
+  if (!std::isfinite(gradient_norm) || !std::isfinite(control_scale) || !std::isfinite(cost)) return false;
+  return gradient_norm * std::max(std::abs(control_scale), 1.0) <= kStationarityFactor * std::max(std::abs(cost), 1.0);
 }
 
 std::string DdpSummary::report(std::string_view label) const {

@@ -182,6 +182,10 @@ DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uin
     plan.predicted_cost = result.belief.expected_cost;
     plan.summary = std::move(result.belief.summary);
     plan.variant = DdpVariant::ILQR;
+    Trajectory reached;
+    reached.x = plan.policy.x_bar;
+    reached.u = plan.policy.u_bar;
+    score_diverged_solve(plan, c.cost, reached);
     return plan;  // no StepModel: PDDP's policy acts without MPC
   };
 }

@@ -31,8 +31,8 @@ std::vector<RunTask> read_tasks(const TomlFields& f, const toml::table& root, in
       f.fail(p + ".name", "must be non-empty without '/' or spaces (it names an HDF5 group)");
     for (const auto& earlier : out)
       if (earlier.name == t.name) f.fail(p + ".name", fmt::format("'{}' is used by two tasks", t.name));
-    t.x0 = f.vector(p + ".x0", n);
-    t.goal = f.vector(p + ".goal", n);
+    t.x0 = f.state_vector(p + ".x0", n);
+    t.goal = f.state_vector(p + ".goal", n);
     t.horizon = f.integer_in(p + ".horizon", 2, limits::kMaxHorizon);
     t.Q = f.vector(p + ".Q", n);
     t.R = f.vector(p + ".R", m);
@@ -123,8 +123,9 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
   c.noise.multiplicative_std = non_negative(f, "noise.actuator_multiplicative", m, Vector());
   c.noise.additive_std = non_negative(f, "noise.actuator_additive", m, Vector());
   c.observation_std = non_negative(f, "noise.observation", n, Vector::Zero(n));
+  (void)f.state_vector("noise.observation", n, Vector::Zero(n));  // a std in state units: bounded like a state
 
-  c.u_init = f.vector("control.u_init", m);
+  c.u_init = f.control_vector("control.u_init", m);
   c.u_min = f.vector("control.u_min", m, Vector());
   c.u_max = f.vector("control.u_max", m, Vector());
   if (c.u_min.size() && c.u_max.size() && (c.u_min.array() > c.u_max.array()).any())

@@ -45,14 +45,14 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
 
   c.noise.additive_std = f.vector("noise.actuator_additive", m, Vector());
   c.noise.multiplicative_std = f.vector("noise.actuator_multiplicative", m, Vector());
-  c.noise.state_std = f.vector("noise.state", n, Vector());
+  c.noise.state_std = f.state_vector("noise.state", n, Vector());
   for (const char* field : {"noise.actuator_additive", "noise.actuator_multiplicative", "noise.state"})
     if (f.has(field) && (f.vector(field, -1).array() < 0.0).any()) f.fail(field, "has negative entries; expected standard deviations >= 0");
 
   c.horizon = f.integer_in("problem.horizon", 1, limits::kMaxHorizon);
   if (const auto problem = limits::trajectory_memory_problem(c.horizon, n, m, false)) f.fail("problem.horizon", *problem);
-  c.x0 = f.vector("problem.x0", n);
-  c.goal = f.vector("problem.goal", n);
+  c.x0 = f.state_vector("problem.x0", n);
+  c.goal = f.state_vector("problem.goal", n);
   c.Q = f.vector("problem.Q", n);
   c.R = f.vector("problem.R", m);
   c.Qf = f.vector("problem.Qf", n);
@@ -62,7 +62,7 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   c.u_max = f.vector("problem.u_max", m, Vector());
   if (c.u_min.size() && c.u_max.size() && (c.u_min.array() > c.u_max.array()).any())
     f.fail("problem.u_min", "exceeds problem.u_max");
-  c.u_init = f.vector("problem.u_init", m, Vector());
+  c.u_init = f.control_vector("problem.u_init", m, Vector());
 
   const std::string algorithm = f.string("solver.algorithm", default_algorithm);
   if (auto v = parse_variant(algorithm)) c.solver.variant = *v;

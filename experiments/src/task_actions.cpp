@@ -1,6 +1,7 @@
 #include "gpilqg/experiments/task_actions.hpp"
 
 #include <chrono>
+#include <cmath>
 
 #include "gpilqg/control/rollout.hpp"
 
@@ -14,6 +15,13 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 Matrix repeated_u_init(const TaskContext& c) { return c.config.u_init.replicate(1, c.task.horizon); }
 
 }  // namespace
+
+void score_diverged_solve(Plan& plan, const Cost& cost, const Trajectory& reached) {
+  if (std::isfinite(plan.predicted_cost) && std::isfinite(plan.nominal_cost)) return;
+  const double scored = trajectory_cost(cost, reached);
+  plan.predicted_cost = plan.nominal_cost = scored;
+  plan.summary.initial_cost = plan.summary.final_cost = scored;
+}
 
 DdpTask ddp_task(const TaskContext& c) {
   DdpTask task;
@@ -49,6 +57,7 @@ Plan plan_with_ddp(const DdpTask& task, std::shared_ptr<const StepModel> model, 
   plan.summary = std::move(result.summary);
   plan.model = std::move(model);
   plan.variant = variant;
+  score_diverged_solve(plan, *task.cost, result.trajectory);
   return plan;
 }
 

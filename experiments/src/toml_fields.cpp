@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/system_registry.hpp"
@@ -190,6 +191,24 @@ Vector TomlFields::vector(const std::string& path, int size, std::optional<Vecto
     else fail(path, fmt::format("entry {} is not a number", i));
     if (!std::isfinite(v(static_cast<Eigen::Index>(i)))) fail(path, fmt::format("entry {} is not finite", i));
   }
+  return v;
+}
+
+void TomlFields::check_bound(const std::string& path, const Vector& v, const char* why) const {
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (std::abs(v(i)) > kDivergedStateMagnitude)
+      fail(path, fmt::format("entry {} is {:g}; expected |value| <= {:g} ({})", i, v(i), kDivergedStateMagnitude, why));
+}
+
+Vector TomlFields::state_vector(const std::string& path, int size, std::optional<Vector> fallback) const {
+  Vector v = vector(path, size, std::move(fallback));
+  check_bound(path, v, "beyond it a state counts as diverged");
+  return v;
+}
+
+Vector TomlFields::control_vector(const std::string& path, int size, std::optional<Vector> fallback) const {
+  Vector v = vector(path, size, std::move(fallback));
+  check_bound(path, v, "beyond it a control drives every model past the divergence bound");
   return v;
 }
 

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "gpilqg/control/ddp_solver.hpp"
 #include "gpilqg/core/finite_difference.hpp"
 #include "gpilqg/core/integrator.hpp"
@@ -59,6 +61,21 @@ TEST(DdpSummary, ReportIsOneLineWithTheTermination) {
   EXPECT_EQ(line.find('\n'), std::string::npos);
   EXPECT_TRUE(converged(DdpTermination::CostChange));
   EXPECT_FALSE(converged(DdpTermination::RegularizationLimit));
+}
+
+TEST(DdpSummary, StationaryComparesTheGradientsFirstOrderEffectWithTheCost) {
+  // |g|_inf max(|u|_inf, 1) <= 1e3 max(|J|, 1).
+  EXPECT_TRUE(stationary(2e-8, 3.5, 0.645));      // the reference swing-up at its optimum
+  EXPECT_TRUE(stationary(5.3, 9.5, 0.32));        // a stiff acrobot swing-up: ratio 50
+  EXPECT_TRUE(stationary(500.0, 0.1, 0.2));       // both floors at 1: 500 <= 1000
+  EXPECT_TRUE(stationary(1000.0, 2.0, -2.0));     // 2000 <= 2000
+  EXPECT_FALSE(stationary(1000.0, 2.0, 1.5));     // 2000 > 1500
+  EXPECT_FALSE(stationary(8.1e53, 0.04, 2.2e-3)); // the cart-pole at dt = 1 s
+  EXPECT_FALSE(stationary(std::numeric_limits<double>::infinity(), 1.0, 1.0));
+  EXPECT_FALSE(stationary(std::numeric_limits<double>::quiet_NaN(), 1.0, 1.0));
+  EXPECT_FALSE(stationary(0.0, 1.0, std::numeric_limits<double>::infinity()));
+  EXPECT_FALSE(converged(DdpTermination::Stalled));
+  EXPECT_EQ(to_string(DdpTermination::Stalled), "stalled");
 }
 
 TEST(AffinePolicy, ClampsToTheLimitsAndMeasuresChange) {

@@ -86,6 +86,31 @@ TEST(SolverFault, InitialControlsThatDivergeGiveAnInfiniteCostAndNoNaN) {
   EXPECT_EQ(r.value_hessians.size(), 41u);
 }
 
+TEST(SolverFault, ATrajectoryTooSensitiveToItsControlsStallsInsteadOfConverging) {
+  // The reference swing-up (cost_change at dt = 0.05 s) with Euler steps of 1 s: the line search
+  // ends on a knife-edge trajectory whose cost is tiny and whose gradient is about 1e53.
+  IntegratedStepModel model(make_system("cartpole"), Integrator::Euler, 1.0);
+  const QuadraticCost cost(1.0, Vector::Zero(4).asDiagonal(), Matrix::Identity(1, 1) * 0.1,
+                           Vector((Vector(4) << 100, 100, 1000, 100).finished()).asDiagonal(),
+                           Vector((Vector(4) << 0, 0, kPi, 0).finished()));
+  DdpProblem problem;
+  problem.model = &model;
+  problem.cost = &cost;
+  problem.x0 = Vector::Zero(4);
+  problem.horizon = 100;
+  DdpOptions options;
+  options.max_iterations = 1000;
+  options.cost_tolerance = 1e-12;
+  DdpSolver solver(options);
+  const DdpResult r = solver.solve(problem, Matrix::Zero(1, 100));
+  EXPECT_EQ(r.summary.termination, DdpTermination::Stalled) << r.summary.report("ilqr");
+  EXPECT_FALSE(converged(r.summary.termination));
+  EXPECT_FALSE(stationary(r.summary.final_gradient_norm, r.trajectory.u.cwiseAbs().maxCoeff(), r.summary.final_cost));
+  EXPECT_TRUE(result_finite(r));
+  EXPECT_TRUE(std::isfinite(r.nominal_cost) && std::isfinite(r.expected_cost));
+  EXPECT_NE(r.summary.report("ilqr").find("stalled"), std::string::npos);
+}
+
 /// The cart-pole with Jacobians poisoned by NaN where |theta_dot| > 1 (the step itself is fine).
 class NanJacobians final : public StepModel {
  public:

@@ -103,6 +103,25 @@ track_line = false
 transfer = true
 )");
   EXPECT_NE(first_transfer.find("user.toml:line 10: field 'tasks[0].transfer'"), std::string::npos) << first_transfer;
+  // State-valued fields beyond the divergence bound (a start that counts as diverged) are bad input.
+  const std::string far_start = error_of("cartpole", R"([[tasks]]
+name = "a"
+x0 = [1e300, 0.0, 0.5, 0.0]
+goal = [0.0, 0.0, 3.14, 0.0]
+horizon = 10
+Q = [0.0, 0.0, 0.0, 0.0]
+R = [0.1]
+Qf = [1.0, 1.0, 1.0, 1.0]
+track_line = false
+transfer = false
+)");
+  EXPECT_EQ(far_start, "user.toml:line 3: field 'tasks[0].x0': entry 0 is 1e+300; expected |value| <= 1e+12 (beyond "
+                       "it a state counts as diverged)");
+  EXPECT_NE(error_of("cartpole", "[noise]\nobservation = [0.1, 2e12, 0.1, 0.1]\n")
+                .find("field 'noise.observation': entry 1 is 2e+12; expected |value| <= 1e+12"),
+            std::string::npos);
+  EXPECT_NE(error_of("cartpole", "[control]\nu_init = [-1e13]\n").find("field 'control.u_init': entry 0 is -1e+13"),
+            std::string::npos);
   EXPECT_THROW(load_run_config("cartpole", std::filesystem::path("/no/such/run.toml")), InputError);
   EXPECT_THROW(default_run_config_text("pendulum"), InputError);
 }

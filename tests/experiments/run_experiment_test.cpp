@@ -14,6 +14,7 @@
 #include "gpilqg/experiments/plot_script.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
 #include "gpilqg/gp/residual_model.hpp"
+#include "finite_checks.hpp"
 #include "test_support.hpp"
 #include "tiny_run_config.hpp"
 
@@ -182,6 +183,27 @@ TEST(RunExperiment, ComparesGpBackendsOnTheSameSeedsAndLinksTheFirstAsGpIlqg) {
   h5.openDataSet("/first/gp_ilqg/cost").read(linked.data(), H5::PredType::NATIVE_DOUBLE);
   h5.openDataSet("/first/gp_ilqg_exact/cost").read(direct.data(), H5::PredType::NATIVE_DOUBLE);
   EXPECT_EQ(linked, direct);
+}
+
+TEST(RunCli, AStartThatDivergesIsRecordedAndTheResultStaysFinite) {
+  // x0 within the config's bound (1e12) but diverging at once: every solve's initial rollout and
+  // every real-world rollout diverge. Once the predicted costs were written as inf.
+  const auto dir = test::temporary_dir("run_diverging_start");
+  std::string text = kTinyRun;
+  text.replace(text.find("x0 = [0.0, 0.0, 0.3, 0.0]"), 25, "x0 = [1e11, 0.0, 0.3, 1e11]");
+  std::ofstream(dir / "far.toml") << text;
+  const auto r = test::run_cli("run cartpole --config " + (dir / "far.toml").string() + " --iterations 1 --out " +
+                               (dir / "r.h5").string() + " --no-plots");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("first ilqg_real iteration 0/1: cost "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" diverged ("), std::string::npos) << r.err;  // "..., 2 diverged (data ..."
+  EXPECT_TRUE(test::hdf5_datasets_finite(dir / "r.h5"));
+  H5::H5File h5((dir / "r.h5").string(), H5F_ACC_RDONLY);
+  const H5::DataSet diverged = h5.openDataSet("/first/ilqg_real/diverged");
+  std::vector<double> counts(static_cast<std::size_t>(diverged.getSpace().getSimpleExtentNpoints()));
+  diverged.read(counts.data(), H5::PredType::NATIVE_DOUBLE);
+  ASSERT_FALSE(counts.empty());
+  EXPECT_GT(counts.front(), 0.0);  // the status is recorded
 }
 
 TEST(RunCli, RunsFromAConfigFileAndRejectsBadOptions) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "finite_checks.hpp"
 #include "test_support.hpp"
 
 namespace gpilqg {
@@ -86,9 +87,59 @@ INSTANTIATE_TEST_SUITE_P(
                   "field 'problem.horizon': is 4294967297; expected an integer from 1 to 1000000"},
         BadConfig{"huge_iterations", "max_iterations = 1000", "max_iterations = 9223372036854775807",
                   "field 'solver.max_iterations': is 9223372036854775807; expected an integer from 1 to"},
+        // A start or goal beyond the divergence bound would only be found to diverge (or overflow).
+        BadConfig{"x0_beyond_bound", "x0 = [0, 0, 0, 0]", "x0 = [1e300, 0, 0, 0]",
+                  "bad.toml:line 10: field 'problem.x0': entry 0 is 1e+300; expected |value| <= 1e+12 (beyond it a "
+                  "state counts as diverged)"},
+        BadConfig{"goal_beyond_bound", "goal = [0, 0, 3.141592653589793, 0]", "goal = [0, 0, -1e13, 0]",
+                  "field 'problem.goal': entry 2 is -1e+13; expected |value| <= 1e+12"},
+        BadConfig{"u_init_beyond_bound", "R = [0.1]", "R = [0.1]\nu_init = [1e300]",
+                  "field 'problem.u_init': entry 0 is 1e+300; expected |value| <= 1e+12"},
         BadConfig{"huge_substeps", "dt = 0.05", "dt = 0.05\nsubsteps = -4294967295",
                   "field 'system.substeps': is -4294967295; expected an integer from 1 to 10000"}),
     [](const auto& info) { return std::string(info.param.name); });
+
+/// The reference config with `edit_from` replaced by `edit_to`, written to a temporary file.
+std::string edited_config(const std::string& edit_from, const std::string& edit_to) {
+  std::ifstream in(config_path("cartpole_swingup.toml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find(edit_from), edit_from.size(), edit_to);
+  const auto file = test::temporary_dir("solve_status") / "problem.toml";
+  std::ofstream(file) << text;
+  return "'" + file.string() + "'";
+}
+
+TEST(SolveCommand, ATooLongStepStallsAndIsNotReportedConverged) {
+  // Euler steps of 1 s: once "converged" (cost_change) with a gradient norm of 8e53.
+  const std::string file = edited_config("dt = 0.05", "dt = 1");
+  const auto text = test::run_cli("solve " + file);
+  EXPECT_EQ(text.status, 1) << text.out;
+  EXPECT_EQ(text.out.rfind("ilqr: stalled after ", 0), 0u) << text.out;
+  EXPECT_NE(text.err.find("warning: not converged: the cost stopped changing but the gradient |g| = "), std::string::npos)
+      << text.err;
+  const auto r = test::run_cli("solve " + file + " --json");
+  EXPECT_EQ(r.status, 1);
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["termination"], "stalled");
+  EXPECT_FALSE(j["converged"].get<bool>());
+  EXPECT_TRUE(test::json_numbers_finite(j));
+}
+
+TEST(SolveCommand, InitialControlsThatDivergeAreAStatusWithAFiniteCost) {
+  // Within the bound of the config, but the first step already leaves |x| <= 1e12.
+  const std::string file = edited_config("R = [0.1]", "R = [0.1]\nu_init = [1e12]");
+  const auto r = test::run_cli("solve " + file + " --json");
+  EXPECT_EQ(r.status, 1) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["termination"], "initial_rollout_diverged");
+  EXPECT_FALSE(j["converged"].get<bool>());
+  ASSERT_TRUE(j["cost"].is_number()) << r.out.substr(0, 300);  // the cost of the states reached, not null
+  EXPECT_GT(j["cost"].get<double>(), 1e20);
+  EXPECT_TRUE(test::json_numbers_finite(j));
+  EXPECT_NE(r.err.find("warning: not converged: the initial controls drive the model beyond"), std::string::npos) << r.err;
+  const auto text = test::run_cli("solve " + file);
+  for (const char* word : {"inf", "nan"}) EXPECT_EQ(text.out.find(word), std::string::npos) << text.out;
+}
 
 TEST(SolveCommand, AMissingFileIsBadInput) {
   const auto r = test::run_cli("solve /nonexistent/problem.toml");

@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 
+#include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -340,6 +341,8 @@ void check_solve_config(const SolveConfig& c) {
     violated("wrong vector sizes accepted");
   for (const Vector* v : {&c.x0, &c.goal, &c.Q, &c.Qf, &c.R, &c.u_min, &c.u_max, &c.u_init})
     if (!v->allFinite()) violated("non-finite numbers accepted");
+  for (const Vector* v : {&c.x0, &c.goal, &c.u_init})
+    if (v->size() > 0 && v->cwiseAbs().maxCoeff() > kDivergedStateMagnitude) violated("a start beyond the divergence bound accepted");
   if ((c.Q.array() < 0).any() || (c.R.array() < 0).any() || (c.Qf.array() < 0).any())
     violated("negative weights accepted");
   if ((c.u_min.size() != 0 && c.u_min.size() != m) || (c.u_max.size() != 0 && c.u_max.size() != m) ||

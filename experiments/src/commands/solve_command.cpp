@@ -1,5 +1,6 @@
 /// `gpilqg solve CONFIG.toml [--json]`: one trajectory-optimisation problem from a TOML file.
 
+#include <cmath>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -17,7 +18,13 @@ std::vector<double> as_list(const VectorCRef& v) { return {v.data(), v.data() + 
 
 int run_solve(const std::string& file, bool json) {
   const SolveConfig config = read_solve_config(file);
-  const DdpResult r = solve_config(config);
+  DdpResult r = solve_config(config);
+  if (!std::isfinite(r.nominal_cost) || !std::isfinite(r.expected_cost)) {
+    // The initial rollout diverged (costs +infinity): scored like a diverged rollout, the cost of the
+    // states reached with the last one repeated (trajectory.hpp); the termination says why.
+    r.nominal_cost = r.expected_cost = trajectory_cost(make_solve_cost(config), r.trajectory);
+    r.summary.initial_cost = r.summary.final_cost = r.nominal_cost;
+  }
   const auto& s = r.summary;
   const Vector x_final = r.trajectory.x.col(r.trajectory.x.cols() - 1);
   if (json) {
@@ -27,7 +34,7 @@ int run_solve(const std::string& file, bool json) {
     out["iterations"] = s.iterations;
     out["termination"] = std::string(to_string(s.termination));
     out["converged"] = converged(s.termination);
-    out["gradient_norm"] = s.final_gradient_norm;
+    if (std::isfinite(s.final_gradient_norm)) out["gradient_norm"] = s.final_gradient_norm;  // absent: not finite
     out["x_final"] = as_list(x_final);
     nlohmann::json u = nlohmann::json::array();
     for (Eigen::Index t = 0; t < r.trajectory.u.cols(); ++t) u.push_back(as_list(r.trajectory.u.col(t)));
@@ -40,6 +47,16 @@ int run_solve(const std::string& file, bool json) {
     std::cout << fmt::format("cost {:.12g} (expected {:.12g}), final state [{}]\n", r.nominal_cost, r.expected_cost,
                              fmt::join(as_list(x_final), ", "));
   }
+  if (s.termination == DdpTermination::Stalled)
+    std::cerr << fmt::format("warning: not converged: the cost stopped changing but the gradient |g| = {} is "
+                             "absurd against the cost {:.6g} (a trajectory too sensitive to its controls; try a "
+                             "smaller system.dt)\n",
+                             std::isfinite(s.final_gradient_norm) ? fmt::format("{:.2g}", s.final_gradient_norm) : "not finite",
+                             r.nominal_cost);
+  else if (s.termination == DdpTermination::InitialRolloutDiverged)
+    std::cerr << fmt::format("warning: not converged: the initial controls drive the model beyond the divergence "
+                             "bound (a state not finite or beyond |x| = {:g}); the cost is that of the states reached "
+                             "(try another problem.u_init)\n", kDivergedStateMagnitude);
   return converged(s.termination) ? kExitSuccess : kExitInternalFailure;
 }
 

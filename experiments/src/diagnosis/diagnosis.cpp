@@ -3,6 +3,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
+#include "gpilqg/control/rollout.hpp"
+
 namespace gpilqg::diagnosis {
 
 void DiagnosisOptions::validate() const {
@@ -69,6 +73,14 @@ Matrix shares(Matrix sensitivity) {
 
 Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   Verdict v;
+  if (r.model_diverges) {
+    v.status = "model_diverges";
+    v.reason = fmt::format("the model diverges (a predicted state not finite or beyond |x| = {:g}) on {} of {} one-step "
+                           "transitions and {} of {} k-step windows started from measured states, which stay within "
+                           "the bound: fix the model (its parameters, dt, integrator) before looking for a missing effect",
+                           kDivergedStateMagnitude, r.non_finite_predictions, r.samples, r.diverged_windows, r.windows);
+    return v;
+  }
   if (r.consistent) {
     v.status = "consistent";
     v.reason = "every state's held-out residual is at its noise floor: there is nothing left to explain";
@@ -105,6 +117,7 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
 DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   o.validate();
   if (set.episodes.empty()) throw std::invalid_argument("the data has no episodes");
+  check_measurement_range(set);
   DiagnosisReport R;
   R.system = o.model.system;
   // A model file's data carry the model's name (<mujoco model="...">), not the file's path.
@@ -178,8 +191,11 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
       score.rmse(i) = rms(e);
       score.fit_percent(i) = fit_percent(score.predictions.measured.col(i), score.predictions.predicted.col(i));
     }
+    R.windows += score.windows + score.diverged;
+    R.diverged_windows += score.diverged;
     R.k_step.push_back(std::move(score));
   }
+  R.model_diverges = R.non_finite_predictions > 0 || R.diverged_windows > 0;
 
   // 2. Where.
   R.sensitivity = gp_sensitivity(R.gp, data, data.rows(false));
@@ -187,13 +203,13 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   R.bins = bin_residuals(data, R.residual, R.input_names, o.bins);
   R.xcorr = cross_correlation(data, R.residual, o.max_lag);
   R.episode_rms = episode_rms(data, R.residual, static_cast<int>(set.episodes.size()));
-  R.consistent = true;
+  R.consistent = !R.model_diverges;
   for (const StateScore& s : R.states) R.consistent = R.consistent && !s.structured;
   R.gp_explained_total = weighted_heldout_explained(data, R.residual, R.gp.mean, R.weights);
 
   // 3. Which.
   const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual};
-  if (o.rank) R.ranking = rank_effects(context, o.alias_threshold, o.progress);
+  if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_threshold, o.progress);
   R.verdict = decide(R, o);
 
   // 4. Add: the four models on the held-out episodes.

@@ -22,7 +22,9 @@ std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integra
 namespace {
 
 /// sqrt(w_i) (x_{t+1,i} - phi_i(x_t, u_t)) stacked row by row over `rows` (index r * n + i); `finite`
-/// turns false when a prediction is not finite (its entries are then set to a large finite value).
+/// turns false when a prediction diverged (prediction_diverged: not finite or beyond 1e12). Such a
+/// prediction is replaced by x_t, as in one_step_predictions, so every entry stays finite and its
+/// square cannot overflow.
 Vector weighted_residual(const StepModel& model, const FitContext& c, const std::vector<int>& rows, bool* finite) {
   const auto n = static_cast<Eigen::Index>(c.weights.size());
   const Vector sqrt_w = c.weights.cwiseSqrt();
@@ -32,10 +34,9 @@ Vector weighted_residual(const StepModel& model, const FitContext& c, const std:
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const int r = rows[k];
     model.step(c.data->x.row(r).transpose(), c.data->u.row(r).transpose(), next, nullptr, *workspace);
-    if (!next.allFinite()) {
+    if (prediction_diverged(next)) {
       if (finite != nullptr) *finite = false;
-      out.segment(static_cast<Eigen::Index>(k) * n, n).setConstant(1e150);
-      continue;
+      next = c.data->x.row(r).transpose();
     }
     out.segment(static_cast<Eigen::Index>(k) * n, n) = sqrt_w.cwiseProduct(c.data->x_next.row(r).transpose() - next);
   }

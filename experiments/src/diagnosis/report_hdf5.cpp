@@ -146,6 +146,10 @@ void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport&
     h5.attribute("/", "status", r.verdict.status);
     h5.attribute("/", "verdict_effect", r.verdict.effect ? r.verdict.effect->effect : std::string());
     h5.attribute("/", "consistent", std::int64_t{r.consistent ? 1 : 0});
+    h5.attribute("/", "model_diverges", std::int64_t{r.model_diverges ? 1 : 0});
+    h5.attribute("/", "diverged_predictions", static_cast<std::int64_t>(r.non_finite_predictions));
+    h5.attribute("/", "diverged_windows", static_cast<std::int64_t>(r.diverged_windows));
+    h5.attribute("/", "windows", static_cast<std::int64_t>(r.windows));
     h5.attribute("/", "model", model_file_text(r.model));
     h5.attribute("/", "model_next", model_file_text(r.model_next));
     h5.attribute("/", "report", report_json(r).dump());

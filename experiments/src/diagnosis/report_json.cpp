@@ -1,6 +1,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "gpilqg/control/rollout.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 
@@ -162,7 +163,12 @@ nlohmann::json report_json(const DiagnosisReport& r) {
           {"added", added},
           {"comparison", comparison},
           {"model_next", model_file_text(r.model_next)},
-          {"non_finite_predictions", r.non_finite_predictions}};
+          {"non_finite_predictions", r.non_finite_predictions},
+          {"model_diverges", r.model_diverges},
+          {"divergence",
+           {{"bound", kDivergedStateMagnitude},
+            {"one_step", {{"diverged", r.non_finite_predictions}, {"transitions", r.samples}}},
+            {"k_step", {{"diverged", r.diverged_windows}, {"windows", r.windows}}}}}};
 }
 
 }  // namespace gpilqg::diagnosis

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "gpilqg/control/rollout.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 
 namespace gpilqg::diagnosis {
@@ -45,7 +46,11 @@ void compare_section(const DiagnosisReport& r, std::string& out) {
                          k.fit_percent(static_cast<Eigen::Index>(i)));
     out += r.state_names.size() > 6 ? "  ...\n" : "\n";
   }
-  if (r.consistent) {
+  if (r.model_diverges) {
+    out += fmt::format("   => the model diverges on the data: {} of {} one-step predictions and {} of {} k-step windows "
+                       "(not finite or beyond |x| = {:g})\n",
+                       r.non_finite_predictions, r.samples, r.diverged_windows, r.windows, kDivergedStateMagnitude);
+  } else if (r.consistent) {
     out += "   => consistent with the measurements: every residual is at its noise floor\n";
   } else {
     std::string above;
@@ -99,6 +104,8 @@ void where_section(const DiagnosisReport& r, std::string& out) {
 }
 
 void which_section(const DiagnosisReport& r, std::string& out) {
+  if (r.model_diverges && r.ranking.empty())
+    out += "\n3. Which effect is missing: not ranked, the model diverges on the data\n";
   if (r.ranking.empty()) return;
   const int worst = worst_state(r);
   out += fmt::format("\n3. Which effect is missing (fitted on training episodes, scored on held-out episodes {})\n",

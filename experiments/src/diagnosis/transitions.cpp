@@ -1,5 +1,9 @@
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
 
+#include <fmt/format.h>
+
+#include "gpilqg/control/rollout.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -67,21 +71,39 @@ Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& 
   return out;
 }
 
-Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* non_finite) {
+void check_measurement_range(const MeasurementSet& set) {
+  const auto check = [](const Episode& e, const MatrixCRef& values, const std::vector<Quantity>& columns) {
+    for (Eigen::Index s = 0; s < values.rows(); ++s)
+      for (Eigen::Index j = 0; j < values.cols(); ++j)
+        if (std::abs(values(s, j)) > kDivergedStateMagnitude)
+          throw std::invalid_argument(fmt::format(
+              "episode {} at t = {}: column '{}' is {:g}; expected |value| <= {:g} (the bound beyond which a state "
+              "counts as diverged)", e.id, e.t(s), columns[static_cast<std::size_t>(j)].name, values(s, j),
+              kDivergedStateMagnitude));
+  };
+  for (const Episode& e : set.episodes) {
+    check(e, e.x, set.system.states);
+    check(e, e.u, set.system.controls);
+  }
+}
+
+bool prediction_diverged(const VectorCRef& x) { return check_divergence(x) != RolloutStatus::Completed; }
+
+Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* diverged) {
   Matrix out(data.size(), model.state_dim());
   Vector next(model.state_dim());
   const auto workspace = model.make_workspace();
   int bad = 0;
   for (int i = 0; i < data.size(); ++i) {
     model.step(data.x.row(i).transpose(), data.u.row(i).transpose(), next, nullptr, *workspace);
-    if (next.allFinite()) {
+    if (!prediction_diverged(next)) {
       out.row(i) = next.transpose();
     } else {
       out.row(i) = data.x.row(i);
       ++bad;
     }
   }
-  if (non_finite != nullptr) *non_finite = bad;
+  if (diverged != nullptr) *diverged = bad;
   return out;
 }
 
@@ -101,7 +123,7 @@ KStepPredictions k_step_predictions(const StepModel& model, const MeasurementSet
       bool finite = true;
       for (int j = 0; j < k && finite; ++j) {
         model.step(x, e.u.row(s + j).transpose(), next, nullptr, *workspace);
-        finite = next.allFinite() && next.cwiseAbs().maxCoeff() < 1e12;
+        finite = !prediction_diverged(next);
         x = next;
       }
       if (!finite) {

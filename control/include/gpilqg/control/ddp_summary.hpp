@@ -16,11 +16,28 @@ enum class DdpTermination {
   RegularizationLimit, ///< no acceptable step even at lambda_max (numerical trouble or a local minimum)
   InitialRolloutDiverged,  ///< the initial controls drive the model to non-finite states
   Cancelled,           ///< DdpOptions::on_iteration asked to stop
+  /// An accepted step changed the cost by less than cost_tolerance, but the projected gradient g is
+  /// not finite or absurd: |g|_inf max(|u|_inf, 1) > 1e3 max(|J|, 1) (stationary() below).
+  /// The line search only found tiny steps on a trajectory too sensitive to its controls for the
+  /// quadratic model (e.g. a step dt far too long for the dynamics): not a minimum, not converged.
+  Stalled,
 };
 
 std::string_view to_string(DdpTermination termination);
-/// True for the terminations that mean convergence (CostChange, GradientNorm).
+/// True for the terminations that mean convergence (CostChange, GradientNorm); Stalled is not.
 bool converged(DdpTermination termination);
+
+/// Whether a trajectory whose cost stopped changing is a minimum rather than a stall: the projected
+/// gradient g = dJ/du (its largest entry over all steps) is finite and its first-order effect over
+/// the controls' own scale is not absurd against the cost,
+///   |g|_inf max(|u|_inf, 1) <= kStationarityFactor max(|J|, 1),   kStationarityFactor = 1e3.
+/// Measured ratios |g| max(|u|, 1) / max(|J|, 1): the reference cart-pole swing-ups 1e-7 to 1e-4, a
+/// stiff acrobot swing-up stopped at a relative cost change of 1e-9 about 50 (large curvature: its
+/// Newton step predicts a further reduction of 2e-6 J), and a line search stalled on a trajectory too
+/// sensitive to its controls about 1e53 (the cart-pole at dt = 1 s, whose Newton step predicts nothing
+/// because the curvature is as absurd). The floors at 1 only make the test more lenient.
+inline constexpr double kStationarityFactor = 1e3;
+bool stationary(double gradient_norm, double control_scale, double cost);
 
 struct DdpIteration {
   int iteration = 0;

@@ -33,6 +33,13 @@ struct Plan {
   DdpVariant variant = DdpVariant::ILQG;
 };
 
+/// A solve whose costs are not finite (its initial rollout diverged, summary.termination
+/// InitialRolloutDiverged: DdpResult's costs are then +infinity) is scored like a diverged rollout
+/// (trajectory.hpp): predicted and nominal cost, and the summary's costs, become the cost of the
+/// states `reached` (the last one repeated), finite and large, so no result holds an infinity; the
+/// termination says why. Plans with finite costs are left as they are.
+void score_diverged_solve(Plan& plan, const Cost& cost, const Trajectory& reached);
+
 /// The context of one task: config, task, models and cost (all outlive the actions), and where
 /// progress lines go (may be empty).
 class RunJournal;

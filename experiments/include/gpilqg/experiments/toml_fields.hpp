@@ -50,6 +50,14 @@ class TomlFields {
   int integer_in(const std::string& path, int min, int max, std::optional<int> fallback = std::nullopt) const;
   /// An array of numbers; `size` >= 0 requires that many entries.
   Vector vector(const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) const;
+  /// A state-valued array (an initial state, a goal, a state noise std): vector(), and every entry
+  /// within |x_i| <= kDivergedStateMagnitude (1e12, control/rollout.hpp). A state beyond that bound
+  /// counts as diverged everywhere else (rollouts, the DDP line search, the diagnosis), so a config
+  /// that starts there is bad input: "field 'problem.x0': entry 0 is 1e+300; expected |value| <= 1e+12".
+  Vector state_vector(const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) const;
+  /// An initial control (u_init), bounded the same way: a control beyond 1e12 drives every model past
+  /// the divergence bound at the first step, and its quadratic cost overflows.
+  Vector control_vector(const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) const;
   bool has(const std::string& path) const;
   /// A system's name (DESIGN.md sections 3 and 10) as the registry resolves it: a MuJoCo model file
   /// given by a relative path is relative to the config file's folder. Fails naming the field for an
@@ -70,6 +78,8 @@ class TomlFields {
 
  private:
   const toml::node* find(const std::string& path) const;
+  /// Fails naming the first entry of `v` with |v_i| > kDivergedStateMagnitude; `why` ends the message.
+  void check_bound(const std::string& path, const Vector& v, const char* why) const;
   /// The file a node was read from (its source region), else the file this reader was made for.
   std::string source_of(const toml::node* node) const;
   const toml::table& root_;

@@ -25,6 +25,12 @@
 ///    the GP (a flexible model of everything learnable) removes on the same rows. A wrong effect can
 ///    still soak up some of the residual; it cannot match the GP.
 ///  - "unexplained" otherwise: the residual has structure no effect of the library accounts for.
+///
+/// Before all of these: "model_diverges" when the model's prediction diverges (not finite, or a state
+/// beyond kDivergedStateMagnitude = 1e12, control/rollout.hpp) on any one-step transition or any k-step
+/// window started from a measured state. The measurements stayed within the bound (check_measurement_range),
+/// so such a model is not consistent with them whatever its other scores; the effects are not ranked
+/// (a fit against a diverging model means nothing) and the reason counts the diverged predictions.
 
 #include <functional>
 #include <optional>
@@ -100,7 +106,7 @@ struct ModelScore {
 };
 
 struct Verdict {
-  std::string status;                    ///< "explained", "unexplained", "consistent"
+  std::string status;                    ///< "explained", "unexplained", "consistent", "model_diverges"
   std::optional<EffectFit> effect;       ///< the proposed effect (status "explained")
   std::vector<std::string> aliases;
   std::string reason;                    ///< one sentence: why this verdict
@@ -120,7 +126,12 @@ struct DiagnosisReport {
   Transitions data;
   Matrix predicted;                      ///< N x n, one-step
   Matrix residual;                       ///< N x n
-  int non_finite_predictions = 0;
+  int non_finite_predictions = 0;        ///< one-step predictions that diverged (prediction_diverged)
+  /// True when the model diverges on the data: a one-step prediction or a k-step window diverged
+  /// (verdict "model_diverges", consistent false, no ranking).
+  bool model_diverges = false;
+  int diverged_windows = 0;              ///< k-step windows that diverged, over all horizons
+  int windows = 0;                       ///< k-step windows, over all horizons (diverged included)
   std::vector<StateScore> states;
   std::vector<KStepScore> k_step;
   ResidualGp gp;
@@ -143,7 +154,7 @@ struct DiagnosisReport {
 };
 
 /// Runs the diagnosis. Throws std::invalid_argument for bad options or data that do not fit the model
-/// (too few episodes, dt varying between episodes).
+/// (too few episodes, dt varying between episodes, a value beyond 1e12: check_measurement_range).
 DiagnosisReport diagnose(const MeasurementSet& data, const DiagnosisOptions& options);
 
 }  // namespace gpilqg::diagnosis

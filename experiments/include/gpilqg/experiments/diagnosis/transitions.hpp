@@ -37,9 +37,20 @@ std::vector<int> heldout_episodes(const MeasurementSet& set, double fraction);
 /// dt differs from `dt` by more than 1e-6 relative (naming the episode and both values).
 Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& heldout, double dt);
 
-/// One-step predictions phi(x_t, u_t) (N x n). A non-finite prediction is replaced by x_t (and counted
-/// in `non_finite` when not null), so no NaN leaves this function.
-Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* non_finite = nullptr);
+/// Throws std::invalid_argument when a state or control of `set` exceeds |value| <= kDivergedStateMagnitude
+/// (1e12, control/rollout.hpp), naming the episode, the time and the column: a measurement beyond the
+/// bound at which every prediction counts as diverged is not a measurement of a physical system, and
+/// the squares of its differences overflow (1e308 - (-1e308) is inf).
+void check_measurement_range(const MeasurementSet& set);
+
+/// Whether a predicted state diverged: not finite or beyond kDivergedStateMagnitude (rollout.hpp's
+/// check_divergence, the one test shared with every rollout).
+bool prediction_diverged(const VectorCRef& x);
+
+/// One-step predictions phi(x_t, u_t) (N x n). A prediction that diverged (prediction_diverged) is
+/// replaced by x_t and counted in `diverged` when not null, so no NaN, inf or overflowing value leaves
+/// this function.
+Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* diverged = nullptr);
 
 /// k-step open-loop predictions: for every episode and every start s = 0, stride, 2 stride, ... with
 /// s + k < T, roll the model k steps from the measured x_s with the measured controls and compare with
@@ -50,7 +61,7 @@ struct KStepPredictions {
   Matrix predicted;            ///< W x n
   std::vector<int> episode;    ///< W
   std::vector<int> start;      ///< W, s
-  int diverged = 0;            ///< windows whose prediction became non-finite (left out of the W rows)
+  int diverged = 0;            ///< windows whose prediction diverged (prediction_diverged; left out of the W rows)
 };
 KStepPredictions k_step_predictions(const StepModel& model, const MeasurementSet& set,
                                     const std::vector<int>& episodes, int k, int stride);
