@@ -272,7 +272,7 @@ TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   expect_bad_input(plan(write(dir / "gp.toml", std::string(test::kTinyPlan) + "points = 3\n"), "--out " + quote(dir / "x.h5")),
                    {"gp.toml:line 27", "gp.points"});
   // A start beyond the divergence bound (the loader of `gpilqg solve`, shared).
-  text = kPlanConfig;
+  text = test::kTinyPlan;
   text.replace(text.find("x0 = [0.0"), 9, "x0 = [1e300");
   expect_bad_input(plan(write(dir / "far.toml", text), "--out " + quote(dir / "x.h5")),
                    {"far.toml:line", "field 'problem.x0': entry 0 is 1e+300; expected |value| <= 1e+12"});
