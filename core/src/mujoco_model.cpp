@@ -160,7 +160,8 @@ std::shared_ptr<const MujocoModel> MujocoModel::with_parameters(const std::map<s
   out->read_names();
   const std::vector<Field> fields = out->fields();
   for (const auto& [key, value] : overrides) {
-    const auto it = std::find_if(fields.begin(), fields.end(), [&](const Field& f) { return f.name == key; });
+    const std::string& name = key;  // (clang 14 cannot capture a structured binding)
+    const auto it = std::find_if(fields.begin(), fields.end(), [&](const Field& f) { return f.name == name; });
     if (it == fields.end()) {
       std::string known;
       for (const Field& f : fields) known += (known.empty() ? "" : ", ") + f.name;

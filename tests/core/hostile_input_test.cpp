@@ -26,20 +26,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CoreReader {
-  const char* name;
-  const char* extension;
-  std::uintmax_t limit;
-  std::function<void(const fs::path&)> read;
-};
-
 const SystemSignature& cartpole() {
   static const SystemSignature signature = system_signature("cartpole");
   return signature;
 }
 
 TEST(HostileInputs, EveryDataReaderRefusesThemWithDataError) {
-  const std::vector<CoreReader> readers = {
+  const std::vector<test::Reader> readers = {
       {"read_measurements (CSV)", ".csv", kMaxDataFileBytes, [](const fs::path& f) { read_measurements(f, cartpole()); }},
       {"read_measurements (HDF5)", ".h5", kMaxDataFileBytes, [](const fs::path& f) { read_measurements(f, cartpole()); }},
       {"read_raw_log (CSV)", ".csv", kMaxDataFileBytes, [](const fs::path& f) { read_raw_log(f); }},
@@ -50,13 +43,7 @@ TEST(HostileInputs, EveryDataReaderRefusesThemWithDataError) {
       {"read_raw_log_hdf5", ".h5", kMaxDataFileBytes, [](const fs::path& f) { read_raw_log_hdf5(f); }},
       {"Hdf5Reader", ".h5", kMaxDataFileBytes, [](const fs::path& f) { Hdf5Reader reader(f); }},
   };
-  const fs::path dir = test::temporary_dir("hostile");
-  for (std::size_t i = 0; i < readers.size(); ++i) {
-    const CoreReader& r = readers[i];
-    const auto inputs = test::make_hostile_inputs(dir / std::to_string(i), r.extension, r.limit);
-    test::expect_refuses_hostile_inputs<DataError>(r.name, r.read, inputs);
-  }
-  fs::remove_all(dir);
+  test::expect_readers_refuse_hostile_inputs<DataError>(readers, test::temporary_dir("hostile"));
 }
 
 TEST(HostileInputs, TheMujocoModelLoaderRefusesThemWithInvalidArgument) {

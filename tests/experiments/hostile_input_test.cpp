@@ -22,15 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliReader {
-  const char* name;
-  const char* extension;
-  std::uintmax_t limit;
-  std::function<void(const fs::path&)> read;
-};
-
 TEST(HostileInputs, EveryCommandLineReaderRefusesThemWithInputError) {
-  const std::vector<CliReader> readers = {
+  const std::vector<test::Reader> readers = {
       {"read_solve_config", ".toml", kMaxConfigFileBytes, [](const fs::path& f) { read_solve_config(f); }},
       {"read_plan_config", ".toml", kMaxConfigFileBytes, [](const fs::path& f) { read_plan_config(f); }},
       {"load_run_config", ".toml", kMaxConfigFileBytes, [](const fs::path& f) { load_run_config("cartpole", f); }},
@@ -46,13 +39,7 @@ TEST(HostileInputs, EveryCommandLineReaderRefusesThemWithInputError) {
          read_profile_data(f, options);
        }},
   };
-  const fs::path dir = test::temporary_dir("hostile");
-  for (std::size_t i = 0; i < readers.size(); ++i) {
-    const CliReader& r = readers[i];
-    const auto inputs = test::make_hostile_inputs(dir / std::to_string(i), r.extension, r.limit);
-    test::expect_refuses_hostile_inputs<InputError>(r.name, r.read, inputs);
-  }
-  fs::remove_all(dir);
+  test::expect_readers_refuse_hostile_inputs<InputError>(readers, test::temporary_dir("hostile"));
 }
 
 TEST(HostileInputs, TheCommandLineExitsTwoOnAFifo) {

@@ -91,30 +91,16 @@ TEST(RunConfig, BadInputNamesFileLineAndField) {
             std::string::npos);
   EXPECT_NE(error_of("cartpole", "[loop\n").find("user.toml:line 1"), std::string::npos);
   EXPECT_NE(error_of("cartpole", "[solver]\ngp_algorithm = \"pddp\"\n").find("field 'solver.gp_algorithm'"), std::string::npos);
-  const std::string first_transfer = error_of("cartpole", R"([[tasks]]
-name = "a"
-x0 = [0.0, 0.0, 0.5, 0.0]
-goal = [0.0, 0.0, 3.14, 0.0]
-horizon = 10
-Q = [0.0, 0.0, 0.0, 0.0]
-R = [0.1]
-Qf = [1.0, 1.0, 1.0, 1.0]
-track_line = false
-transfer = true
-)");
+  // One [[tasks]] table with the given start and transfer flag.
+  auto one_task = [](const std::string& x0, const std::string& transfer) {
+    return "[[tasks]]\nname = \"a\"\nx0 = " + x0 +
+           "\ngoal = [0.0, 0.0, 3.14, 0.0]\nhorizon = 10\nQ = [0.0, 0.0, 0.0, 0.0]\nR = [0.1]\n"
+           "Qf = [1.0, 1.0, 1.0, 1.0]\ntrack_line = false\ntransfer = " + transfer + "\n";
+  };
+  const std::string first_transfer = error_of("cartpole", one_task("[0.0, 0.0, 0.5, 0.0]", "true"));
   EXPECT_NE(first_transfer.find("user.toml:line 10: field 'tasks[0].transfer'"), std::string::npos) << first_transfer;
   // State-valued fields beyond the divergence bound (a start that counts as diverged) are bad input.
-  const std::string far_start = error_of("cartpole", R"([[tasks]]
-name = "a"
-x0 = [1e300, 0.0, 0.5, 0.0]
-goal = [0.0, 0.0, 3.14, 0.0]
-horizon = 10
-Q = [0.0, 0.0, 0.0, 0.0]
-R = [0.1]
-Qf = [1.0, 1.0, 1.0, 1.0]
-track_line = false
-transfer = false
-)");
+  const std::string far_start = error_of("cartpole", one_task("[1e300, 0.0, 0.5, 0.0]", "false"));
   EXPECT_EQ(far_start, "user.toml:line 3: field 'tasks[0].x0': entry 0 is 1e+300; expected |value| <= 1e+12 (beyond "
                        "it a state counts as diverged)");
   EXPECT_NE(error_of("cartpole", "[noise]\nobservation = [0.1, 2e12, 0.1, 0.1]\n")

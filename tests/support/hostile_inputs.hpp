@@ -59,4 +59,25 @@ void expect_refuses_hostile_inputs(const std::string& reader, const std::functio
   }
 }
 
+/// One reader of a table-driven test: its name, the extension and size limit of its files, and a
+/// call that reads a file.
+struct Reader {
+  const char* name;
+  const char* extension;
+  std::uintmax_t limit;
+  std::function<void(const std::filesystem::path&)> read;
+};
+
+/// expect_refuses_hostile_inputs for every reader of `readers`, each on its own inputs in a folder
+/// of `dir` (removed afterwards).
+template <class Error>
+void expect_readers_refuse_hostile_inputs(const std::vector<Reader>& readers, const std::filesystem::path& dir) {
+  for (std::size_t i = 0; i < readers.size(); ++i) {
+    const Reader& r = readers[i];
+    const auto inputs = make_hostile_inputs(dir / std::to_string(i), r.extension, r.limit);
+    expect_refuses_hostile_inputs<Error>(r.name, r.read, inputs);
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace gpilqg::test
