@@ -68,9 +68,6 @@ std::string previous_state(const std::filesystem::path& target) {
              : "no file was written";
 }
 
-/// The longest file name POSIX file systems accept (NAME_MAX on Linux, ext4, tmpfs, XFS, btrfs).
-constexpr std::size_t kMaxFileNameBytes = 255;
-
 /// The part of a temporary's name before ".tmp-<pid>-<n>": the target's name, or, when the whole
 /// temporary name would be too long, its first bytes + "~" + 8 hex digits of its FNV-1a hash.
 std::string temporary_stem(const std::string& name) {

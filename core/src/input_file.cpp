@@ -37,17 +37,32 @@ std::string unresolved(int error) {
   }
 }
 
-/// The kind of a file that is not a regular file, e.g. "a FIFO (named pipe)".
-std::string kind_of(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  return "a special file";
+/// The file type of a stat(2) mode.
+std::filesystem::file_type type_of(mode_t mode) {
+  using std::filesystem::file_type;
+  if (S_ISREG(mode)) return file_type::regular;
+  if (S_ISDIR(mode)) return file_type::directory;
+  if (S_ISFIFO(mode)) return file_type::fifo;
+  if (S_ISSOCK(mode)) return file_type::socket;
+  if (S_ISCHR(mode)) return file_type::character;
+  if (S_ISBLK(mode)) return file_type::block;
+  return file_type::unknown;
 }
 
 }  // namespace
+
+const char* file_kind(std::filesystem::file_type type) {
+  switch (type) {
+    case std::filesystem::file_type::regular: return "a regular file";
+    case std::filesystem::file_type::directory: return "a folder";
+    case std::filesystem::file_type::fifo: return "a FIFO (named pipe)";
+    case std::filesystem::file_type::socket: return "a socket";
+    case std::filesystem::file_type::character: return "a character device";
+    case std::filesystem::file_type::block: return "a block device";
+    case std::filesystem::file_type::symlink: return "a symbolic link";
+    default: return "a special file";
+  }
+}
 
 std::string InputFileIssue::message(const std::filesystem::path& file) const {
   return file.string() + ": " + problem + "; expected " + expected;
@@ -62,7 +77,7 @@ std::optional<InputFileIssue> input_file_issue(const std::filesystem::path& file
     return InputFileIssue{unresolved(error), expected};
   }
   if (!S_ISREG(status.st_mode))
-    return InputFileIssue{"is " + kind_of(status.st_mode) + ", not a regular file", expected};
+    return InputFileIssue{std::string("is ") + file_kind(type_of(status.st_mode)) + ", not a regular file", expected};
   if (::access(file.c_str(), R_OK) != 0) {
     const int error = errno;
     return InputFileIssue{fmt::format("cannot be read ({})", std::strerror(error)), expected + " readable by this user"};

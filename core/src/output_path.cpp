@@ -8,26 +8,14 @@
 #include <cstring>
 #include <system_error>
 
+#include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/input_file.hpp"
+
 namespace gpilqg {
 
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr std::size_t kMaxFileNameBytes = 255;
-
-/// "a folder", "a FIFO", "a regular file", ...: the kind of an entry, for messages.
-const char* kind_of(fs::file_type type) {
-  switch (type) {
-    case fs::file_type::directory: return "a folder";
-    case fs::file_type::fifo: return "a FIFO (named pipe)";
-    case fs::file_type::socket: return "a socket";
-    case fs::file_type::character: return "a character device";
-    case fs::file_type::block: return "a block device";
-    case fs::file_type::regular: return "a regular file";
-    default: return "neither a file nor a folder";
-  }
-}
 
 /// The folder that will hold `path`'s entry, or the nearest ancestor of it that exists; checked
 /// for being a folder this process may create files in (access(2) with W_OK | X_OK).
@@ -40,7 +28,7 @@ std::optional<std::string> folder_problem(fs::path folder) {
   const fs::file_status status = fs::status(folder, error);
   if (error) return "cannot inspect the folder " + folder.string() + " (" + error.message() + ")";
   if (status.type() != fs::file_type::directory)
-    return folder.string() + " is " + kind_of(status.type()) + "; expected a folder";
+    return folder.string() + " is " + file_kind(status.type()) + "; expected a folder";
   if (::access(folder.c_str(), W_OK | X_OK) != 0)
     return "the folder " + folder.string() + " is not writable (" + std::strerror(errno) + ")";
   return std::nullopt;
@@ -58,7 +46,7 @@ std::optional<std::string> output_file_problem(const fs::path& file) {
   if (error && error != std::errc::no_such_file_or_directory && error != std::errc::not_a_directory)
     return "cannot inspect it (" + error.message() + ")";
   if (fs::exists(own) && own.type() != fs::file_type::regular && own.type() != fs::file_type::symlink)
-    return std::string("is ") + kind_of(own.type()) + "; expected a regular file or a new file name";
+    return std::string("is ") + file_kind(own.type()) + "; expected a regular file or a new file name";
   return folder_problem(file.parent_path());
 }
 
@@ -66,7 +54,7 @@ std::optional<std::string> output_folder_problem(const fs::path& folder) {
   std::error_code error;
   const fs::file_status status = fs::status(folder, error);
   if (fs::exists(status) && status.type() != fs::file_type::directory)
-    return std::string("is ") + kind_of(status.type()) + "; expected a folder";
+    return std::string("is ") + file_kind(status.type()) + "; expected a folder";
   return folder_problem(folder);
 }
 

@@ -69,7 +69,7 @@ TEST(HostileInputs, TheMessagesNameTheKindOfFileAndTheLimit) {
   EXPECT_EQ(message("fifo"), d + "fifo.csv: is a FIFO (named pipe), not a regular file; expected a measurement file");
   EXPECT_EQ(message("link to /dev/zero"),
             d + "zero.csv: is a character device, not a regular file; expected a measurement file");
-  EXPECT_EQ(message("directory"), d + "folder.csv: is a directory, not a regular file; expected a measurement file");
+  EXPECT_EQ(message("directory"), d + "folder.csv: is a folder, not a regular file; expected a measurement file");
   EXPECT_EQ(message("symbolic link loop"), d + "loop.csv: too many levels of symbolic links (a loop of symbolic "
                                                "links); expected a measurement file");
   EXPECT_EQ(message("missing file"), d + "missing.csv: no such file; expected a measurement file");

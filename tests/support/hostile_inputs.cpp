@@ -25,7 +25,7 @@ std::vector<HostileInput> make_hostile_inputs(const std::filesystem::path& dir, 
   inputs.push_back({"link to /dev/zero", path("zero"), "is a character device, not a regular file"});
 
   fs::create_directory(path("folder"));
-  inputs.push_back({"directory", path("folder"), "is a directory, not a regular file"});
+  inputs.push_back({"directory", path("folder"), "is a folder, not a regular file"});
 
   fs::create_symlink(path("loop").filename(), path("loop"));  // a link to itself
   inputs.push_back({"symbolic link loop", path("loop"), "too many levels of symbolic links"});

@@ -26,6 +26,9 @@
 
 namespace gpilqg {
 
+/// The longest file name the usual file systems accept (NAME_MAX on Linux: ext4, tmpfs, XFS, btrfs).
+inline constexpr std::size_t kMaxFileNameBytes = 255;
+
 /// A failure of the atomic-write machinery itself (temporary not created, flush or rename failed).
 /// what() reads "<target>: <problem> (<system reason>)"; target() is the file that was being written.
 class AtomicWriteError : public std::runtime_error {

@@ -25,9 +25,13 @@ inline constexpr std::uintmax_t kMaxDataFileBytes = std::uintmax_t{4} << 30;
 /// files of `gpilqg diagnose`, MuJoCo models. 16 MiB.
 inline constexpr std::uintmax_t kMaxConfigFileBytes = std::uintmax_t{16} << 20;
 
+/// How messages name the kind of a file-system entry: "a regular file", "a folder", "a FIFO (named
+/// pipe)", "a socket", "a character device", "a block device", "a symbolic link", "a special file".
+const char* file_kind(std::filesystem::file_type type);
+
 /// Why a path cannot be read as an input file.
 struct InputFileIssue {
-  std::string problem;   ///< e.g. "no such file", "is a directory, not a regular file"
+  std::string problem;   ///< e.g. "no such file", "is a folder, not a regular file"
   std::string expected;  ///< what the reader needs, e.g. "a measurement file"
   /// "<file>: <problem>; expected <expected>".
   std::string message(const std::filesystem::path& file) const;
@@ -37,7 +41,7 @@ struct InputFileIssue {
 /// ("a measurement file", "an HDF5 file"). Problems, in the order they are found:
 ///  - the path cannot be resolved: "no such file", "too many levels of symbolic links (a loop of
 ///    symbolic links)", "a component of the path is not a folder", or the system's reason;
-///  - it is not a regular file: "is a directory", "is a FIFO (named pipe)", "is a socket",
+///  - it is not a regular file: "is a folder", "is a FIFO (named pipe)", "is a socket",
 ///    "is a character device", "is a block device" (each followed by ", not a regular file");
 ///  - it is not readable by this user;
 ///  - it is larger than `max_bytes` (the expected text then states the limit).
