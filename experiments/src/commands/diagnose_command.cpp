@@ -116,7 +116,7 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   if (!h5.empty()) std::cout << "report: " << h5.string() << '\n';
   if (!o.plots.empty()) std::cout << "plots: " << o.plots << '\n';
   if (!o.write_model.empty()) std::cout << "model for the next round: " << o.write_model << '\n';
-  if (report.verdict.effect && r.add.empty())
+  if (report.verdict.effect && r.add.empty() && !r.auto_select)
     std::cout << fmt::format("next: gpilqg diagnose{} --system {} --data {}{} --add {}\n", plugin_option(r.system),
                              r.system, o.data, r.model_file.empty() ? "" : " --model " + r.model_file,
                              report.verdict.effect->effect);
@@ -136,6 +136,9 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--model", r.model_file, "Model file (TOML): preset, recalibrated parameters, effects");
   cmd->add_option("--preset", r.preset, "Preset without --model: sim or real")->capture_default_str();
   cmd->add_option("--add", r.add, "Add a library effect, EFFECT or EFFECT=VALUE (fitted without a value; repeatable)");
+  cmd->add_flag("--auto", r.auto_select,
+                "Add several effects in one call: forward selection with joint refits, stopped when the held-out "
+                "improvement is no longer significant; --write-model writes the final model");
   cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the report");
   cmd->add_option("--out", o->out, "Write the HDF5 report here");
   cmd->add_option("--plots", o->plots, "Write PNG plots into this folder (needs matplotlib and h5py)");

@@ -33,6 +33,7 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("--backend: ") + e.what());
   }
+  d.auto_select = o.auto_select;
   d.heldout_fraction = o.heldout;
   d.gp.points = o.gp_points;
   d.gp.restarts = o.gp_restarts;

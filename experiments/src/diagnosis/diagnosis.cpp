@@ -1,11 +1,13 @@
 #include "gpilqg/experiments/diagnosis/diagnosis.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "gpilqg/control/rollout.hpp"
+#include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -142,16 +144,53 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   ResidualGp gp_before = fit_residual_gp(before_step, data, residual_before, o.gp);
   if (o.progress) o.progress("residual GP of the model fitted");
 
-  // Effects to add: given values, or fitted on the training episodes against the model so far.
+  // Effects to add: given values first (kept as given), then the others fitted jointly on the training
+  // episodes, together with the effects the model already has (refitted from their current values).
   R.model = o.model;
   Matrix residual = residual_before;
+  const Vector weights_before = floor_weights(data, residual_before, gp_before);
+  std::vector<const LibraryEffect*> to_fit;
+  std::vector<std::string> given;
   for (const EffectRequest& request : o.add) {
     const LibraryEffect& effect = find_effect(R.system, request.effect);
-    FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, floor_weights(data, residual_before, gp_before), residual};
-    EffectFit fit = request.values ? score_effect(effect, *request.values, context) : fit_effect(effect, context);
-    R.model = R.model.with(effect, fit.estimate);
+    if (!request.values) {
+      to_fit.push_back(&effect);
+      continue;
+    }
+    const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual};
+    R.added.push_back(score_effect(effect, *request.values, context));
+    R.model = R.model.with(effect, *request.values);
     residual = residual_of(data, one_step_predictions(*make_step_model(R.model, o.integrator, R.dt, o.substeps), data));
-    R.added.push_back(std::move(fit));
+    given.push_back(effect.name);
+  }
+  if (!to_fit.empty()) {
+    std::vector<RefitEffect> refit;
+    for (std::size_t i = 1; i < to_fit.size(); ++i) refit.push_back({to_fit[i], R.model.current_values(*to_fit[i])});
+    for (const RefitEffect& r : model_effects(R.model)) {
+      const bool requested = std::find(to_fit.begin(), to_fit.end(), r.effect) != to_fit.end();
+      const bool kept = std::find(given.begin(), given.end(), r.effect->name) != given.end();
+      if (!requested && !kept) refit.push_back(r);
+    }
+    const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual};
+    const EffectFit joint = fit_jointly(*to_fit.front(), refit, context);
+    R.model = R.model.with(*to_fit.front(), joint.estimate);
+    for (const EffectValues& v : joint.refitted) R.model = R.model.with(find_effect(R.system, v.effect), v.estimate);
+    // One entry per requested effect, with the joint scores; the model's own effects as refitted values.
+    EffectFit first = joint;
+    first.refitted.clear();
+    R.added.push_back(first);
+    for (std::size_t i = 1; i < to_fit.size(); ++i) {
+      EffectFit f = first;
+      const EffectValues& v = joint.refitted[i - 1];
+      f.effect = v.effect;
+      f.parameters = v.parameters;
+      f.initial = f.linear_estimate = v.initial;
+      f.estimate = v.estimate;
+      f.ci_low = v.ci_low;
+      f.ci_high = v.ci_high;
+      R.added.push_back(std::move(f));
+    }
+    R.refitted.assign(joint.refitted.begin() + static_cast<std::ptrdiff_t>(to_fit.size() - 1), joint.refitted.end());
   }
   const auto step = make_step_model(R.model, o.integrator, R.dt, o.substeps);
   R.predicted = one_step_predictions(*step, data, &R.non_finite_predictions);
@@ -207,10 +246,26 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   for (const StateScore& s : R.states) R.consistent = R.consistent && !s.structured;
   R.gp_explained_total = weighted_heldout_explained(data, R.residual, R.gp.mean, R.weights);
 
-  // 3. Which.
+  // 3. Which: one effect (the verdict), or several by forward selection (--auto).
   const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual};
-  if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_threshold, o.progress);
+  const std::vector<RefitEffect> present = o.auto_select ? model_effects(R.model) : std::vector<RefitEffect>{};
+  if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_threshold, o.progress, present, o.gp.threads);
   R.verdict = decide(R, o);
+  if (o.auto_select && !R.model_diverges) {
+    SelectionOptions so;
+    so.alias_threshold = o.alias_threshold;
+    so.min_explained = o.min_explained;
+    so.min_z = o.min_z;
+    so.floor_tolerance = o.floor_tolerance;
+    so.noise_floor = floors;
+    so.threads = o.gp.threads;
+    so.progress = o.progress;
+    // Step 1 is the verdict: its ranking is the first step's, and without an explained verdict nothing is added.
+    if (R.verdict.status == "explained")
+      R.selection = select_effects(context, so, R.ranking);
+    else
+      R.selection = Selection{{}, R.model, R.ranking, "no effect is added: " + R.verdict.reason};
+  }
 
   // 4. Add: the four models on the held-out episodes.
   R.model_next = R.model;
@@ -224,6 +279,14 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     base_residual = residual_before;
     R.residual_after = R.residual;
     for (const EffectFit& f : R.added) R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + f.effect;
+  } else if (R.selection && !R.selection->steps.empty()) {
+    R.model_next = R.selection->model;
+    with_effect = &R.model_next;
+    base_gp = &R.gp;
+    base_residual = R.residual;
+    R.residual_after = residual_of(data, one_step_predictions(*make_step_model(R.model_next, o.integrator, R.dt, o.substeps), data));
+    for (const SelectionStep& s : R.selection->steps)
+      R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + s.fit.effect;
   } else if (R.verdict.status == "explained") {
     proposed = R.model.with(find_effect(R.system, R.verdict.effect->effect), R.verdict.effect->estimate);
     R.model_next = proposed;

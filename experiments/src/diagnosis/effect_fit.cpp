@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <atomic>
 #include <map>
+#include <mutex>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <stdexcept>
@@ -11,6 +14,7 @@
 #include <Eigen/Dense>
 #include <nlopt.hpp>
 
+#include "gpilqg/core/fork_join.hpp"
 #include "gpilqg/core/system_registry.hpp"
 
 namespace gpilqg::diagnosis {
@@ -43,19 +47,44 @@ Vector weighted_residual(const StepModel& model, const FitContext& c, const std:
   return out;
 }
 
-Vector weighted_residual_at(const LibraryEffect& effect, const VectorCRef& theta, const FitContext& c,
+/// The effects of one fit with their parameters stacked, theta = [theta_1; ...; theta_E]; the
+/// candidate is effects[0], so column 0 of the regressor is its first parameter.
+struct EffectSet {
+  std::vector<const LibraryEffect*> effects;
+  std::vector<Eigen::Index> offset{0};  ///< E + 1 entries: effect e owns theta[offset[e], offset[e + 1])
+
+  void add(const LibraryEffect& effect) {
+    effects.push_back(&effect);
+    offset.push_back(offset.back() + static_cast<Eigen::Index>(effect.parameters.size()));
+  }
+  Eigen::Index size() const { return offset.back(); }
+  Eigen::Index length(std::size_t e) const { return offset[e + 1] - offset[e]; }
+  const EffectParameter& parameter(Eigen::Index j) const {
+    std::size_t e = 0;
+    while (offset[e + 1] <= j) ++e;
+    return effects[e]->parameters[static_cast<std::size_t>(j - offset[e])];
+  }
+  /// `base` with every effect of the set at its slice of theta (ModelSpec::with, which validates).
+  ModelSpec model_at(const ModelSpec& base, const VectorCRef& theta) const {
+    ModelSpec model = base;
+    for (std::size_t e = 0; e < effects.size(); ++e) model = model.with(*effects[e], theta.segment(offset[e], length(e)));
+    return model;
+  }
+};
+
+Vector weighted_residual_at(const EffectSet& set, const VectorCRef& theta, const FitContext& c,
                             const std::vector<int>& rows, bool* finite = nullptr) {
-  const auto model = make_step_model(c.model.with(effect, theta), c.integrator, c.dt, c.substeps);
+  const auto model = make_step_model(set.model_at(c.model, theta), c.integrator, c.dt, c.substeps);
   return weighted_residual(*model, c, rows, finite);
 }
 
 /// Weighted regressor d phi / d theta (rows.size() n x p) by central differences (one-sided when the
 /// lower step would leave the physical range).
-Matrix regressor(const LibraryEffect& effect, const VectorCRef& theta, const FitContext& c, const std::vector<int>& rows) {
+Matrix regressor(const EffectSet& set, const VectorCRef& theta, const FitContext& c, const std::vector<int>& rows) {
   const auto p = theta.size();
   Matrix J(static_cast<Eigen::Index>(rows.size()) * c.weights.size(), p);
   for (Eigen::Index j = 0; j < p; ++j) {
-    const EffectParameter& spec = effect.parameters[static_cast<std::size_t>(j)];
+    const EffectParameter& spec = set.parameter(j);
     const double h = 1e-4 * std::max(std::abs(theta(j)), spec.scale);
     Vector plus = theta, minus = theta;
     plus(j) += h;
@@ -66,7 +95,7 @@ Matrix regressor(const LibraryEffect& effect, const VectorCRef& theta, const Fit
       width = h;
     }
     // The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
-    J.col(j) = (weighted_residual_at(effect, minus, c, rows) - weighted_residual_at(effect, plus, c, rows)) / width;
+    J.col(j) = (weighted_residual_at(set, minus, c, rows) - weighted_residual_at(set, plus, c, rows)) / width;
   }
   return J;
 }
@@ -83,7 +112,7 @@ Vector weighted_model_residual(const FitContext& c, const std::vector<int>& rows
 Vector clamp_to(const Vector& theta, const Vector& lo, const Vector& hi) { return theta.cwiseMax(lo).cwiseMin(hi); }
 
 struct Objective {
-  const LibraryEffect* effect;
+  const EffectSet* set;
   const FitContext* context;
   const std::vector<int>* rows;
   double penalty;
@@ -97,7 +126,7 @@ double nlopt_objective(unsigned p, const double* x, double* gradient, void* data
   const Eigen::Map<const Vector> theta(x, static_cast<Eigen::Index>(p));
   try {
     bool finite = true;
-    const Vector r = weighted_residual_at(*o->effect, theta, *o->context, *o->rows, &finite);
+    const Vector r = weighted_residual_at(*o->set, theta, *o->context, *o->rows, &finite);
     return finite ? r.squaredNorm() : o->penalty;
   } catch (const std::invalid_argument&) {
     return o->penalty;  // outside what the model accepts (e.g. a mass of 0): a wall for the optimiser
@@ -105,11 +134,11 @@ double nlopt_objective(unsigned p, const double* x, double* gradient, void* data
 }
 
 /// Held-out scores of theta_hat against the model (step 4).
-void score_heldout(const LibraryEffect& effect, const FitContext& c, EffectFit& fit) {
+void score_heldout(const EffectSet& set, const Vector& theta, const FitContext& c, EffectFit& fit) {
   const std::vector<int> rows = c.data->rows(true);
   const auto n = static_cast<Eigen::Index>(c.weights.size());
   const Vector before = weighted_model_residual(c, rows);
-  const Vector after = weighted_residual_at(effect, fit.estimate, c, rows);
+  const Vector after = weighted_residual_at(set, theta, c, rows);
   const Vector sqrt_w = c.weights.cwiseSqrt();
   fit.heldout_rmse_before = Vector::Zero(n);
   fit.heldout_rmse_after = Vector::Zero(n);
@@ -154,11 +183,11 @@ void score_heldout(const LibraryEffect& effect, const FitContext& c, EffectFit& 
   fit.z_score = se > 0.0 ? fit.explained / se : (fit.explained > 0.0 ? 1e6 : 0.0);
 }
 
-/// The 95% interval at theta_hat (step 3).
-void confidence_interval(const LibraryEffect& effect, const FitContext& c, const std::vector<int>& rows,
-                         EffectFit& fit) {
-  const Matrix J = regressor(effect, fit.estimate, c, rows);
-  const Vector r = weighted_residual_at(effect, fit.estimate, c, rows);
+/// The 95% interval at theta_hat (step 3): [low, high].
+std::pair<Vector, Vector> confidence_interval(const EffectSet& set, const Vector& estimate, const FitContext& c,
+                                              const std::vector<int>& rows) {
+  const Matrix J = regressor(set, estimate, c, rows);
+  const Vector r = weighted_residual_at(set, estimate, c, rows);
   const auto p = J.cols();
   const auto n = static_cast<Eigen::Index>(c.weights.size());
   const Matrix A = J.transpose() * J;
@@ -182,7 +211,7 @@ void confidence_interval(const LibraryEffect& effect, const FitContext& c, const
     for (const auto& [e, sums] : per_episode) {
       const Vector step = (A - sums.first).ldlt().solve(g - sums.second);
       if (!step.allFinite()) continue;
-      replicates.push_back(fit.estimate + step);
+      replicates.push_back(estimate + step);
       mean += replicates.back();
     }
     if (replicates.size() >= 2) {
@@ -195,8 +224,7 @@ void confidence_interval(const LibraryEffect& effect, const FitContext& c, const
   }
   if (!variance.allFinite()) variance.setZero();
   const Vector half = 1.96 * variance.cwiseMax(0.0).cwiseSqrt();
-  fit.ci_low = fit.estimate - half;
-  fit.ci_high = fit.estimate + half;
+  return {estimate - half, estimate + half};
 }
 
 }  // namespace
@@ -207,72 +235,110 @@ double regressor_correlation(const Vector& a, const Vector& b) {
   return std::min(1.0, std::abs(a.dot(b)) / (na * nb));
 }
 
-EffectFit fit_effect(const LibraryEffect& effect, const FitContext& c) {
-  if (c.data == nullptr) throw std::invalid_argument("fit_effect: no data");
-  EffectFit fit;
-  fit.effect = effect.name;
-  fit.parameters = effect.parameters;
-  fit.initial = c.model.current_values(effect);
-  const auto p = fit.initial.size();
-  const std::vector<int> training = c.data->rows(false);
+namespace {
 
-  // 1. Linear least squares at theta_0.
-  const Matrix J = regressor(effect, fit.initial, c, training);
-  const Vector r0 = weighted_model_residual(c, training);
-  fit.training_objective_before = r0.squaredNorm();
-  fit.regressor = J.col(0);
+/// Steps 1-4 on the stacked parameters of `set`, from `initial`.
+EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext& c) {
+  if (c.data == nullptr) throw std::invalid_argument("fit_effect: no data");
+  const auto p = set.size();
+  const std::vector<int> training = c.data->rows(false);
   Vector lower(p), upper(p), scale(p);
   for (Eigen::Index j = 0; j < p; ++j) {
-    lower(j) = effect.parameters[static_cast<std::size_t>(j)].lower;
-    upper(j) = effect.parameters[static_cast<std::size_t>(j)].upper;
-    scale(j) = effect.parameters[static_cast<std::size_t>(j)].scale;
+    lower(j) = set.parameter(j).lower;
+    upper(j) = set.parameter(j).upper;
+    scale(j) = set.parameter(j).scale;
   }
-  if (!(J.norm() > 0.0) || !J.allFinite()) {
+  Vector theta_ls = initial, theta_hat = initial, ci_low = initial, ci_high = initial;
+  EffectFit fit;
+  fit.training_objective_before = weighted_model_residual(c, training).squaredNorm();
+
+  // 1. Linear least squares at theta_0 (a Gauss-Newton step from a warm start for a joint fit).
+  const Matrix J = regressor(set, initial, c, training);
+  fit.regressor = J.col(0);
+  if (!(J.col(0).norm() > 0.0) || !J.allFinite()) {
     fit.identifiable = false;
-    fit.linear_estimate = fit.estimate = fit.ci_low = fit.ci_high = fit.initial;
-    fit.training_objective_after = fit.training_objective_before;
-    score_heldout(effect, c, fit);
-    return fit;
-  }
-  const Vector delta = J.colPivHouseholderQr().solve(r0);
-  fit.linear_estimate = clamp_to(fit.initial + delta, lower, upper);
+    fit.training_objective_after = weighted_residual_at(set, initial, c, training).squaredNorm();
+  } else {
+    const Vector r_initial = weighted_residual_at(set, initial, c, training);
+    const Vector delta = J.colPivHouseholderQr().solve(r_initial);
+    theta_ls = clamp_to(initial + delta, lower, upper);
 
-  // 2. Nonlinear refit of S(theta) with NLopt, in a box around theta_LS inside the physical range.
-  const Vector radius = 2.0 * delta.cwiseAbs() + 0.05 * scale;
-  const Vector lo = (fit.linear_estimate - radius).cwiseMax(lower);
-  const Vector hi = (fit.linear_estimate + radius).cwiseMin(upper);
-  Objective objective{&effect, &c, &training, 1e30 * (1.0 + fit.training_objective_before)};
-  std::vector<double> x(fit.linear_estimate.data(), fit.linear_estimate.data() + p);
-  double best = std::numeric_limits<double>::infinity();
-  try {
-    nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(p));
-    opt.set_lower_bounds(std::vector<double>(lo.data(), lo.data() + p));
-    opt.set_upper_bounds(std::vector<double>(hi.data(), hi.data() + p));
-    opt.set_min_objective(nlopt_objective, &objective);
-    opt.set_xtol_abs(std::vector<double>(p, 0.0));
-    opt.set_xtol_rel(1e-7);
-    opt.set_ftol_rel(1e-12);
-    opt.set_maxeval(200);
-    std::vector<double> step(static_cast<std::size_t>(p));
-    for (Eigen::Index j = 0; j < p; ++j) step[static_cast<std::size_t>(j)] = std::max(0.25 * (hi(j) - lo(j)), 1e-8 * scale(j));
-    opt.set_initial_step(step);
-    opt.optimize(x, best);
-  } catch (const std::exception&) {
-    // NLopt gave up (roundoff, invalid step): keep the best point it reported, checked below.
-  }
-  fit.evaluations = objective.evaluations;
-  fit.estimate = Eigen::Map<const Vector>(x.data(), p);
-  const double at_linear = nlopt_objective(static_cast<unsigned>(p), fit.linear_estimate.data(), nullptr, &objective);
-  const double at_refit = fit.estimate.allFinite()
-                              ? nlopt_objective(static_cast<unsigned>(p), fit.estimate.data(), nullptr, &objective)
-                              : std::numeric_limits<double>::infinity();
-  if (!(at_refit <= at_linear)) fit.estimate = fit.linear_estimate;
-  fit.training_objective_after = std::min(at_refit, at_linear);
+    // 2. Nonlinear refit of S(theta) with NLopt, in a box around theta_LS inside the physical range.
+    const Vector radius = 2.0 * delta.cwiseAbs() + 0.05 * scale;
+    const Vector lo = (theta_ls - radius).cwiseMax(lower);
+    const Vector hi = (theta_ls + radius).cwiseMin(upper);
+    Objective objective{&set, &c, &training, 1e30 * (1.0 + fit.training_objective_before)};
+    std::vector<double> x(theta_ls.data(), theta_ls.data() + p);
+    double best = std::numeric_limits<double>::infinity();
+    try {
+      nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(p));
+      opt.set_lower_bounds(std::vector<double>(lo.data(), lo.data() + p));
+      opt.set_upper_bounds(std::vector<double>(hi.data(), hi.data() + p));
+      opt.set_min_objective(nlopt_objective, &objective);
+      opt.set_xtol_abs(std::vector<double>(static_cast<std::size_t>(p), 0.0));
+      opt.set_xtol_rel(1e-7);
+      opt.set_ftol_rel(1e-12);
+      opt.set_maxeval(static_cast<int>(200 * p));
+      std::vector<double> step(static_cast<std::size_t>(p));
+      for (Eigen::Index j = 0; j < p; ++j) step[static_cast<std::size_t>(j)] = std::max(0.25 * (hi(j) - lo(j)), 1e-8 * scale(j));
+      opt.set_initial_step(step);
+      opt.optimize(x, best);
+    } catch (const std::exception&) {
+      // NLopt gave up (roundoff, invalid step): keep the best point it reported, checked below.
+    }
+    fit.evaluations = objective.evaluations;
+    theta_hat = Eigen::Map<const Vector>(x.data(), p);
+    const double at_linear = nlopt_objective(static_cast<unsigned>(p), theta_ls.data(), nullptr, &objective);
+    const double at_refit = theta_hat.allFinite()
+                                ? nlopt_objective(static_cast<unsigned>(p), theta_hat.data(), nullptr, &objective)
+                                : std::numeric_limits<double>::infinity();
+    if (!(at_refit <= at_linear)) theta_hat = theta_ls;
+    fit.training_objective_after = std::min(at_refit, at_linear);
 
-  // 3. Interval; 4. held-out scores.
-  confidence_interval(effect, c, training, fit);
-  score_heldout(effect, c, fit);
+    // 3. Interval.
+    std::tie(ci_low, ci_high) = confidence_interval(set, theta_hat, c, training);
+  }
+  // 4. Held-out scores; then each effect's slice.
+  score_heldout(set, theta_hat, c, fit);
+  for (std::size_t e = 0; e < set.effects.size(); ++e) {
+    const Eigen::Index at = set.offset[e], length = set.length(e);
+    EffectValues values{set.effects[e]->name, set.effects[e]->parameters, initial.segment(at, length),
+                        theta_hat.segment(at, length), ci_low.segment(at, length), ci_high.segment(at, length)};
+    if (e == 0) {
+      fit.effect = values.effect;
+      fit.parameters = values.parameters;
+      fit.initial = values.initial;
+      fit.linear_estimate = theta_ls.segment(at, length);
+      fit.estimate = values.estimate;
+      fit.ci_low = values.ci_low;
+      fit.ci_high = values.ci_high;
+    } else {
+      fit.refitted.push_back(std::move(values));
+    }
+  }
   return fit;
+}
+
+}  // namespace
+
+EffectFit fit_effect(const LibraryEffect& effect, const FitContext& c) { return fit_jointly(effect, {}, c); }
+
+EffectFit fit_jointly(const LibraryEffect& effect, const std::vector<RefitEffect>& refit, const FitContext& c,
+                      const Vector& start) {
+  EffectSet set;
+  set.add(effect);
+  for (const RefitEffect& r : refit) {
+    if (r.effect == nullptr) throw std::invalid_argument("fit_jointly: a refitted effect is null");
+    for (const LibraryEffect* e : set.effects)
+      if (e->name == r.effect->name) throw std::invalid_argument("fit_jointly: effect '" + e->name + "' appears twice");
+    if (r.start.size() != static_cast<Eigen::Index>(r.effect->parameters.size()))
+      throw std::invalid_argument("fit_jointly: the start of '" + r.effect->name + "' has the wrong size");
+    set.add(*r.effect);
+  }
+  Vector initial(set.size());
+  initial.head(set.length(0)) = start.size() > 0 ? start : c.model.current_values(effect);
+  for (std::size_t e = 1; e < set.effects.size(); ++e) initial.segment(set.offset[e], set.length(e)) = refit[e - 1].start;
+  return fit_set(set, initial, c);
 }
 
 EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, const FitContext& c) {
@@ -284,9 +350,11 @@ EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, co
   fit.initial = c.model.current_values(effect);
   fit.linear_estimate = fit.estimate = fit.ci_low = fit.ci_high = values;
   const std::vector<int> training = c.data->rows(false);
+  EffectSet set;
+  set.add(effect);
   fit.training_objective_before = weighted_model_residual(c, training).squaredNorm();
-  fit.training_objective_after = weighted_residual_at(effect, values, c, training).squaredNorm();
-  score_heldout(effect, c, fit);
+  fit.training_objective_after = weighted_residual_at(set, values, c, training).squaredNorm();
+  score_heldout(set, values, c, fit);
   return fit;
 }
 
@@ -303,16 +371,31 @@ bool same_physics(const SystemEntry& entry, const std::string& a, const std::str
 }  // namespace
 
 std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold,
-                                       const std::function<void(const std::string&)>& progress) {
+                                       const std::function<void(const std::string&)>& progress,
+                                       const std::vector<RefitEffect>& refit, int threads) {
   const SystemEntryPtr system = find_system(context.model.system);
-  std::vector<EffectFit> fits;
-  const std::vector<LibraryEffect>& library = effect_library(context.model.system);
-  for (const LibraryEffect& effect : library) {
-    fits.push_back(fit_effect(effect, context));
-    if (progress)
-      progress(fmt::format("effect {}/{} fitted: {} explains {:.1f}%", fits.size(), library.size(), fits.back().effect,
-                           100.0 * fits.back().explained));
+  // Candidates: the library without the effects being refitted and their declared aliases.
+  std::vector<const LibraryEffect*> candidates;
+  for (const LibraryEffect& effect : effect_library(context.model.system)) {
+    bool chosen = false;
+    for (const RefitEffect& r : refit)
+      chosen = chosen || r.effect->name == effect.name || same_physics(*system, r.effect->name, effect.name);
+    if (!chosen) candidates.push_back(&effect);
   }
+  std::vector<EffectFit> fits(candidates.size());
+  std::atomic<std::size_t> next{0}, done{0};
+  std::mutex report;
+  ForkJoin workers;
+  workers.run(std::max(1, std::min<int>(threads, static_cast<int>(candidates.size()))), [&](int, int) {
+    for (std::size_t i = next++; i < candidates.size(); i = next++) {
+      fits[i] = fit_jointly(*candidates[i], refit, context);
+      if (progress) {
+        const std::lock_guard<std::mutex> lock(report);
+        progress(fmt::format("effect {}/{} fitted: {} explains {:.1f}%", ++done, candidates.size(), fits[i].effect,
+                             100.0 * fits[i].explained));
+      }
+    }
+  });
   std::stable_sort(fits.begin(), fits.end(),
                    [](const EffectFit& a, const EffectFit& b) { return a.explained > b.explained; });
   std::vector<bool> used(fits.size(), false);

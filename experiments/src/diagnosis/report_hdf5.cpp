@@ -5,6 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
 #include "gpilqg/core/utc_time.hpp"
@@ -134,6 +136,49 @@ void write_add(Hdf5Writer& h5, const DiagnosisReport& r) {
   h5.attribute("/add", "model", names);
 }
 
+/// /selection (--auto): heldout_rmse ((steps + 1) x n: row 0 before the first step, row k after step k),
+/// explained and z_score per step, and per step /selection/step_<k> with the joint values of every
+/// effect of the model after that step (parameter names "<effect>.<parameter>", the added effect first).
+void write_selection(Hdf5Writer& h5, const DiagnosisReport& r) {
+  if (!r.selection) return;
+  const auto& steps = r.selection->steps;
+  const auto n = static_cast<Eigen::Index>(r.states.size());
+  Matrix rmse(static_cast<Eigen::Index>(steps.size()) + 1, n);
+  for (Eigen::Index i = 0; i < n; ++i) rmse(0, i) = r.states[static_cast<std::size_t>(i)].heldout_rmse;
+  std::vector<double> explained, z;
+  std::vector<std::string> effects;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const EffectFit& f = steps[k].fit;
+    rmse.row(static_cast<Eigen::Index>(k) + 1) = f.heldout_rmse_after.transpose();
+    explained.push_back(f.explained);
+    z.push_back(f.z_score);
+    effects.push_back(f.effect);
+    std::vector<EffectValues> values{{f.effect, f.parameters, f.initial, f.estimate, f.ci_low, f.ci_high}};
+    values.insert(values.end(), f.refitted.begin(), f.refitted.end());
+    std::vector<std::string> names;
+    std::vector<double> estimate, low, high;
+    for (const EffectValues& v : values)
+      for (std::size_t i = 0; i < v.parameters.size(); ++i) {
+        const auto ii = static_cast<Eigen::Index>(i);
+        names.push_back(v.effect + "." + v.parameters[i].name);
+        estimate.push_back(v.estimate(ii));
+        low.push_back(v.ci_low(ii));
+        high.push_back(v.ci_high(ii));
+      }
+    const std::string group = fmt::format("/selection/step_{}", k + 1);
+    h5.write_vector(group + "/estimate", estimate);
+    h5.write_vector(group + "/ci_low", low);
+    h5.write_vector(group + "/ci_high", high);
+    h5.attribute(group, "parameter_name", names);
+    h5.attribute(group, "effect", f.effect);
+  }
+  h5.write_matrix("/selection/heldout_rmse", rmse);
+  h5.write_vector("/selection/explained", explained);
+  h5.write_vector("/selection/z_score", z);
+  h5.attribute("/selection", "effect", effects);
+  h5.attribute("/selection", "stop_reason", r.selection->stop_reason);
+}
+
 }  // namespace
 
 void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport& r) {
@@ -160,6 +205,7 @@ void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport&
     write_where(h5, r);
     write_ranking(h5, r);
     write_add(h5, r);
+    write_selection(h5, r);
     h5.close();
   });
 }

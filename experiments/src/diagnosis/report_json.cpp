@@ -39,6 +39,18 @@ json parameters_json(const EffectFit& f, const Vector& values) {
   return out;
 }
 
+/// {"effect", "parameters", "parameter_ci95", "initial"} of an effect refitted jointly with another.
+json values_json(const EffectValues& v) {
+  json parameters = json::object(), ci = json::object(), initial = json::object();
+  for (std::size_t i = 0; i < v.parameters.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    parameters[v.parameters[i].name] = v.estimate(k);
+    ci[v.parameters[i].name] = {v.ci_low(k), v.ci_high(k)};
+    initial[v.parameters[i].name] = v.initial(k);
+  }
+  return {{"effect", v.effect}, {"parameters", parameters}, {"parameter_ci95", ci}, {"initial", initial}};
+}
+
 json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
   json ci = json::object();
   for (std::size_t i = 0; i < f.parameters.size(); ++i)
@@ -145,6 +157,22 @@ nlohmann::json report_json(const DiagnosisReport& r) {
   }
   json added = json::array();
   for (const EffectFit& f : r.added) added.push_back(fit_json(f, r, state));
+  json refitted = json::array();
+  for (const EffectValues& v : r.refitted) refitted.push_back(values_json(v));
+  json selection = nullptr;
+  if (r.selection) {
+    json steps = json::array();
+    for (const SelectionStep& step : r.selection->steps) {
+      json entry = fit_json(step.fit, r, state);
+      json joint = json::array();
+      for (const EffectValues& v : step.fit.refitted) joint.push_back(values_json(v));
+      entry["refitted"] = joint;
+      entry["heldout_rmse_after_by_state"] = by_name(r.state_names, step.fit.heldout_rmse_after);
+      entry["model"] = model_file_text(step.model);
+      steps.push_back(entry);
+    }
+    selection = {{"steps", steps}, {"stop_reason", r.selection->stop_reason}, {"model", model_file_text(r.selection->model)}};
+  }
   json heldout_ids = r.heldout_episode_ids;
   return {{"system", r.system},
           {"samples", r.samples},
@@ -161,6 +189,8 @@ nlohmann::json report_json(const DiagnosisReport& r) {
           {"verdict", verdict},
           {"model", model_file_text(r.model)},
           {"added", added},
+          {"refitted", refitted},
+          {"selection", selection},
           {"comparison", comparison},
           {"model_next", model_file_text(r.model_next)},
           {"non_finite_predictions", r.non_finite_predictions},

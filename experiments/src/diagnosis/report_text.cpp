@@ -13,15 +13,22 @@ namespace {
 
 std::string percent(double fraction) { return fmt::format("{:.1f}%", 100.0 * fraction); }
 
-std::string parameter_text(const EffectFit& f, bool interval) {
+std::string parameter_text(const std::vector<EffectParameter>& parameters, const Vector& estimate, const Vector& low,
+                           const Vector& high, bool interval) {
   std::string out;
-  for (std::size_t i = 0; i < f.parameters.size(); ++i) {
+  for (std::size_t i = 0; i < parameters.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
-    out += fmt::format("{}{} = {:.4g} {}", i == 0 ? "" : ", ", f.parameters[i].name, f.estimate(k), f.parameters[i].unit);
-    if (interval) out += fmt::format(" [{:.4g}, {:.4g}]", f.ci_low(k), f.ci_high(k));
+    out += fmt::format("{}{} = {:.4g} {}", i == 0 ? "" : ", ", parameters[i].name, estimate(k), parameters[i].unit);
+    if (interval) out += fmt::format(" [{:.4g}, {:.4g}]", low(k), high(k));
   }
   return out;
 }
+
+std::string parameter_text(const EffectFit& f, bool interval) {
+  return parameter_text(f.parameters, f.estimate, f.ci_low, f.ci_high, interval);
+}
+
+std::string parameter_text(const EffectValues& v) { return parameter_text(v.parameters, v.estimate, v.ci_low, v.ci_high, true); }
 
 std::string model_text(const ModelSpec& model) {
   std::string out = fmt::format("{} preset '{}'", model.system, to_string(model.preset));
@@ -134,11 +141,33 @@ void which_section(const DiagnosisReport& r, std::string& out) {
   }
 }
 
+void selection_section(const DiagnosisReport& r, std::string& out) {
+  if (!r.selection) return;
+  out += "\n3b. Several effects (--auto): forward selection, every step refitting the chosen effects jointly\n";
+  int k = 1;
+  for (const SelectionStep& step : r.selection->steps) {
+    const EffectFit& f = step.fit;
+    out += fmt::format("   step {}: + {}: {}\n", k++, f.effect, parameter_text(f, true));
+    for (const EffectValues& v : f.refitted) out += fmt::format("           refitted {}: {}\n", v.effect, parameter_text(v));
+    out += fmt::format("           removes {} +- {} of the held-out residual left (z = {:.1f}); held-out rmse:", percent(f.explained),
+                       percent(f.explained_ci), f.z_score);
+    for (std::size_t i = 0; i < r.state_names.size(); ++i) {
+      const auto ii = static_cast<Eigen::Index>(i);
+      if (f.heldout_rmse_before(ii) > 1.05 * f.heldout_rmse_after(ii))
+        out += fmt::format(" {} {:.3e} -> {:.3e}", r.state_names[i], f.heldout_rmse_before(ii), f.heldout_rmse_after(ii));
+    }
+    out += "\n";
+  }
+  out += "   stop: " + r.selection->stop_reason + "\n";
+}
+
 void add_section(const DiagnosisReport& r, std::string& out) {
   if (r.comparison.empty()) return;
   out += fmt::format("\n4. {} on the held-out episodes (effect = {})\n",
-                     r.added.empty() ? "What adding it would do" : "Add it and watch the error fall", r.comparison_effect);
+                     r.added.empty() && !r.selection ? "What adding it would do" : "Add it and watch the error fall",
+                     r.comparison_effect);
   for (const EffectFit& f : r.added) out += fmt::format("   added {}: {}\n", f.effect, parameter_text(f, true));
+  for (const EffectValues& v : r.refitted) out += fmt::format("   refitted with them {}: {}\n", v.effect, parameter_text(v));
   std::vector<int> shown;
   for (std::size_t i = 0; i < r.states.size(); ++i)
     if (r.states[i].structured || r.comparison[0].heldout_rmse(static_cast<Eigen::Index>(i)) >
@@ -167,6 +196,7 @@ std::string report_text(const DiagnosisReport& r) {
   compare_section(r, out);
   where_section(r, out);
   which_section(r, out);
+  selection_section(r, out);
   add_section(r, out);
   out += "\nverdict: " + r.verdict.status;
   if (r.verdict.effect) {

@@ -16,6 +16,7 @@ struct DiagnoseRequest {
   std::string model_file;        ///< a model file (TOML); empty: `preset`
   std::string preset = "sim";
   std::vector<std::string> add;  ///< EFFECT or EFFECT=VALUE
+  bool auto_select = false;      ///< --auto: forward selection of several effects
   std::string integrator = "rk4";
   double heldout = 0.3;          ///< fraction of the episodes held out
   int gp_points = 300;           ///< GP training points per state

@@ -42,6 +42,7 @@
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
+#include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
 
@@ -70,6 +71,9 @@ struct DiagnosisOptions {
   double min_z = 3.0;                     ///< ... this significance ...
   double relative_to_gp = 0.5;            ///< ... and this share of what the GP explains
   bool rank = true;                       ///< false: skip the ranking (faster; verdict from the GP only)
+  /// --auto: add several effects by forward selection with joint refits (effect_selection.hpp); the
+  /// final model becomes model_next.
+  bool auto_select = false;
   /// Optional: one line after the residual GP and after every fitted effect; it may throw to stop.
   std::function<void(const std::string&)> progress;
   /// Throws std::invalid_argument naming the field.
@@ -116,7 +120,11 @@ struct DiagnosisReport {
   std::string system;
   ModelSpec model_before;                ///< as given
   ModelSpec model;                       ///< as diagnosed: model_before plus the added effects
-  std::vector<EffectFit> added;          ///< fits of the --add effects (values given: estimate = value)
+  /// Fits of the --add effects (values given: estimate = value). The fitted ones are fitted jointly,
+  /// with the model's own effects (`refitted`), so they share the scores of the joint fit.
+  std::vector<EffectFit> added;
+  std::vector<EffectValues> refitted;    ///< the model's own effects, refitted jointly with the --add effects
+  std::optional<Selection> selection;    ///< --auto: the selection path
   ModelSpec model_next;                  ///< what the next diagnosis should start from
   std::vector<std::string> state_names, control_names, input_names;
   double dt = 0.0;

@@ -24,6 +24,12 @@
 ///    means of the per-sample reduction (batches of consecutive samples within an episode, so the
 ///    serial correlation of the residual does not inflate the significance).
 ///
+/// Joint fits. Effects already in a model are refitted together with a new one: theta stacks the
+/// parameters of every effect of the set, [theta_1; ...; theta_E], and steps 1-4 run on the stacked
+/// vector (the regressor has one column per parameter, the interval comes from the joint covariance,
+/// so it accounts for the correlation between the effects). Forward selection (effect_selection.hpp)
+/// and `--add` use them.
+///
 /// Aliases: two effects whose weighted regressors are nearly collinear (|cos angle| >= 0.95, the
 /// uncentred correlation that governs least-squares identifiability) cannot be told apart on these
 /// data; they are reported as one group under the best of them.
@@ -53,6 +59,15 @@ struct FitContext {
 /// The model integrated as configured.
 std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integrator integrator, double dt, int substeps);
 
+/// The values of one effect inside a joint fit: where it started, where it ended, its 95% interval.
+struct EffectValues {
+  std::string effect;
+  std::vector<EffectParameter> parameters;
+  Vector initial;          ///< the start of the fit
+  Vector estimate;         ///< the joint estimate
+  Vector ci_low, ci_high;  ///< 95% interval from the joint covariance
+};
+
 struct EffectFit {
   std::string effect;
   std::vector<EffectParameter> parameters;
@@ -70,11 +85,29 @@ struct EffectFit {
   double z_score = 0.0;        ///< mean reduction / its batch-means standard error
   Vector regressor;            ///< weighted J at theta_0 over the training rows (first parameter), for aliasing
   bool identifiable = true;    ///< false when the effect does not change the predictions at all
+  /// Effects refitted jointly with this one (fit_jointly), with their new values; empty for a fit of
+  /// one effect alone. The scores above (objective, held-out RMSE, explained) are those of the set.
+  std::vector<EffectValues> refitted;
 };
 
 /// Fits one effect (steps 1-4 above). Never returns NaN: an effect without influence on the data
 /// (J = 0) keeps theta_0, identifiable = false and explained = 0.
 EffectFit fit_effect(const LibraryEffect& effect, const FitContext& context);
+
+/// An effect already in the model, refitted jointly with the candidate, from the value `start`.
+struct RefitEffect {
+  const LibraryEffect* effect = nullptr;
+  Vector start;
+};
+
+/// Fits `effect` jointly with the effects of `refit` (steps 1-4 on the stacked parameters; see the
+/// file comment): the model is context.model with every effect of the set at its values, the
+/// candidate starting from `start` (its current value in context.model when empty). The held-out
+/// scores compare the fitted set with context.residual, so with a context whose residual is that of
+/// the model with `refit` at their starts they measure what adding `effect` (and refitting the rest)
+/// gains. Each effect may appear once. Never returns NaN.
+EffectFit fit_jointly(const LibraryEffect& effect, const std::vector<RefitEffect>& refit, const FitContext& context,
+                      const Vector& start = {});
 
 /// Scores the effect at given values without fitting (step 4 only): estimate = linear_estimate =
 /// ci_low = ci_high = values. Throws std::invalid_argument for values the effect does not accept.
@@ -93,7 +126,10 @@ struct RankedEffect {
 /// (greedy grouping: the best remaining effect takes every remaining effect whose regressor correlation
 /// with it is >= alias_threshold).
 /// `progress` (optional) receives one line per fitted effect and may throw to stop the ranking.
+/// `refit` (forward selection): effects already chosen, refitted jointly with every candidate
+/// (fit_jointly); they and their aliases are not candidates. `threads` candidates are fitted at once.
 std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold = 0.95,
-                                       const std::function<void(const std::string&)>& progress = {});
+                                       const std::function<void(const std::string&)>& progress = {},
+                                       const std::vector<RefitEffect>& refit = {}, int threads = 1);
 
 }  // namespace gpilqg::diagnosis

@@ -1,0 +1,71 @@
+#pragma once
+/// @file effect_selection.hpp
+/// Several missing effects in one call (`gpilqg diagnose --auto`): forward selection with joint refits.
+///
+/// Start from the diagnosed model M_0 with its one-step residual r_0 and the noise-floor weights
+/// w_i = 1 / floor_i^2 (diagnosis.hpp). The effects M_0 already has (model_effects) are refitted
+/// with every new one. Step k = 1, 2, ...:
+///  1. every candidate of the library (not chosen, not declared the same physics as a chosen effect)
+///     is fitted jointly with the chosen effects on the training episodes (fit_jointly: the chosen
+///     effects start from their values in M_{k-1} and are refitted together with the candidate);
+///  2. each joint fit is scored on the held-out episodes against M_{k-1}: the fraction of M_{k-1}'s
+///     weighted held-out squared residual it removes, "explained", and its z score from batch means of
+///     the per-sample reduction (effect_fit.hpp, step 4);
+///  3. the candidate with the largest held-out reduction is added when it is significant and large,
+///     z >= min_z and explained >= min_explained (the single-effect verdict's thresholds, 3 and 10%);
+///     M_k is then M_0 with the chosen effects at their joint estimates. Otherwise selection stops.
+/// Selection stops too when M_k's held-out RMSE is within floor_tolerance of the noise floor in every
+/// state: nothing learnable is left.
+///
+/// Why a held-out test and not an information criterion. AIC and BIC with the noise floor as the known
+/// variance assume independent residuals; one-step residuals of one episode are serially correlated
+/// (a missing effect makes them so), and the effective sample size is unknown, so the penalty is
+/// uncalibrated and a spurious effect gets in on long records. Held-out whole episodes penalise
+/// complexity directly: an effect that fits the training noise does not lower the held-out error. The
+/// batch-means z score accounts for the serial correlation that remains, and explained >= 10% keeps
+/// effects whose contribution is real but negligible out of the model.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gpilqg/experiments/diagnosis/effect_fit.hpp"
+
+namespace gpilqg::diagnosis {
+
+/// The effects `model` has beyond its preset, at their current values: its forces (in order), the
+/// actuator gain when it is not 1, its recalibrated parameters. These are refitted with a new effect.
+std::vector<RefitEffect> model_effects(const ModelSpec& model);
+
+struct SelectionOptions {
+  double alias_threshold = 0.95;
+  double min_explained = 0.1;   ///< step 3: explained >= this ...
+  double min_z = 3.0;           ///< ... and z >= this
+  double floor_tolerance = 1.05;
+  Vector noise_floor;           ///< n, the diagnosis's noise floor per state
+  int max_steps = 10;           ///< at most this many effects
+  int threads = 1;              ///< candidates fitted at once
+  std::function<void(const std::string&)> progress;
+};
+
+/// One step of the path: the effect added, with the values of the effects refitted jointly with it.
+struct SelectionStep {
+  EffectFit fit;               ///< fit.refitted: the earlier effects' new values; explained, z: against M_{k-1}
+  ModelSpec model;             ///< M_k
+  std::vector<RankedEffect> ranking;  ///< every candidate of this step, best first
+};
+
+struct Selection {
+  std::vector<SelectionStep> steps;       ///< the effects added, in order
+  ModelSpec model;                        ///< the final model (M_0 when nothing was added)
+  std::vector<RankedEffect> rejected;     ///< the candidates of the step that stopped the selection
+  std::string stop_reason;                ///< one sentence
+};
+
+/// Runs the selection from context.model = M_0 (context.residual its residual, context.weights the
+/// floor weights). `first` (optional) is step 1's ranking when the caller already has it: rank_effects
+/// on the same context with refit = model_effects(M_0).
+Selection select_effects(const FitContext& context, const SelectionOptions& options,
+                         std::vector<RankedEffect> first = {});
+
+}  // namespace gpilqg::diagnosis

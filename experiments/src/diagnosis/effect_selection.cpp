@@ -1,0 +1,91 @@
+#include "gpilqg/experiments/diagnosis/effect_selection.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+namespace gpilqg::diagnosis {
+
+std::vector<RefitEffect> model_effects(const ModelSpec& model) {
+  std::vector<RefitEffect> out;
+  for (const LibraryEffect& effect : effect_library(model.system)) {
+    bool present = false;
+    switch (effect.kind) {
+      case EffectKind::Force:
+        present = std::any_of(model.forces.begin(), model.forces.end(), [&](const auto& f) { return f.first == effect.name; });
+        break;
+      case EffectKind::ActuatorGain:
+        present = model.actuator_gain != 1.0;
+        break;
+      case EffectKind::Recalibration:
+        present = model.parameters.count(effect.recalibrated) > 0;
+        break;
+    }
+    if (present) out.push_back({&effect, model.current_values(effect)});
+  }
+  return out;
+}
+
+namespace {
+
+/// M_0 with the effect of `fit` and those it refitted at their joint estimates.
+ModelSpec model_after(const ModelSpec& base, const EffectFit& fit) {
+  ModelSpec model = base.with(find_effect(base.system, fit.effect), fit.estimate);
+  for (const EffectValues& v : fit.refitted) model = model.with(find_effect(base.system, v.effect), v.estimate);
+  return model;
+}
+
+}  // namespace
+
+Selection select_effects(const FitContext& context, const SelectionOptions& o, std::vector<RankedEffect> first) {
+  if (context.data == nullptr) throw std::invalid_argument("select_effects: no data");
+  Selection S;
+  S.model = context.model;
+  std::vector<RefitEffect> chosen = model_effects(context.model);
+  FitContext step_context = context;  // model stays M_0; residual becomes M_{k-1}'s
+  for (int k = 1;; ++k) {
+    if (k > o.max_steps) {
+      S.stop_reason = fmt::format("the selection stops at its limit of {} effects", o.max_steps);
+      break;
+    }
+    std::vector<RankedEffect> ranking =
+        k == 1 && !first.empty() ? std::move(first)
+                                 : rank_effects(step_context, o.alias_threshold, o.progress, chosen, o.threads);
+    if (ranking.empty()) {
+      S.stop_reason = "no candidate effect is left";
+      break;
+    }
+    const EffectFit& best = ranking.front().fit;
+    if (best.z_score < o.min_z || best.explained < o.min_explained) {
+      S.stop_reason = fmt::format(
+          "the best remaining candidate '{}' removes {:.1f}% of the held-out residual left (z = {:.1f}); adding an effect "
+          "needs at least {:.0f}% and z >= {:g}",
+          best.effect, 100.0 * best.explained, best.z_score, 100.0 * o.min_explained, o.min_z);
+      S.rejected = std::move(ranking);
+      break;
+    }
+    SelectionStep step{best, model_after(context.model, best), std::move(ranking)};
+    if (o.progress) o.progress(fmt::format("step {}: added {} ({:.1f}% of the held-out residual left)", k, best.effect,
+                                           100.0 * best.explained));
+    // The chosen effects and their new starts, in the order they were chosen.
+    std::vector<RefitEffect> next;
+    for (const RefitEffect& r : chosen)
+      for (const EffectValues& v : best.refitted)
+        if (v.effect == r.effect->name) next.push_back({r.effect, v.estimate});
+    next.push_back({&find_effect(context.model.system, best.effect), best.estimate});
+    chosen = std::move(next);
+    step_context.residual =
+        context.data->x_next - one_step_predictions(*make_step_model(step.model, context.integrator, context.dt, context.substeps),
+                                                    *context.data);
+    S.model = step.model;
+    const Vector& after = best.heldout_rmse_after;
+    S.steps.push_back(std::move(step));
+    if (o.noise_floor.size() == after.size() && (after.array() <= o.floor_tolerance * o.noise_floor.array()).all()) {
+      S.stop_reason = fmt::format("after {} effect(s) the held-out residual is at the noise floor in every state", k);
+      break;
+    }
+  }
+  return S;
+}
+
+}  // namespace gpilqg::diagnosis
