@@ -85,6 +85,7 @@ std::vector<LibraryEffect> cartpole_library() {
   out.push_back(linear_force_entry("quadratic_drag", {"c_d", "N s^2/m^2", 0.1}, "Q_x = -c_d |x_dot| x_dot", 2,
                                    quadratic_drag(1, 1)));
   out.push_back(actuator_gain_entry());
+  out.push_back(input_delay_entry());
   add_recalibrations(*build_cartpole(Preset::Simulator, {}, {}), out);
   return out;
 }
@@ -100,6 +101,7 @@ std::vector<LibraryEffect> quadrotor_library() {
   out.push_back(linear_force_entry("quadratic_drag", {"c_d", "N s^2/m^2", 0.1}, "F_i = -c_d |v_i| v_i (world frame)", 6,
                                    quadratic_drag(3, 3)));
   out.push_back(actuator_gain_entry());
+  out.push_back(input_delay_entry());
   add_recalibrations(*build_quadrotor(Preset::Simulator, {}, {}), out);
   return out;
 }

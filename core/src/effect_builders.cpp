@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "gpilqg/core/input_delay.hpp"
+
 namespace gpilqg::effect_bases {
 
 LinearForceEffect::Basis viscous(int component, int velocity) {
@@ -65,6 +67,16 @@ LibraryEffect actuator_gain_entry() {
   e.parameters = {{"k", "-", 1.0, 0.0, std::numeric_limits<double>::infinity()}};
   e.formula = "applied input = k u";
   e.linear = true;  // the built-in systems are control-affine
+  return e;
+}
+
+LibraryEffect input_delay_entry() {
+  LibraryEffect e;
+  e.name = "input_delay";
+  e.kind = EffectKind::InputDelay;
+  e.parameters = {{"d", "steps", 1.0, 0.0, kMaxInputDelay}};
+  e.formula = "applied input = u(t - d), fractional d by linear interpolation";
+  e.linear = false;
   return e;
 }
 

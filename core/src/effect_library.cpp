@@ -60,6 +60,8 @@ Vector ModelSpec::current_values(const LibraryEffect& effect) const {
       return Vector::Zero(static_cast<Eigen::Index>(effect.parameters.size()));
     case EffectKind::ActuatorGain:
       return Vector::Constant(1, actuator_gain);
+    case EffectKind::InputDelay:
+      return Vector::Constant(1, input_delay);
     case EffectKind::Recalibration:
       for (const Parameter& p : make_system(system, preset, parameters)->parameters())
         if (p.name == effect.recalibrated) return Vector::Constant(1, p.value);
@@ -96,6 +98,9 @@ ModelSpec ModelSpec::with(const LibraryEffect& effect, const VectorCRef& values)
     case EffectKind::Recalibration:
       out.parameters[effect.recalibrated] = values(0);
       break;
+    case EffectKind::InputDelay:
+      out.input_delay = values(0);
+      break;
   }
   return out;
 }
@@ -110,6 +115,7 @@ std::vector<std::string> ModelSpec::describe() const {
     lines.push_back(fmt::format("{}: {} = {:.6g} {}", effect->name, name, value, effect->parameters[0].unit));
   }
   if (actuator_gain != 1.0) lines.push_back(fmt::format("actuator_gain: k = {:.6g}", actuator_gain));
+  if (input_delay != 0.0) lines.push_back(fmt::format("input_delay: d = {:.6g} steps", input_delay));
   for (const auto& [name, values] : forces) {
     const LibraryEffect& e = find_effect(system, name);
     std::string text = name + ":";

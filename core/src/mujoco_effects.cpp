@@ -108,6 +108,7 @@ std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
     gain.formula = fmt::format("actuator {} applies k u", actuator);
     out.push_back(std::move(gain));
   }
+  out.push_back(input_delay_entry());
   const char* axes[] = {"x", "y", "z"};
   const auto bodies = system.body_names();
   for (std::size_t b = 0; b < bodies.size(); ++b) {

@@ -69,6 +69,7 @@ std::vector<LibraryEffect> acrobot_effects() {
                                              coulomb(joint, joint + 2)));
   }
   out.push_back(gpilqg::actuator_gain_entry());
+  out.push_back(gpilqg::input_delay_entry());
   // Masses and lengths stay positive; xdot is not linear in any of them (they enter through M^-1).
   for (const gpilqg::Parameter& p : Acrobot().parameters())
     if (p.name != "gravity") out.push_back(gpilqg::recalibration_entry("param:" + p.name, p, false, false));

@@ -7,6 +7,7 @@
 
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/effects.hpp"
+#include "gpilqg/core/input_delay.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/mujoco_system.hpp"
 
@@ -48,6 +49,9 @@ void ExcitationSettings::validate(int n, int m) const {
   check_size(observation_std, n, "observation_std");
   if ((observation_std.array() < 0.0).any())
     throw std::invalid_argument("excitation 'observation_std' has negative entries");
+  if (!(input_delay >= 0.0 && input_delay <= kMaxInputDelay))
+    throw std::invalid_argument("excitation 'input_delay' = " + std::to_string(input_delay) + "; expected a value in [0, " +
+                                std::to_string(kMaxInputDelay) + "]");
 }
 
 ExcitationSettings default_excitation(const Dynamics& system) {
@@ -122,7 +126,8 @@ SyntheticData simulate_measurements(const DynamicsPtr& system, const ExcitationS
       else
         u.col(t) = u.col(t - 1);
     }
-    const RolloutResult r = rollout(world, x0, u.leftCols(T - 1), RolloutNoise::Process, &rng);
+    const Matrix applied = delay_controls(u.transpose(), settings.input_delay).transpose();
+    const RolloutResult r = rollout(world, x0, applied.leftCols(T - 1), RolloutNoise::Process, &rng);
     const int samples = r.steps_completed + 1;
     if (!r.finite) ++out.truncated_episodes;
     if (samples < 2) continue;

@@ -73,7 +73,7 @@ int run_rollout(const RolloutOptions& o) {
   const int n = static_cast<int>(signature.states.size());
   const int m = static_cast<int>(signature.controls.size());
 
-  const DynamicsPtr dynamics = build_world(o.world);
+  const DynamicsPtr dynamics = build_world(o.world, nullptr, "rollout");
   if (own_integrator(*dynamics) != nullptr && (o.integrator_option->count() || o.substeps_option->count()))
     throw InputError(fmt::format("--integrator/--substeps: {} steps with its own integrator; leave them out",
                                  o.world.system));

@@ -34,9 +34,11 @@ int run_simulate(const SimulateOptions& o) {
   check_output_file_option("--out", o.out);
   const auto signature = system_signature(o.world.system);
   const int n = static_cast<int>(signature.states.size());
-  const auto system = build_world(o.world);
+  double input_delay = 0.0;
+  const auto system = build_world(o.world, &input_delay);
 
   ExcitationSettings settings = default_excitation(*system);
+  settings.input_delay = input_delay;
   if (o.episodes > 0) settings.episodes = o.episodes;
   if (o.steps > 0) settings.steps = o.steps;
   if (o.dt > 0.0) settings.dt = o.dt;

@@ -56,7 +56,7 @@ Vector per_quantity(const std::vector<double>& values, int size, const std::stri
   return Eigen::Map<const Vector>(values.data(), size);
 }
 
-DynamicsPtr build_world(const WorldOptions& o) {
+DynamicsPtr build_world(const WorldOptions& o, double* input_delay, const std::string& command) {
   const auto preset = parse_preset(o.preset);
   if (!preset) throw InputError("--preset '" + o.preset + "': expected 'sim' or 'real'");
   const SystemSignature signature = system_signature(o.system);
@@ -79,6 +79,10 @@ DynamicsPtr build_world(const WorldOptions& o) {
     if (!request.values) throw InputError("--effect '" + text + "': expected EFFECT=VALUE, e.g. cart_coulomb_friction=1");
     world = world.with(find_effect(world.system, request.effect), *request.values);
   }
+  if (input_delay != nullptr) *input_delay = world.input_delay;
+  else if (world.input_delay != 0.0)
+    throw InputError(fmt::format("--effect input_delay: `gpilqg {}` does not simulate an input delay in closed loop; "
+                                 "`gpilqg simulate` does", command));
   return world.build(noise);
 }
 

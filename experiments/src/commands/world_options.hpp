@@ -37,6 +37,8 @@ std::map<std::string, double> parse_assignments(const std::vector<std::string>& 
 Vector per_quantity(const std::vector<double>& values, int size, const std::string& option, const Vector& fallback);
 
 /// The world's dynamics with its noise; the signature it must share is `system`'s (checked for --world).
-DynamicsPtr build_world(const WorldOptions& options);
+/// `input_delay` receives the world's input delay (--effect input_delay=D, control periods); a command
+/// that passes null cannot simulate one, and a delay is then an InputError naming the command.
+DynamicsPtr build_world(const WorldOptions& options, double* input_delay = nullptr, const std::string& command = "");
 
 }  // namespace gpilqg::cli

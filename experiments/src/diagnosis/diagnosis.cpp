@@ -139,8 +139,11 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   const int n = static_cast<int>(R.state_names.size());
 
   // The model as given, its residual and GP.
+  // One-step predictions of a model (its input delay applied to the measured inputs).
+  const FitContext settings{&data, o.model, o.integrator, R.dt, o.substeps, Vector(), Matrix()};
+  const auto residual_of_model = [&](const ModelSpec& model) { return residual_of(data, model_predictions(model, settings)); };
   const auto before_step = make_step_model(o.model, o.integrator, R.dt, o.substeps);
-  const Matrix residual_before = residual_of(data, one_step_predictions(*before_step, data));
+  const Matrix residual_before = residual_of_model(o.model);
   ResidualGp gp_before = fit_residual_gp(before_step, data, residual_before, o.gp);
   if (o.progress) o.progress("residual GP of the model fitted");
 
@@ -160,7 +163,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual};
     R.added.push_back(score_effect(effect, *request.values, context));
     R.model = R.model.with(effect, *request.values);
-    residual = residual_of(data, one_step_predictions(*make_step_model(R.model, o.integrator, R.dt, o.substeps), data));
+    residual = residual_of_model(R.model);
     given.push_back(effect.name);
   }
   if (!to_fit.empty()) {
@@ -193,7 +196,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     R.refitted.assign(joint.refitted.begin() + static_cast<std::ptrdiff_t>(to_fit.size() - 1), joint.refitted.end());
   }
   const auto step = make_step_model(R.model, o.integrator, R.dt, o.substeps);
-  R.predicted = one_step_predictions(*step, data, &R.non_finite_predictions);
+  R.predicted = model_predictions(R.model, settings, &R.non_finite_predictions);
   R.residual = residual_of(data, R.predicted);
   R.gp = o.add.empty() ? gp_before : fit_residual_gp(step, data, R.residual, o.gp);
   const Vector floors = noise_floor(data, R.residual, R.gp);
@@ -220,7 +223,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     KStepScore score;
     score.k = k;
     score.stride = std::max(1, k / 10);
-    score.predictions = k_step_predictions(*step, set, all_episodes, k, score.stride);
+    score.predictions = k_step_predictions(*step, set, all_episodes, k, score.stride, R.model.input_delay);
     score.windows = static_cast<int>(score.predictions.measured.rows());
     score.diverged = score.predictions.diverged;
     score.rmse = Vector::Zero(n);
@@ -250,14 +253,18 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual};
   const std::vector<RefitEffect> present = o.auto_select ? model_effects(R.model) : std::vector<RefitEffect>{};
   if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_threshold, o.progress, present, o.gp.threads);
+  // The GP sees (x_t, u_t) only: the residual of an effect of the input history (input_delay) looks
+  // like noise to it. An effect that removes a large and significant share of the held-out residual
+  // shows that the residual is not at its floor, whatever the GP found.
+  if (R.consistent && !R.ranking.empty() && R.ranking.front().fit.explained >= o.min_explained &&
+      R.ranking.front().fit.z_score >= o.min_z)
+    R.consistent = false;
   R.verdict = decide(R, o);
   if (o.auto_select && !R.model_diverges) {
     SelectionOptions so;
     so.alias_threshold = o.alias_threshold;
     so.min_explained = o.min_explained;
     so.min_z = o.min_z;
-    so.floor_tolerance = o.floor_tolerance;
-    so.noise_floor = floors;
     so.threads = o.gp.threads;
     so.progress = o.progress;
     // Step 1 is the verdict: its ranking is the first step's, and without an explained verdict nothing is added.
@@ -284,7 +291,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     with_effect = &R.model_next;
     base_gp = &R.gp;
     base_residual = R.residual;
-    R.residual_after = residual_of(data, one_step_predictions(*make_step_model(R.model_next, o.integrator, R.dt, o.substeps), data));
+    R.residual_after = residual_of_model(R.model_next);
     for (const SelectionStep& s : R.selection->steps)
       R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + s.fit.effect;
   } else if (R.verdict.status == "explained") {
@@ -293,7 +300,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     with_effect = &proposed;
     base_gp = &R.gp;
     base_residual = R.residual;
-    R.residual_after = residual_of(data, one_step_predictions(*make_step_model(proposed, o.integrator, R.dt, o.substeps), data));
+    R.residual_after = residual_of_model(proposed);
     R.comparison_effect = R.verdict.effect->effect;
   }
   if (with_effect != nullptr) {

@@ -16,11 +16,17 @@
 
 #include "gpilqg/core/fork_join.hpp"
 #include "gpilqg/core/system_registry.hpp"
+#include "gpilqg/experiments/diagnosis/delay_start.hpp"
 
 namespace gpilqg::diagnosis {
 
 std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integrator integrator, double dt, int substeps) {
   return gpilqg::make_step_model(model.build(), integrator, dt, substeps);
+}
+
+Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int* diverged) {
+  return one_step_predictions(*make_step_model(model, settings.integrator, settings.dt, settings.substeps), *settings.data,
+                              diverged, model.input_delay);
 }
 
 namespace {
@@ -29,7 +35,8 @@ namespace {
 /// turns false when a prediction diverged (prediction_diverged: not finite or beyond 1e12). Such a
 /// prediction is replaced by x_t, as in one_step_predictions, so every entry stays finite and its
 /// square cannot overflow.
-Vector weighted_residual(const StepModel& model, const FitContext& c, const std::vector<int>& rows, bool* finite) {
+Vector weighted_residual(const StepModel& model, const Matrix& u, const FitContext& c, const std::vector<int>& rows,
+                         bool* finite) {
   const auto n = static_cast<Eigen::Index>(c.weights.size());
   const Vector sqrt_w = c.weights.cwiseSqrt();
   Vector out(static_cast<Eigen::Index>(rows.size()) * n);
@@ -37,7 +44,7 @@ Vector weighted_residual(const StepModel& model, const FitContext& c, const std:
   const auto workspace = model.make_workspace();
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const int r = rows[k];
-    model.step(c.data->x.row(r).transpose(), c.data->u.row(r).transpose(), next, nullptr, *workspace);
+    model.step(c.data->x.row(r).transpose(), u.row(r).transpose(), next, nullptr, *workspace);
     if (prediction_diverged(next)) {
       if (finite != nullptr) *finite = false;
       next = c.data->x.row(r).transpose();
@@ -74,8 +81,9 @@ struct EffectSet {
 
 Vector weighted_residual_at(const EffectSet& set, const VectorCRef& theta, const FitContext& c,
                             const std::vector<int>& rows, bool* finite = nullptr) {
-  const auto model = make_step_model(set.model_at(c.model, theta), c.integrator, c.dt, c.substeps);
-  return weighted_residual(*model, c, rows, finite);
+  const ModelSpec spec = set.model_at(c.model, theta);
+  const auto model = make_step_model(spec, c.integrator, c.dt, c.substeps);
+  return weighted_residual(*model, applied_controls(*c.data, spec.input_delay), c, rows, finite);
 }
 
 /// Weighted regressor d phi / d theta (rows.size() n x p) by central differences (one-sided when the
@@ -337,6 +345,10 @@ EffectFit fit_jointly(const LibraryEffect& effect, const std::vector<RefitEffect
   }
   Vector initial(set.size());
   initial.head(set.length(0)) = start.size() > 0 ? start : c.model.current_values(effect);
+  // A delay is not found by a Gauss-Newton step from 0 (its regressor there is a difference of
+  // inputs): it starts at the lag of the peak cross-correlation (delay_start.hpp).
+  if (start.size() == 0 && effect.kind == EffectKind::InputDelay && c.model.input_delay == 0.0)
+    initial(0) = input_delay_start(c);
   for (std::size_t e = 1; e < set.effects.size(); ++e) initial.segment(set.offset[e], set.length(e)) = refit[e - 1].start;
   return fit_set(set, initial, c);
 }

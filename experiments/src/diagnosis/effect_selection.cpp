@@ -20,6 +20,9 @@ std::vector<RefitEffect> model_effects(const ModelSpec& model) {
       case EffectKind::Recalibration:
         present = model.parameters.count(effect.recalibrated) > 0;
         break;
+      case EffectKind::InputDelay:
+        present = model.input_delay != 0.0;
+        break;
     }
     if (present) out.push_back({&effect, model.current_values(effect)});
   }
@@ -64,26 +67,20 @@ Selection select_effects(const FitContext& context, const SelectionOptions& o, s
       S.rejected = std::move(ranking);
       break;
     }
-    SelectionStep step{best, model_after(context.model, best), std::move(ranking)};
-    if (o.progress) o.progress(fmt::format("step {}: added {} ({:.1f}% of the held-out residual left)", k, best.effect,
-                                           100.0 * best.explained));
+    const EffectFit added = best;
+    SelectionStep step{added, model_after(context.model, added), std::move(ranking)};
+    if (o.progress) o.progress(fmt::format("step {}: added {} ({:.1f}% of the held-out residual left)", k, added.effect,
+                                           100.0 * added.explained));
     // The chosen effects and their new starts, in the order they were chosen.
     std::vector<RefitEffect> next;
     for (const RefitEffect& r : chosen)
-      for (const EffectValues& v : best.refitted)
+      for (const EffectValues& v : added.refitted)
         if (v.effect == r.effect->name) next.push_back({r.effect, v.estimate});
-    next.push_back({&find_effect(context.model.system, best.effect), best.estimate});
+    next.push_back({&find_effect(context.model.system, added.effect), added.estimate});
     chosen = std::move(next);
-    step_context.residual =
-        context.data->x_next - one_step_predictions(*make_step_model(step.model, context.integrator, context.dt, context.substeps),
-                                                    *context.data);
+    step_context.residual = context.data->x_next - model_predictions(step.model, context);
     S.model = step.model;
-    const Vector& after = best.heldout_rmse_after;
     S.steps.push_back(std::move(step));
-    if (o.noise_floor.size() == after.size() && (after.array() <= o.floor_tolerance * o.noise_floor.array()).all()) {
-      S.stop_reason = fmt::format("after {} effect(s) the held-out residual is at the noise floor in every state", k);
-      break;
-    }
   }
   return S;
 }

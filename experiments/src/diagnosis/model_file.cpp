@@ -111,9 +111,10 @@ std::string model_file_text(const ModelSpec& model, const std::vector<std::strin
     out += "\n[parameters]\n";
     for (const auto& [name, value] : model.parameters) out += fmt::format("{} = {}\n", toml_key(name), value);
   }
-  if (model.actuator_gain != 1.0 || !model.forces.empty()) {
+  if (model.actuator_gain != 1.0 || model.input_delay != 0.0 || !model.forces.empty()) {
     out += "\n[effects]\n";
     if (model.actuator_gain != 1.0) out += fmt::format("actuator_gain = {}\n", model.actuator_gain);
+    if (model.input_delay != 0.0) out += fmt::format("input_delay = {}   # control periods\n", model.input_delay);
     for (const auto& [name, values] : model.forces) {
       const LibraryEffect& effect = find_effect(model.system, name);
       std::string table;

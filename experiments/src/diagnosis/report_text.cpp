@@ -63,7 +63,9 @@ void compare_section(const DiagnosisReport& r, std::string& out) {
     std::string above;
     for (const StateScore& s : r.states)
       if (s.structured) above += (above.empty() ? "" : ", ") + s.name;
-    out += "   => not consistent with the measurements: " + above + " above the noise floor\n";
+    out += above.empty() ? "   => not consistent with the measurements: the GP of (x, u) finds no structure, but an effect "
+                           "removes a significant share of the held-out residual (section 3)\n"
+                         : "   => not consistent with the measurements: " + above + " above the noise floor\n";
   }
 }
 

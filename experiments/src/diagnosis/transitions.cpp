@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "gpilqg/control/rollout.hpp"
+#include "gpilqg/core/input_delay.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -89,13 +90,26 @@ void check_measurement_range(const MeasurementSet& set) {
 
 bool prediction_diverged(const VectorCRef& x) { return check_divergence(x) != RolloutStatus::Completed; }
 
-Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* diverged) {
+Matrix applied_controls(const Transitions& data, double delay) {
+  if (delay == 0.0) return data.u;
+  Matrix out(data.u.rows(), data.u.cols());
+  for (int first = 0; first < data.size();) {
+    int end = first;
+    while (end < data.size() && data.episode[static_cast<std::size_t>(end)] == data.episode[static_cast<std::size_t>(first)]) ++end;
+    out.middleRows(first, end - first) = delay_controls(data.u.middleRows(first, end - first), delay);
+    first = end;
+  }
+  return out;
+}
+
+Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* diverged, double input_delay) {
+  const Matrix u = applied_controls(data, input_delay);
   Matrix out(data.size(), model.state_dim());
   Vector next(model.state_dim());
   const auto workspace = model.make_workspace();
   int bad = 0;
   for (int i = 0; i < data.size(); ++i) {
-    model.step(data.x.row(i).transpose(), data.u.row(i).transpose(), next, nullptr, *workspace);
+    model.step(data.x.row(i).transpose(), u.row(i).transpose(), next, nullptr, *workspace);
     if (!prediction_diverged(next)) {
       out.row(i) = next.transpose();
     } else {
@@ -108,7 +122,7 @@ Matrix one_step_predictions(const StepModel& model, const Transitions& data, int
 }
 
 KStepPredictions k_step_predictions(const StepModel& model, const MeasurementSet& set,
-                                    const std::vector<int>& episodes, int k, int stride) {
+                                    const std::vector<int>& episodes, int k, int stride, double input_delay) {
   if (k < 1 || stride < 1) throw std::invalid_argument("k_step_predictions: k and stride must be >= 1");
   const int n = model.state_dim();
   KStepPredictions out;
@@ -118,11 +132,12 @@ KStepPredictions k_step_predictions(const StepModel& model, const MeasurementSet
   const auto workspace = model.make_workspace();
   for (int index : episodes) {
     const Episode& e = set.episodes.at(static_cast<std::size_t>(index));
+    const Matrix u = delay_controls(e.u, input_delay);
     for (int s = 0; s + k < e.length(); s += stride) {
       x = e.x.row(s).transpose();
       bool finite = true;
       for (int j = 0; j < k && finite; ++j) {
-        model.step(x, e.u.row(s + j).transpose(), next, nullptr, *workspace);
+        model.step(x, u.row(s + j).transpose(), next, nullptr, *workspace);
         finite = !prediction_diverged(next);
         x = next;
       }

@@ -40,6 +40,9 @@ LibraryEffect force_entry(ForceEffectPtr force);
 /// "actuator_gain" (k, the applied input is k u, on every control).
 LibraryEffect actuator_gain_entry();
 
+/// "input_delay" (d in control periods, 0 to kMaxInputDelay: the applied input is u(t - d); input_delay.hpp).
+LibraryEffect input_delay_entry();
+
 /// A recalibration entry: `effect_name` (e.g. "param:pole_length") sets the system parameter
 /// `parameter` (e.g. "pole_length") to the fitted value. `non_negative` lets the value reach 0;
 /// otherwise it stays above 1e-6 times the current value (masses, lengths). `linear` says xdot is

@@ -13,6 +13,7 @@
 /// | external_force_x, _y, _z | F [N]          | constant force on the body (cart: x only)           |
 /// | quadratic_drag           | c_d [N s^2/m^2]| -c_d abs(v) v on the translational velocity         |
 /// | param:<name>             | the value      | recalibrates one physical parameter                 |
+/// | input_delay              | d [steps]      | the applied input is u(t - d) (input_delay.hpp)     |
 ///
 /// `quadratic_drag` is elementwise, F_i = -c_d |v_i| v_i (the cart: Q_x = -c_d |x_dot| x_dot; the
 /// quadrotor: per world axis, drag of a body with the same area in every direction along the axes).
@@ -35,6 +36,7 @@ enum class EffectKind {
   Force,          ///< a generalised force (ForceEffect)
   ActuatorGain,   ///< the applied input is k u
   Recalibration,  ///< one physical parameter takes another value
+  InputDelay,     ///< the applied input is the command of d control periods earlier (input_delay.hpp)
 };
 
 /// One candidate of the library for one system.
@@ -70,8 +72,13 @@ struct ModelSpec {
   std::map<std::string, double> parameters;        ///< recalibrations: name -> value (overrides the preset)
   double actuator_gain = 1.0;                      ///< k
   std::vector<std::pair<std::string, Vector>> forces;  ///< library force effects -> parameter values, in order
+  /// d [control periods]: the applied input is u(t - d). Not part of the Dynamics (which maps the
+  /// applied input to xdot): whoever drives the model with measured or commanded inputs applies it
+  /// (delay_controls, input_delay.hpp): the diagnosis's predictions, the simulated world.
+  double input_delay = 0.0;
 
-  /// The model's Dynamics (an EffectDynamics when it has a gain other than 1 or forces), with `noise`.
+  /// The model's Dynamics (an EffectDynamics when it has a gain other than 1 or forces), with `noise`;
+  /// without the input delay (see input_delay).
   /// Throws std::invalid_argument for an unknown system, parameter or effect, or invalid values.
   DynamicsPtr build(const ActuatorNoise& noise = {}) const;
 

@@ -24,6 +24,9 @@ struct ExcitationSettings {
   int hold_steps = 5;           ///< each random control level is held for this many samples
   Vector observation_std;       ///< std of Gaussian noise added to each recorded state (empty: none)
   std::uint64_t seed = 1;       ///< the same seed gives the same data, bit for bit
+  /// The world applies the command of this many control periods earlier (input_delay.hpp); the data
+  /// record the commands.
+  double input_delay = 0.0;
 
   /// Throws std::invalid_argument naming the field when a value or a size is invalid.
   void validate(int n, int m) const;

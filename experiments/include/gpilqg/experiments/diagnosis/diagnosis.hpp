@@ -19,7 +19,9 @@
 ///
 ///  - "consistent" when no state's residual is structured. State i is structured when the GP removes
 ///    more than `structure_threshold` of its held-out squared residual, i.e. its held-out RMSE exceeds
-///    the noise floor by more than `floor_tolerance`. Nothing is proposed then.
+///    the noise floor by more than `floor_tolerance`, and no effect removes a large and significant
+///    share of the held-out residual (explained >= min_explained, z >= min_z: the GP sees (x_t, u_t)
+///    only, so the error of an input delay looks like noise to it). Nothing is proposed then.
 ///  - otherwise "explained" when the best alias group removes a significant share of the held-out
 ///    residual: explained >= min_explained, z score >= min_z, and explained >= relative_to_gp times what
 ///    the GP (a flexible model of everything learnable) removes on the same rows. A wrong effect can

@@ -59,6 +59,11 @@ struct FitContext {
 /// The model integrated as configured.
 std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integrator integrator, double dt, int substeps);
 
+/// One-step predictions of `model` on settings.data (one_step_predictions), integrated as
+/// `settings` says and driven by the measured inputs delayed by model.input_delay. Only the data,
+/// integrator, dt and substeps of `settings` are used.
+Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int* diverged = nullptr);
+
 /// The values of one effect inside a joint fit: where it started, where it ended, its 95% interval.
 struct EffectValues {
   std::string effect;

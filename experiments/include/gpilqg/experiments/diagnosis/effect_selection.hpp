@@ -14,8 +14,9 @@
 ///  3. the candidate with the largest held-out reduction is added when it is significant and large,
 ///     z >= min_z and explained >= min_explained (the single-effect verdict's thresholds, 3 and 10%);
 ///     M_k is then M_0 with the chosen effects at their joint estimates. Otherwise selection stops.
-/// Selection stops too when M_k's held-out RMSE is within floor_tolerance of the noise floor in every
-/// state: nothing learnable is left.
+/// Reaching the noise floor is not a stopping rule: the floor comes from a GP of (x_t, u_t), which
+/// cannot see an effect of the input history (input_delay), so a model can be at that floor with an
+/// effect still missing; only the held-out test decides.
 ///
 /// Why a held-out test and not an information criterion. AIC and BIC with the noise floor as the known
 /// variance assume independent residuals; one-step residuals of one episode are serially correlated
@@ -41,8 +42,6 @@ struct SelectionOptions {
   double alias_threshold = 0.95;
   double min_explained = 0.1;   ///< step 3: explained >= this ...
   double min_z = 3.0;           ///< ... and z >= this
-  double floor_tolerance = 1.05;
-  Vector noise_floor;           ///< n, the diagnosis's noise floor per state
   int max_steps = 10;           ///< at most this many effects
   int threads = 1;              ///< candidates fitted at once
   std::function<void(const std::string&)> progress;

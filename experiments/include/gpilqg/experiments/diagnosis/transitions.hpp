@@ -47,14 +47,19 @@ void check_measurement_range(const MeasurementSet& set);
 /// check_divergence, the one test shared with every rollout).
 bool prediction_diverged(const VectorCRef& x);
 
-/// One-step predictions phi(x_t, u_t) (N x n). A prediction that diverged (prediction_diverged) is
-/// replaced by x_t and counted in `diverged` when not null, so no NaN, inf or overflowing value leaves
-/// this function.
-Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* diverged = nullptr);
+/// The inputs a system with an input delay of `delay` control periods applies at every row (N x m):
+/// delay_controls (input_delay.hpp) within each episode; data.u for 0.
+Matrix applied_controls(const Transitions& data, double delay);
+
+/// One-step predictions phi(x_t, u_t) (N x n), u_t the applied input (applied_controls with
+/// `input_delay`). A prediction that diverged (prediction_diverged) is replaced by x_t and counted in
+/// `diverged` when not null, so no NaN, inf or overflowing value leaves this function.
+Matrix one_step_predictions(const StepModel& model, const Transitions& data, int* diverged = nullptr,
+                            double input_delay = 0.0);
 
 /// k-step open-loop predictions: for every episode and every start s = 0, stride, 2 stride, ... with
-/// s + k < T, roll the model k steps from the measured x_s with the measured controls and compare with
-/// the measured x_{s+k}.
+/// s + k < T, roll the model k steps from the measured x_s with the measured controls (delayed by
+/// `input_delay` control periods, input_delay.hpp) and compare with the measured x_{s+k}.
 struct KStepPredictions {
   int k = 1;
   Matrix measured;             ///< W x n, x_{s+k}
@@ -64,6 +69,6 @@ struct KStepPredictions {
   int diverged = 0;            ///< windows whose prediction diverged (prediction_diverged; left out of the W rows)
 };
 KStepPredictions k_step_predictions(const StepModel& model, const MeasurementSet& set,
-                                    const std::vector<int>& episodes, int k, int stride);
+                                    const std::vector<int>& episodes, int k, int stride, double input_delay = 0.0);
 
 }  // namespace gpilqg::diagnosis

@@ -1,0 +1,54 @@
+#include "gpilqg/experiments/diagnosis/delay_start.hpp"
+
+#include <cmath>
+
+namespace gpilqg::diagnosis {
+
+int input_delay_start(const FitContext& c, int max_lag) {
+  const Transitions& data = *c.data;
+  const int N = data.size();
+  const auto n = static_cast<Eigen::Index>(c.weights.size());
+  if (N == 0) return 0;
+  const std::vector<int> training = data.rows(false);
+  Vector u_ref = Vector::Zero(data.u.cols());
+  for (int r : training) u_ref += data.u.row(r).transpose();
+  u_ref /= static_cast<double>(std::max<std::size_t>(1, training.size()));
+
+  // Weighted responses at every row (rows of held-out episodes are not used below).
+  const auto model = make_step_model(c.model, c.integrator, c.dt, c.substeps);
+  const auto workspace = model->make_workspace();
+  const Vector sqrt_w = c.weights.cwiseSqrt();
+  Matrix measured(N, n), predicted(N, n);
+  Vector with_u(n), with_ref(n);
+  for (int r = 0; r < N; ++r) {
+    model->step(data.x.row(r).transpose(), u_ref, with_ref, nullptr, *workspace);
+    model->step(data.x.row(r).transpose(), data.u.row(r).transpose(), with_u, nullptr, *workspace);
+    if (prediction_diverged(with_ref) || prediction_diverged(with_u)) {
+      measured.row(r).setZero();
+      predicted.row(r).setZero();
+      continue;
+    }
+    measured.row(r) = sqrt_w.cwiseProduct(data.x_next.row(r).transpose() - with_ref).transpose();
+    predicted.row(r) = sqrt_w.cwiseProduct(with_u - with_ref).transpose();
+  }
+  int best_lag = 0;
+  double best = 0.0;
+  for (int lag = 0; lag <= max_lag; ++lag) {
+    double cross = 0.0, mm = 0.0, pp = 0.0;
+    for (int r : training) {
+      const int s = r - lag;
+      if (s < 0 || data.episode[static_cast<std::size_t>(s)] != data.episode[static_cast<std::size_t>(r)]) continue;
+      cross += measured.row(r).dot(predicted.row(s));
+      mm += measured.row(r).squaredNorm();
+      pp += predicted.row(s).squaredNorm();
+    }
+    const double rho = mm > 0.0 && pp > 0.0 ? cross / std::sqrt(mm * pp) : 0.0;
+    if (rho > best) {
+      best = rho;
+      best_lag = lag;
+    }
+  }
+  return best_lag;
+}
+
+}  // namespace gpilqg::diagnosis
