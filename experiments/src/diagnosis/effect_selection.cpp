@@ -38,6 +38,39 @@ ModelSpec model_after(const ModelSpec& base, const EffectFit& fit) {
   return model;
 }
 
+/// True when the joint 95% interval of `v` contains `value` in every parameter.
+bool interval_contains(const EffectValues& v, const Vector& value) {
+  return (v.ci_low.array() <= value.array()).all() && (value.array() <= v.ci_high.array()).all();
+}
+
+/// The backward check after a step. An effect chosen at an earlier step whose joint 95% interval now
+/// contains its value in M_0 (a force of 0, a gain of 1, the preset's parameter, no delay) is no
+/// longer needed: a later effect explains what it had soaked up. It is dropped and the others are
+/// refitted jointly, until none is left to drop. Effects M_0 had already are never dropped.
+EffectFit without_redundant(EffectFit fit, const FitContext& context, const FitContext& step_context,
+                            std::vector<std::string>& removed) {
+  const std::vector<RefitEffect> given = model_effects(context.model);
+  const auto in_m0 = [&](const std::string& name) {
+    return std::any_of(given.begin(), given.end(), [&](const RefitEffect& r) { return r.effect->name == name; });
+  };
+  for (;;) {
+    const LibraryEffect* drop = nullptr;
+    for (const EffectValues& v : fit.refitted) {
+      const LibraryEffect& effect = find_effect(context.model.system, v.effect);
+      if (!in_m0(v.effect) && interval_contains(v, context.model.current_values(effect))) {
+        drop = &effect;
+        break;
+      }
+    }
+    if (drop == nullptr) return fit;
+    removed.push_back(drop->name);
+    std::vector<RefitEffect> keep;
+    for (const EffectValues& v : fit.refitted)
+      if (v.effect != drop->name) keep.push_back({&find_effect(context.model.system, v.effect), v.estimate});
+    fit = fit_jointly(find_effect(context.model.system, fit.effect), keep, step_context, fit.estimate);
+  }
+}
+
 }  // namespace
 
 Selection select_effects(const FitContext& context, const SelectionOptions& o, std::vector<RankedEffect> first) {
@@ -59,6 +92,7 @@ Selection select_effects(const FitContext& context, const SelectionOptions& o, s
       break;
     }
     const EffectFit& best = ranking.front().fit;
+    std::vector<std::string> removed;
     if (best.z_score < o.min_z || best.explained < o.min_explained) {
       S.stop_reason = fmt::format(
           "the best remaining candidate '{}' removes {:.1f}% of the held-out residual left (z = {:.1f}); adding an effect "
@@ -67,8 +101,8 @@ Selection select_effects(const FitContext& context, const SelectionOptions& o, s
       S.rejected = std::move(ranking);
       break;
     }
-    const EffectFit added = best;
-    SelectionStep step{added, model_after(context.model, added), std::move(ranking)};
+    const EffectFit added = without_redundant(best, context, step_context, removed);
+    SelectionStep step{added, model_after(context.model, added), std::move(ranking), removed};
     if (o.progress) o.progress(fmt::format("step {}: added {} ({:.1f}% of the held-out residual left)", k, added.effect,
                                            100.0 * added.explained));
     // The chosen effects and their new starts, in the order they were chosen.

@@ -171,6 +171,7 @@ void write_selection(Hdf5Writer& h5, const DiagnosisReport& r) {
     h5.write_vector(group + "/ci_high", high);
     h5.attribute(group, "parameter_name", names);
     h5.attribute(group, "effect", f.effect);
+    if (!steps[k].removed.empty()) h5.attribute(group, "removed", steps[k].removed);
   }
   h5.write_matrix("/selection/heldout_rmse", rmse);
   h5.write_vector("/selection/explained", explained);

@@ -167,6 +167,7 @@ nlohmann::json report_json(const DiagnosisReport& r) {
       json joint = json::array();
       for (const EffectValues& v : step.fit.refitted) joint.push_back(values_json(v));
       entry["refitted"] = joint;
+      entry["removed"] = step.removed;
       entry["heldout_rmse_after_by_state"] = by_name(r.state_names, step.fit.heldout_rmse_after);
       entry["model"] = model_file_text(step.model);
       steps.push_back(entry);

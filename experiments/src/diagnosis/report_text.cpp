@@ -151,6 +151,8 @@ void selection_section(const DiagnosisReport& r, std::string& out) {
     const EffectFit& f = step.fit;
     out += fmt::format("   step {}: + {}: {}\n", k++, f.effect, parameter_text(f, true));
     for (const EffectValues& v : f.refitted) out += fmt::format("           refitted {}: {}\n", v.effect, parameter_text(v));
+    for (const std::string& name : step.removed)
+      out += fmt::format("           removed {}: its joint interval contains its value without it\n", name);
     out += fmt::format("           removes {} +- {} of the held-out residual left (z = {:.1f}); held-out rmse:", percent(f.explained),
                        percent(f.explained_ci), f.z_score);
     for (std::size_t i = 0; i < r.state_names.size(); ++i) {

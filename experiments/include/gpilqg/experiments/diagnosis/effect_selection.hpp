@@ -13,7 +13,11 @@
 ///     the per-sample reduction (effect_fit.hpp, step 4);
 ///  3. the candidate with the largest held-out reduction is added when it is significant and large,
 ///     z >= min_z and explained >= min_explained (the single-effect verdict's thresholds, 3 and 10%);
-///     M_k is then M_0 with the chosen effects at their joint estimates. Otherwise selection stops.
+///     M_k is then M_0 with the chosen effects at their joint estimates. Otherwise selection stops;
+///  4. a backward check: an effect chosen at an earlier step whose joint 95% interval now contains its
+///     value in M_0 (a force of 0, a gain of 1, the preset's parameter, no delay) is dropped and the
+///     others refitted jointly: a later effect explains what it had soaked up (a gain fitted first
+///     to what a constant force does, say). Effects M_0 had are never dropped.
 /// Reaching the noise floor is not a stopping rule: the floor comes from a GP of (x_t, u_t), which
 /// cannot see an effect of the input history (input_delay), so a model can be at that floor with an
 /// effect still missing; only the held-out test decides.
@@ -52,6 +56,7 @@ struct SelectionStep {
   EffectFit fit;               ///< fit.refitted: the earlier effects' new values; explained, z: against M_{k-1}
   ModelSpec model;             ///< M_k
   std::vector<RankedEffect> ranking;  ///< every candidate of this step, best first
+  std::vector<std::string> removed;   ///< earlier effects dropped by the backward check (step 4)
 };
 
 struct Selection {
