@@ -6,6 +6,9 @@ writes PNG files into a folder:
   residual_gp_band.png       residual of the worst states over time with the GP mean +- 2 std band
   ranking.png                explained fraction of every effect with its 95% interval (and the parameter)
   residual_vs_input.png      residual against its most relevant input, before and after the effect
+  residual_whiteness.png     autocorrelation of the held-out residual per state with the 95% band
+  free_run.png               measured states against the free-run simulations (sim, sim+effect,
+                             sim+GP) of the first held-out episodes, fit % in the legend (MATLAB `compare`)
 
 Usage: /usr/bin/python3 diagnose_plots.py REPORT.h5 OUT_DIR
 """
@@ -18,6 +21,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 
 
@@ -137,6 +141,109 @@ def residual_vs_input(f, out, states, inputs, shown):
     plt.close(fig)
 
 
+def residual_whiteness(f, out, states):
+    """Stem plot of rho(k), k = 0..L, per state with the +-band shaded, the Ljung-Box verdict in the title."""
+    g = f["whiteness"]
+    lags = g["lags"][()]
+    rho = g["autocorrelation"][()]
+    band = float(g.attrs["band"])
+    white = g["white"][()]
+    q, p = g["ljung_box_q"][()], g["p_value"][()]
+    critical = float(g.attrs["critical_value"])
+    dt = float(json.loads(text(f.attrs["report"]))["dt"])
+    n = len(states)
+    cols = 2 if n > 1 else 1
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols, 2.6 * rows + 0.6), sharex=True, squeeze=False)
+    for i in range(rows * cols):
+        ax = axes[i // cols, i % cols]
+        if i >= n:
+            ax.axis("off")
+            continue
+        ax.axhspan(-band, band, color="tab:blue", alpha=0.15, label=f"95% band +-{band:.3f}")
+        ax.axhline(0.0, color="k", lw=0.5)
+        outside = np.abs(rho[i]) > band
+        outside[0] = False
+        ax.vlines(lags, 0.0, rho[i], color="0.3", lw=1.2)
+        ax.plot(lags[~outside], rho[i][~outside], "o", color="0.3", ms=3.5)
+        ax.plot(lags[outside], rho[i][outside], "o", color="tab:red", ms=4, label="outside the band")
+        verdict = "white" if white[i] else "not white"
+        p_text = "p < 0.001" if p[i] < 0.001 else f"p = {p[i]:.3f}"
+        ax.set_title(f"{states[i]}: {verdict} (Q = {q[i]:.3g}, {p_text})", fontsize=9,
+                     color="k" if white[i] else "tab:red")
+        ax.set_ylabel("autocorrelation")
+        ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
+        ax.set_xlim(-0.5, lags[-1] + 0.5)
+        ax.set_ylim(min(-1.05, rho[i].min() - 0.05), 1.05)
+        if i // cols == rows - 1 or i + cols >= n:
+            ax.set_xlabel(f"lag [samples of {dt:g} s]")
+            ax.xaxis.set_tick_params(labelbottom=True)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper right", fontsize=8)
+    dof = int(g.attrs["degrees_of_freedom"])
+    fig.suptitle(f"Whiteness of the held-out one-step residual (N = {int(g.attrs['samples'])}; "
+                 f"white when Ljung-Box Q <= chi2_0.95({dof}) = {critical:.1f})", fontsize=10, x=0.02, ha="left")
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    fig.savefig(os.path.join(out, "residual_whiteness.png"), dpi=110)
+    plt.close(fig)
+
+
+FREE_RUN_STYLE = {"sim": dict(color="tab:red", ls="--"), "sim+effect": dict(color="tab:green", ls="-"),
+                  "sim+GP": dict(color="tab:blue", ls="-.")}
+
+
+def free_run(f, out, states, shown, episodes=3):
+    """Measured states and the free-run simulations of the first held-out episodes, fit % in the legend."""
+    g = f["free_run"]
+    groups = sorted(g, key=int)[:episodes]
+    models = names(g.attrs["models"])
+    units = names(f.attrs["state_units"]) if "state_units" in f.attrs else [""] * len(states)
+    fig, axes = plt.subplots(len(shown), len(groups), figsize=(4.8 * len(groups) + 0.4, 2.5 * len(shown) + 1.0),
+                             sharex="col", squeeze=False)
+    for c, key in enumerate(groups):
+        e = g[key]
+        t = e["t"][()]
+        measured = e["measured"][()]
+        fit = e["fit_percent"][()]
+        steps, diverged = e["steps"][()], e["diverged"][()]
+        for r, i in enumerate(shown):
+            ax = axes[r, c]
+            ax.plot(t, measured[:, i], "k-", lw=1.8, label="measured")
+            values = [measured[:, i]]
+            for k, name in enumerate(models):
+                predicted = e["predicted"][name][()]
+                label = f"{name} {fit[k, i]:.1f}%"
+                if diverged[k] and steps[k] == 0:
+                    label = f"{name}: diverged at the first step"
+                elif diverged[k]:
+                    label += f" until it diverged at {t[int(steps[k]) + 1]:.2f} s"
+                ax.plot(t[: predicted.shape[0]], predicted[:, i], lw=1.2, label=label, **FREE_RUN_STYLE.get(name, {}))
+                values.append(predicted[:, i])
+            # Headroom above the curves for the legend of the fits, so that it hides none of them; a
+            # simulation that drifts far away leaves the axes beyond 3 measured spans (its fit says how far).
+            m_low, m_high = measured[:, i].min(), measured[:, i].max()
+            m_span = max(m_high - m_low, 1e-12)
+            low = max(min(v.min() for v in values), m_low - 3 * m_span)
+            high = min(max(v.max() for v in values), m_high + 3 * m_span)
+            span = max(high - low, 1e-12)
+            ax.set_ylim(low - 0.05 * span, high + 0.45 * span)
+            handles, labels = ax.get_legend_handles_labels()
+            ax.legend(handles[1:], labels[1:], loc="upper center", fontsize=7, ncol=1 if diverged.any() else len(models),
+                      handlelength=1.8, columnspacing=1.0, framealpha=0.9)
+            if c == 0:
+                ax.set_ylabel(f"{states[i]} [{units[i]}]" if units[i] else states[i])
+            if r == 0:
+                ax.set_title(f"held-out episode {int(e.attrs['id'])}", fontsize=10)
+            if r == len(shown) - 1:
+                ax.set_xlabel("t [s]")
+    fig.legend(handles[:1], labels[:1], loc="upper right", fontsize=8)
+    fig.suptitle("Free-run simulation (k = inf) from the measured initial state with the measured controls; "
+                 "fit = 100 (1 - |y - y^| / |y - mean y|)", fontsize=10, x=0.02, ha="left")
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    fig.savefig(os.path.join(out, "free_run.png"), dpi=110)
+    plt.close(fig)
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit("usage: diagnose_plots.py REPORT.h5 OUT_DIR")
@@ -153,7 +260,14 @@ def main():
             rmse = f["add/heldout_rmse"][()]
             shown = list(np.argsort(-(rmse[0] / np.maximum(rmse[1], 1e-300)))[: min(3, len(states))])
         residual_vs_input(f, out, states, inputs, shown)
-    print(f"wrote 4 plots to {out}")
+        count = 4
+        if "whiteness" in f:
+            residual_whiteness(f, out, states)
+            count += 1
+        if "free_run" in f:  # every state up to 6 (the worst ones first beyond that)
+            free_run(f, out, states, sorted(worst_states(f, min(6, len(states)))))
+            count += 1
+    print(f"wrote {count} plots to {out}")
 
 
 if __name__ == "__main__":

@@ -150,8 +150,77 @@ TEST(DiagnoseCli, PlotsNeedMatplotlibAndSayWhenItIsMissing) {
     GTEST_SKIP() << "/usr/bin/python3 has no matplotlib/h5py: the PNG part is not checked here";
   const auto ok = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --plots " + quote(dir / "p") + kFast);
   ASSERT_EQ(ok.status, 0) << ok.err;
-  for (const char* png : {"measured_vs_predicted.png", "residual_gp_band.png", "ranking.png", "residual_vs_input.png"})
+  for (const char* png : {"measured_vs_predicted.png", "residual_gp_band.png", "ranking.png", "residual_vs_input.png",
+                          "residual_whiteness.png", "free_run.png"})
     EXPECT_GT(fs::file_size(dir / "p" / png), 1000u) << png;
+}
+
+TEST(DiagnoseCli, HorizonsAndTheTestsOfSystemIdentificationAreInEveryReport) {
+  const fs::path dir = test::temporary_dir("diagnose_sysid");
+  const fs::path data = friction_csv(dir), report = dir / "report.h5";
+  const std::string base = "diagnose --system cartpole --data " + quote(data) + kFast;
+  const auto result = test::run_cli(base + " --horizons 1,5,20 --json --out " + quote(report));
+  ASSERT_EQ(result.status, 0) << result.err;
+  const json j = json::parse(result.out);
+  ASSERT_EQ(j["k_step"].size(), 3u);
+  EXPECT_EQ(j["k_step"][1]["k"], 5);
+  EXPECT_EQ(j["k_step"][2]["k"], 20);
+  for (const char* key : {"rmse", "fit_percent"}) EXPECT_TRUE(j["k_step"][2]["states"][0].contains(key)) << key;
+  // Whiteness: band 1.96 / sqrt(N) over the held-out samples, one entry per state with L + 1 lags.
+  const json& w = j["whiteness"];
+  for (const char* key : {"band", "lags", "samples", "test", "level", "degrees_of_freedom", "critical_value", "states"})
+    EXPECT_TRUE(w.contains(key)) << key;
+  EXPECT_EQ(w["lags"], 20);
+  EXPECT_NEAR(w["band"].get<double>(), 1.96 / std::sqrt(w["samples"].get<double>()), 1e-12);
+  ASSERT_EQ(w["states"].size(), 4u);
+  for (const char* key : {"name", "autocorrelation", "outside_band", "ljung_box_q", "p_value", "white"})
+    EXPECT_TRUE(w["states"][0].contains(key)) << key;
+  EXPECT_EQ(w["states"][0]["autocorrelation"].size(), 21u);
+  // Free run: one entry per held-out episode, the three models (the verdict proposes the friction).
+  ASSERT_EQ(j["free_run"].size(), j["heldout_episodes"].size());
+  const json& run = j["free_run"][0];
+  EXPECT_EQ(run["episode"], j["heldout_episodes"][0]);
+  ASSERT_EQ(run["models"].size(), 3u);
+  EXPECT_EQ(run["models"][0]["name"], "sim");
+  EXPECT_EQ(run["models"][1]["name"], "sim+effect");
+  EXPECT_EQ(run["models"][2]["name"], "sim+GP");
+  EXPECT_FALSE(run["models"][0]["diverged"].get<bool>());
+  EXPECT_EQ(run["models"][0]["fit_percent"].size(), 4u);
+  EXPECT_TRUE(has_no_nan(j));
+  {
+    H5::H5File h5(report.string(), H5F_ACC_RDONLY);
+    for (const char* name : {"/compare/k_5/fit_percent", "/compare/k_20/rmse", "/whiteness/autocorrelation",
+                             "/whiteness/white", "/free_run/0/measured", "/free_run/0/predicted/sim+GP", "/free_run/0/fit_percent"})
+      EXPECT_TRUE(h5.nameExists(name)) << name;
+  }
+  // The text has a section for each.
+  const auto text = test::run_cli(base + " --horizons 2");
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("   k = 2 "), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("   k = 10 "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("\nWhiteness of the held-out residual"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("\nFree-run fit (k = inf) per held-out episode"), std::string::npos) << text.out;
+}
+
+TEST(DiagnoseCli, BadHorizonsAreExitTwoNamingTheOption) {
+  const fs::path dir = test::temporary_dir("diagnose_bad_horizons");
+  const fs::path data = friction_csv(dir);
+  const std::string base = "diagnose --system cartpole --data " + quote(data) + kFast + " --horizons ";
+  for (const std::string value : {"0", "-1", "abc", "1,0", "5,x", "1.5", "2000000", "''"}) {
+    const auto r = test::run_cli(base + value);
+    EXPECT_EQ(r.status, 2) << value << ": " << r.out;
+    EXPECT_EQ(r.err.rfind("error:", 0), 0u) << value << ": " << r.err;
+    EXPECT_NE(r.err.find("--horizons"), std::string::npos) << value << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << value;
+  }
+  const auto twice = test::run_cli(base + "10,5,10");
+  EXPECT_EQ(twice.status, 2);
+  EXPECT_NE(twice.err.find("--horizons 10,5,10: 10 is listed twice"), std::string::npos) << twice.err;
+  std::string many = "1";
+  for (int k = 2; k <= 33; ++k) many += "," + std::to_string(k);
+  const auto too_many = test::run_cli(base + many);
+  EXPECT_EQ(too_many.status, 2);
+  EXPECT_NE(too_many.err.find("33 horizons; expected at most 32"), std::string::npos) << too_many.err;
 }
 
 TEST(DiagnosisPieces, FitPercentHasItsClosedForm) {

@@ -1,6 +1,7 @@
 /// `gpilqg diagnose --system NAME --data FILE [--model F.toml] [--add EFFECT[=VALUE]]... [--json]
-/// [--out F.h5] [--plots DIR]`: compare a model with measurements, see where it fails, learn which
-/// physical effect is missing, add it and watch the error fall (DESIGN.md sections 5, 6 and 8).
+/// [--out F.h5] [--plots DIR] [--horizons LIST]`: compare a model with measurements, see where it fails,
+/// learn which physical effect is missing, add it and watch the error fall (DESIGN.md sections 5, 6
+/// and 8).
 
 #include <unistd.h>
 
@@ -145,6 +146,10 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--write-model", o->write_model, "Write the improved model (TOML) for the next diagnosis");
   cmd->add_option("--integrator", r.integrator, "rk4 or euler")->capture_default_str();
   cmd->add_option("--heldout", r.heldout, "Fraction of the episodes held out")->capture_default_str();
+  cmd->add_option("--horizons", r.horizons, "Horizons k of the k-step predictions, comma-separated (e.g. 1,5,20)")
+      ->capture_default_str()
+      ->delimiter(',')
+      ->check(integer_in(1, limits::kMaxHorizon));
   cmd->add_option("--gp-points", r.gp_points, "GP training points per state")
       ->capture_default_str()
       ->check(integer_in(2, limits::kMaxExactPoints));

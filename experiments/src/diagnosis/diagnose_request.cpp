@@ -1,8 +1,10 @@
 #include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
@@ -26,6 +28,18 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   d.integrator = *integrator;
   if (!(o.heldout > 0.0 && o.heldout < 1.0))
     throw InputError(fmt::format("--heldout {}: expected a fraction of the episodes in (0, 1)", o.heldout));
+  const std::string horizons = fmt::format("{}", fmt::join(o.horizons, ","));
+  if (o.horizons.empty()) throw InputError("--horizons: expected at least one horizon k >= 1");
+  if (o.horizons.size() > kMaxHorizonCount)
+    throw InputError(fmt::format("--horizons {}: {} horizons; expected at most {}", horizons, o.horizons.size(), kMaxHorizonCount));
+  for (std::size_t i = 0; i < o.horizons.size(); ++i) {
+    if (o.horizons[i] < 1 || o.horizons[i] > limits::kMaxHorizon)
+      throw InputError(fmt::format("--horizons {}: {} is not a horizon; expected whole numbers from 1 to {}", horizons,
+                                   o.horizons[i], limits::kMaxHorizon));
+    for (std::size_t j = 0; j < i; ++j)
+      if (o.horizons[j] == o.horizons[i])
+        throw InputError(fmt::format("--horizons {}: {} is listed twice; expected distinct horizons", horizons, o.horizons[i]));
+  }
   if (o.gp_points < 10) throw InputError(fmt::format("--gp-points {}: expected at least 10", o.gp_points));
   if (o.gp_restarts < 0) throw InputError(fmt::format("--gp-restarts {}: expected >= 0", o.gp_restarts));
   try {
@@ -35,6 +49,7 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   }
   d.auto_select = o.auto_select;
   d.heldout_fraction = o.heldout;
+  d.horizons = o.horizons;
   d.gp.points = o.gp_points;
   d.gp.restarts = o.gp_restarts;
   d.gp.backend = o.backend;

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "gpilqg/control/rollout.hpp"
+#include "gpilqg/core/input_delay.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 
 namespace gpilqg::diagnosis {
@@ -18,6 +19,9 @@ void DiagnosisOptions::validate() const {
   require(substeps >= 1, "'substeps' must be >= 1");
   require(heldout_fraction > 0.0 && heldout_fraction < 1.0, "'heldout_fraction' must be in (0, 1)");
   for (int k : horizons) require(k >= 1, "'horizons' must be >= 1");
+  std::vector<int> sorted = horizons;
+  std::sort(sorted.begin(), sorted.end());
+  require(std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end(), "'horizons' must be distinct");
   require(gp.points >= 10, "'gp.points' must be >= 10");
   require(gp.restarts >= 0 && gp.threads >= 1, "'gp.restarts' must be >= 0 and 'gp.threads' >= 1");
   require(bins >= 1 && max_lag >= 0, "'bins' must be >= 1 and 'max_lag' >= 0");
@@ -315,6 +319,18 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     R.comparison.push_back({"sim+GP", heldout_rmse(data, base_residual - base_gp->mean), base_gp->signal_variance});
     R.comparison.push_back({"sim+effect+GP", heldout_rmse(data, R.residual_after - gp_after.mean), gp_after.signal_variance});
   }
+
+  // 5. Whiteness and free run on the held-out episodes.
+  R.whiteness = whiteness_test(data, R.residual, R.state_names, o.max_lag);
+  // Each model driven by the measured inputs as it applies them (its input delay).
+  const auto applied = [](const ModelSpec& model) -> ControlSource {
+    return [delay = model.input_delay](const MatrixCRef& u) { return delay_controls(Matrix(u), delay); };
+  };
+  std::vector<FreeRunModel> runs{{"sim", before_step, applied(o.model)}};
+  if (with_effect != nullptr)
+    runs.push_back({"sim+effect", make_step_model(R.model_next, o.integrator, R.dt, o.substeps), applied(R.model_next)});
+  runs.push_back({"sim+GP", gp_before.model, applied(o.model)});
+  R.free_run = free_run(set, R.heldout_episode_index, runs);
   return R;
 }
 

@@ -9,6 +9,7 @@
 
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
+#include "gpilqg/core/systems.hpp"
 #include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/core/version.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
@@ -23,6 +24,19 @@ std::vector<double> row_major(const std::vector<std::vector<Vector>>& values) {
   for (const auto& row : values)
     for (const Vector& v : row) out.insert(out.end(), v.data(), v.data() + v.size());
   return out;
+}
+
+std::vector<std::string> units_of(const std::vector<Quantity>& quantities) {
+  std::vector<std::string> out;
+  for (const Quantity& q : quantities) out.push_back(q.unit);
+  return out;
+}
+
+/// The units of the states and controls (for the plots' axes), from the system's signature.
+void write_units(Hdf5Writer& h5, const DiagnosisReport& r) {
+  const SystemSignature signature = system_signature(r.system);
+  if (signature.states.size() == r.state_names.size()) h5.attribute("/", "state_units", units_of(signature.states));
+  if (signature.controls.size() == r.control_names.size()) h5.attribute("/", "control_units", units_of(signature.controls));
 }
 
 void write_data(Hdf5Writer& h5, const DiagnosisReport& r) {
@@ -56,9 +70,70 @@ void write_data(Hdf5Writer& h5, const DiagnosisReport& r) {
     h5.write_matrix(g + "/predicted", k.predictions.predicted);
     h5.write_vector(g + "/episode", k.predictions.episode);
     h5.write_vector(g + "/start", k.predictions.start);
+    h5.write_vector(g + "/rmse", k.rmse);
+    h5.write_vector(g + "/fit_percent", k.fit_percent);
     h5.attribute(g, "k", static_cast<std::int64_t>(k.k));
     h5.attribute(g, "stride", static_cast<std::int64_t>(k.stride));
+    h5.attribute(g, "windows", static_cast<std::int64_t>(k.windows));
+    h5.attribute(g, "diverged", static_cast<std::int64_t>(k.diverged));
   }
+}
+
+void write_whiteness(Hdf5Writer& h5, const DiagnosisReport& r) {
+  const Whiteness& w = r.whiteness;
+  if (w.states.empty()) return;
+  std::vector<int> lags, outside, white;
+  for (int k = 0; k <= w.max_lag; ++k) lags.push_back(k);
+  Matrix rho(static_cast<Eigen::Index>(w.states.size()), w.max_lag + 1);
+  std::vector<double> q, p;
+  for (std::size_t i = 0; i < w.states.size(); ++i) {
+    const StateWhiteness& s = w.states[i];
+    rho.row(static_cast<Eigen::Index>(i)) = s.autocorrelation.transpose();
+    outside.push_back(s.outside_band);
+    white.push_back(s.white ? 1 : 0);
+    q.push_back(s.ljung_box);
+    p.push_back(s.p_value);
+  }
+  h5.write_vector("/whiteness/lags", lags);
+  h5.write_matrix("/whiteness/autocorrelation", rho);
+  h5.write_vector("/whiteness/outside_band", outside);
+  h5.write_vector("/whiteness/ljung_box_q", q);
+  h5.write_vector("/whiteness/p_value", p);
+  h5.write_vector("/whiteness/white", white);
+  h5.attribute("/whiteness", "test", std::string("ljung_box"));
+  h5.attribute("/whiteness", "band", w.band);
+  h5.attribute("/whiteness", "samples", static_cast<std::int64_t>(w.samples));
+  h5.attribute("/whiteness", "max_lag", static_cast<std::int64_t>(w.max_lag));
+  h5.attribute("/whiteness", "level", w.level);
+  h5.attribute("/whiteness", "degrees_of_freedom", static_cast<std::int64_t>(w.degrees_of_freedom));
+  h5.attribute("/whiteness", "critical_value", w.critical_value);
+}
+
+void write_free_run(Hdf5Writer& h5, const DiagnosisReport& r) {
+  if (r.free_run.empty()) return;
+  std::vector<std::string> models;
+  for (const FreeRunTrajectory& m : r.free_run.front().models) models.push_back(m.model);
+  for (std::size_t j = 0; j < r.free_run.size(); ++j) {
+    const FreeRunEpisode& e = r.free_run[j];
+    const std::string g = "/free_run/" + std::to_string(j);
+    h5.write_vector(g + "/t", e.t);
+    h5.write_matrix(g + "/measured", e.measured);
+    Matrix fit(static_cast<Eigen::Index>(e.models.size()), e.measured.cols());
+    std::vector<int> steps, diverged;
+    for (std::size_t k = 0; k < e.models.size(); ++k) {
+      const FreeRunTrajectory& m = e.models[k];
+      fit.row(static_cast<Eigen::Index>(k)) = m.fit_percent.transpose();
+      steps.push_back(m.steps);
+      diverged.push_back(m.diverged ? 1 : 0);
+      h5.write_matrix(g + "/predicted/" + m.model, m.predicted);
+    }
+    h5.write_matrix(g + "/fit_percent", fit);
+    h5.write_vector(g + "/steps", steps);
+    h5.write_vector(g + "/diverged", diverged);
+    h5.attribute(g, "id", static_cast<std::int64_t>(e.id));
+    h5.attribute(g, "index", static_cast<std::int64_t>(e.index));
+  }
+  h5.attribute("/free_run", "models", models);
 }
 
 void write_where(Hdf5Writer& h5, const DiagnosisReport& r) {
@@ -202,11 +277,14 @@ void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport&
     h5.attribute("/", "state_names", r.state_names);
     h5.attribute("/", "control_names", r.control_names);
     h5.attribute("/", "input_names", r.input_names);
+    write_units(h5, r);
     write_data(h5, r);
     write_where(h5, r);
     write_ranking(h5, r);
     write_add(h5, r);
     write_selection(h5, r);
+    write_whiteness(h5, r);
+    write_free_run(h5, r);
     h5.close();
   });
 }

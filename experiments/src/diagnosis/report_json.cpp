@@ -101,6 +101,34 @@ json where_json(const DiagnosisReport& r) {
           {"episode_rmse", episodes}};
 }
 
+json whiteness_json(const DiagnosisReport& r) {
+  const Whiteness& w = r.whiteness;
+  json states = json::array();
+  for (const StateWhiteness& s : w.states)
+    states.push_back({{"name", s.name}, {"autocorrelation", vector_json(s.autocorrelation)}, {"outside_band", s.outside_band},
+                      {"ljung_box_q", s.ljung_box}, {"p_value", s.p_value}, {"white", s.white}});
+  return {{"test", "ljung_box"},
+          {"lags", w.max_lag},
+          {"samples", w.samples},
+          {"band", w.band},
+          {"level", w.level},
+          {"degrees_of_freedom", w.degrees_of_freedom},
+          {"critical_value", w.critical_value},
+          {"states", states}};
+}
+
+json free_run_json(const DiagnosisReport& r) {
+  json out = json::array();
+  for (const FreeRunEpisode& e : r.free_run) {
+    json models = json::array();
+    for (const FreeRunTrajectory& m : e.models)
+      models.push_back({{"name", m.model}, {"fit_percent", by_name(r.state_names, m.fit_percent)}, {"diverged", m.diverged},
+                        {"steps", m.steps}});
+    out.push_back({{"episode", e.id}, {"index", e.index}, {"steps", e.t.size() - 1}, {"models", models}});
+  }
+  return out;
+}
+
 }  // namespace
 
 nlohmann::json report_json(const DiagnosisReport& r) {
@@ -182,6 +210,8 @@ nlohmann::json report_json(const DiagnosisReport& r) {
           {"consistent", r.consistent},
           {"states", states},
           {"k_step", k_step},
+          {"whiteness", whiteness_json(r)},
+          {"free_run", free_run_json(r)},
           {"relevance", relevance},
           {"sensitivity", sensitivity},
           {"where", where_json(r)},

@@ -69,6 +69,70 @@ void compare_section(const DiagnosisReport& r, std::string& out) {
   }
 }
 
+/// A fit percent in a column of 9: fixed point, or exponent form when a simulation drifted far.
+std::string fit_text(double fit) { return std::abs(fit) < 1e5 ? fmt::format("{:>9.1f}", fit) : fmt::format("{:>9.2e}", fit); }
+
+/// At most 6 state columns, as wide as their names.
+constexpr std::size_t kStateColumns = 6;
+
+std::string state_header(const DiagnosisReport& r) {
+  std::string out;
+  for (std::size_t i = 0; i < std::min(kStateColumns, r.state_names.size()); ++i)
+    out += fmt::format(" {:>9}", r.state_names[i]);
+  return out + (r.state_names.size() > kStateColumns ? "  ..." : "");
+}
+
+void whiteness_section(const DiagnosisReport& r, std::string& out) {
+  const Whiteness& w = r.whiteness;
+  if (w.states.empty()) return;
+  out += fmt::format("\nWhiteness of the held-out residual (one-step, autocorrelation within episodes, lags 1..{}, N = {})\n",
+                     w.max_lag, w.samples);
+  if (w.degrees_of_freedom == 0) {
+    out += "   no lag has a pair of samples within an episode: nothing to test\n";
+    return;
+  }
+  out += fmt::format("   95% band +-{:.3f}; white when the Ljung-Box Q <= chi2_{:.2f}({}) = {:.2f} (p >= {:g})\n", w.band,
+                     1.0 - w.level, w.degrees_of_freedom, w.critical_value, w.level);
+  out += fmt::format("   {:<10} {:>8} {:>13} {:>10} {:>7}  {}\n", "state", "rho(1)", "outside band", "Q", "p", "white");
+  std::string coloured, noise_like;
+  for (const StateWhiteness& s : w.states) {
+    const double lag_one = w.max_lag >= 1 ? s.autocorrelation(1) : 0.0;
+    out += fmt::format("   {:<10} {:>8.3f} {:>13} {:>10.4g} {:>7}  {}\n", s.name, lag_one,
+                       fmt::format("{}/{}", s.outside_band, w.max_lag), s.ljung_box,
+                       s.p_value < 0.001 ? std::string("<0.001") : fmt::format("{:.3f}", s.p_value), s.white ? "yes" : "no");
+    if (s.white) continue;
+    // rho(1) near -1/2: the one-step residual differences the noise of the measured state (whiteness.hpp).
+    std::string& list = lag_one <= -0.35 ? noise_like : coloured;
+    list += (list.empty() ? "" : ", ") + s.name;
+  }
+  if (coloured.empty() && noise_like.empty()) out += "   => white: no time structure left in the one-step residual\n";
+  if (!coloured.empty()) out += "   => not white: " + coloured + " (the one-step errors are predictable from the past)\n";
+  if (!noise_like.empty())
+    out += "   => not white: " + noise_like + " with rho(1) near -1/2, the mark of noise on the measured state\n";
+}
+
+void free_run_section(const DiagnosisReport& r, std::string& out) {
+  if (r.free_run.empty()) return;
+  out += "\nFree-run fit (k = inf) per held-out episode: simulated from the measured x[0] with the measured controls, "
+         "fit % per state\n";
+  out += fmt::format("   {:<8} {:<11}{}\n", "episode", "model", state_header(r));
+  for (const FreeRunEpisode& e : r.free_run) {
+    bool first = true;
+    for (const FreeRunTrajectory& m : e.models) {
+      out += fmt::format("   {:<8} {:<11}", first ? std::to_string(e.id) : std::string(), m.model);
+      first = false;
+      for (Eigen::Index i = 0; i < std::min<Eigen::Index>(kStateColumns, m.fit_percent.size()); ++i)
+        out += " " + fit_text(m.fit_percent(i));
+      if (m.diverged && m.steps == 0)
+        out += fmt::format("  (diverged at the first step, t = {:.3g} s: no fit)", e.t(1));
+      else if (m.diverged)
+        out += fmt::format("  (diverged after {} of {} steps, at t = {:.3g} s; fit over the steps before)", m.steps,
+                           e.t.size() - 1, e.t(m.steps + 1));
+      out += "\n";
+    }
+  }
+}
+
 void where_section(const DiagnosisReport& r, std::string& out) {
   out += "\n2. Where it fails\n";
   for (std::size_t i = 0; i < r.states.size(); ++i) {
@@ -198,10 +262,12 @@ std::string report_text(const DiagnosisReport& r) {
   out += fmt::format("data: {} transitions, dt = {} s, held-out episodes {}\n", r.samples, r.dt,
                      fmt::join(r.heldout_episode_ids, ", "));
   compare_section(r, out);
+  whiteness_section(r, out);
   where_section(r, out);
   which_section(r, out);
   selection_section(r, out);
   add_section(r, out);
+  free_run_section(r, out);
   out += "\nverdict: " + r.verdict.status;
   if (r.verdict.effect) {
     out += fmt::format(": {} ({})", r.verdict.effect->effect, parameter_text(*r.verdict.effect, true));

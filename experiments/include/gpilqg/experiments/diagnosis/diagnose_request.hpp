@@ -19,14 +19,19 @@ struct DiagnoseRequest {
   bool auto_select = false;      ///< --auto: forward selection of several effects
   std::string integrator = "rk4";
   double heldout = 0.3;          ///< fraction of the episodes held out
+  std::vector<int> horizons = {1, 10, 50};  ///< k of the k-step predictions (distinct, >= 1)
   int gp_points = 300;           ///< GP training points per state
   int gp_restarts = 1;
   std::string backend = "exact";
   std::uint64_t seed = 1;
 };
 
+/// At most this many k-step horizons (each stores its windows' predictions in the report).
+inline constexpr std::size_t kMaxHorizonCount = 32;
+
 /// The diagnosis options of a request. Throws InputError naming the option (`--preset`, `--add`,
-/// `--integrator`, `--heldout`, `--gp-points`, `--gp-restarts`, `--backend`) or the model file.
+/// `--integrator`, `--heldout`, `--horizons`, `--gp-points`, `--gp-restarts`, `--backend`) or the model
+/// file.
 DiagnosisOptions diagnosis_options(const DiagnoseRequest& request);
 
 }  // namespace gpilqg::diagnosis

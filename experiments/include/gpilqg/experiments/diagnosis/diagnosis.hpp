@@ -11,7 +11,10 @@
 ///  3. which (effect_fit.hpp): every effect of the library fitted on the training episodes and scored
 ///     on the held-out episodes, grouped into aliases, and a verdict;
 ///  4. add: before and after on the held-out episodes for sim, sim + effect, sim + GP and
-///     sim + effect + GP, with the GP's learned signal variance.
+///     sim + effect + GP, with the GP's learned signal variance;
+///  5. the tests of system identification on the held-out episodes: the whiteness of the diagnosed
+///     model's one-step residual (whiteness.hpp) and the free-run simulation fit, k = infinity, of sim,
+///     sim + effect and sim + GP (free_run.hpp).
 ///
 /// Verdict.
 /// Noise floor of state i: min(held-out RMSE of the model, held-out RMSE of the model corrected by a
@@ -45,8 +48,10 @@
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
+#include "gpilqg/experiments/diagnosis/free_run.hpp"
 #include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
+#include "gpilqg/experiments/diagnosis/whiteness.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -65,7 +70,7 @@ struct DiagnosisOptions {
   std::vector<int> horizons = {1, 10, 50};
   GpSettings gp;
   int bins = 5;                           ///< quantile bins per input
-  int max_lag = 20;                       ///< cross-correlation lags
+  int max_lag = 20;                       ///< cross-correlation and residual autocorrelation lags
   double alias_threshold = 0.95;          ///< |regressor correlation| that makes two effects aliases
   double structure_threshold = 0.1;       ///< GP held-out explained fraction above which a state is structured
   double floor_tolerance = 1.05;          ///< held-out RMSE / noise floor above which a state is structured
@@ -161,6 +166,11 @@ struct DiagnosisReport {
   Matrix residual_base;                  ///< N x n, one-step residual of "sim" in the comparison
   Matrix residual_after;                 ///< N x n, one-step residual of sim + effect (when comparison exists)
   Matrix relevance_base;                 ///< n x (n + m), relevance of the "sim" model's GP
+  /// Whiteness of the held-out one-step residual of the diagnosed model (`residual`).
+  Whiteness whiteness;
+  /// Free run of every held-out episode: "sim" (model_before), "sim+effect" (model_next, present when
+  /// the four-model comparison is) and "sim+GP" (model_before plus the mean of its residual GP).
+  std::vector<FreeRunEpisode> free_run;
 };
 
 /// Runs the diagnosis. Throws std::invalid_argument for bad options or data that do not fit the model

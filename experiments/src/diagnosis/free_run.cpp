@@ -1,0 +1,68 @@
+#include "gpilqg/experiments/diagnosis/free_run.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
+#include "gpilqg/experiments/diagnosis/transitions.hpp"
+
+namespace gpilqg::diagnosis {
+
+Matrix measured_controls(const MatrixCRef& measured) { return measured; }
+
+FreeRunTrajectory free_run(const FreeRunModel& model, const Episode& episode) {
+  const StepModel& phi = *model.step;
+  const int n = phi.state_dim();
+  const Eigen::Index T = episode.x.rows();
+  if (episode.x.cols() != n || episode.u.cols() != phi.control_dim() || episode.u.rows() != T || T < 1)
+    throw std::invalid_argument(fmt::format("free run of '{}': episode {} has {} x {} states and {} x {} controls; the model "
+                                            "has {} states and {} controls", model.name, episode.id, T, episode.x.cols(),
+                                            episode.u.rows(), episode.u.cols(), n, phi.control_dim()));
+  const Matrix u = (model.controls ? model.controls : ControlSource(measured_controls))(episode.u);
+  if (u.rows() != episode.u.rows() || u.cols() != episode.u.cols())
+    throw std::invalid_argument(fmt::format("free run of '{}': the control source returned {} x {} controls for {} x {}",
+                                            model.name, u.rows(), u.cols(), episode.u.rows(), episode.u.cols()));
+
+  FreeRunTrajectory out;
+  out.model = model.name;
+  Matrix predicted(T, n);
+  predicted.row(0) = episode.x.row(0);
+  Vector x = episode.x.row(0).transpose(), next(n);
+  const auto workspace = phi.make_workspace();
+  for (Eigen::Index t = 0; t + 1 < T; ++t) {
+    phi.step(x, u.row(t).transpose(), next, nullptr, *workspace);
+    if (prediction_diverged(next)) {
+      out.diverged = true;
+      break;
+    }
+    x = next;
+    predicted.row(t + 1) = x.transpose();
+    ++out.steps;
+  }
+  out.predicted = predicted.topRows(out.steps + 1);
+  out.fit_percent = Vector::Zero(n);
+  if (out.steps > 0)
+    for (int i = 0; i < n; ++i)
+      out.fit_percent(i) = fit_percent(episode.x.col(i).segment(1, out.steps), out.predicted.col(i).tail(out.steps));
+  return out;
+}
+
+std::vector<FreeRunEpisode> free_run(const MeasurementSet& set, const std::vector<int>& episodes,
+                                     const std::vector<FreeRunModel>& models) {
+  std::vector<FreeRunEpisode> out;
+  for (int index : episodes) {
+    const Episode& e = set.episodes.at(static_cast<std::size_t>(index));
+    if (e.length() < 2) continue;
+    FreeRunEpisode run;
+    run.index = index;
+    run.id = e.id;
+    run.t = e.t;
+    run.measured = e.x;
+    for (const FreeRunModel& model : models) run.models.push_back(free_run(model, e));
+    out.push_back(std::move(run));
+  }
+  return out;
+}
+
+}  // namespace gpilqg::diagnosis
