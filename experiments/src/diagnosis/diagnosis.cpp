@@ -146,7 +146,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   R.model = o.model;
   Matrix residual = residual_before;
   for (const EffectRequest& request : o.add) {
-    const LibraryEffect& effect = find_effect(R.system, request.effect);
+    const LibraryEffect effect = find_candidate(R.model, request.effect);
     FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, floor_weights(data, residual_before, gp_before), residual};
     EffectFit fit = request.values ? score_effect(effect, *request.values, context) : fit_effect(effect, context);
     R.model = R.model.with(effect, fit.estimate);
@@ -225,7 +225,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     R.residual_after = R.residual;
     for (const EffectFit& f : R.added) R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + f.effect;
   } else if (R.verdict.status == "explained") {
-    proposed = R.model.with(find_effect(R.system, R.verdict.effect->effect), R.verdict.effect->estimate);
+    proposed = R.model.with(find_candidate(R.model, R.verdict.effect->effect), R.verdict.effect->estimate);
     R.model_next = proposed;
     with_effect = &proposed;
     base_gp = &R.gp;

@@ -306,7 +306,7 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_t
                                        const std::function<void(const std::string&)>& progress) {
   const SystemEntryPtr system = find_system(context.model.system);
   std::vector<EffectFit> fits;
-  const std::vector<LibraryEffect>& library = effect_library(context.model.system);
+  const std::vector<LibraryEffect> library = candidate_effects(context.model);
   for (const LibraryEffect& effect : library) {
     fits.push_back(fit_effect(effect, context));
     if (progress)
