@@ -1,5 +1,6 @@
 #include "gpilqg/core/effect_library.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -17,7 +18,54 @@ std::string joined_names(const std::vector<LibraryEffect>& library) {
   return out;
 }
 
+bool in_library(std::string_view system, std::string_view name) {
+  for (const LibraryEffect& e : effect_library(system))
+    if (e.name == name) return true;
+  return false;
+}
+
 }  // namespace
+
+LibraryEffect user_effect_entry(std::string_view system, const BasisForceDeclaration& declaration) {
+  for (const LibraryEffect& e : effect_library(system))
+    if (e.name == declaration.name)
+      throw DeclarationError("name", -1, fmt::format("'{}' is the name of the library effect '{}' ({}) of system '{}'; "
+                                                     "expected a name of its own",
+                                                     declaration.name, e.name, e.formula, system));
+  const SystemEntryPtr entry = find_system(system);
+  const DynamicsPtr probe = entry->build(Preset::Simulator, {}, {});
+  auto force = std::make_shared<const BasisForceEffect>(*probe, declaration);
+  LibraryEffect out;
+  out.name = force->name();
+  out.kind = EffectKind::Force;
+  out.parameters = force->parameters();
+  out.formula = force->formula();
+  out.linear = true;
+  out.force = std::move(force);
+  return out;
+}
+
+const BasisForceDeclaration* user_declaration(const LibraryEffect& effect) {
+  const auto* basis = dynamic_cast<const BasisForceEffect*>(effect.force.get());
+  return basis == nullptr ? nullptr : &basis->declaration();
+}
+
+std::vector<LibraryEffect> candidate_effects(const ModelSpec& model) {
+  std::vector<LibraryEffect> out = effect_library(model.system);
+  out.insert(out.end(), model.user_effects.begin(), model.user_effects.end());
+  return out;
+}
+
+std::string candidate_names(const ModelSpec& model) { return joined_names(candidate_effects(model)); }
+
+LibraryEffect find_candidate(const ModelSpec& model, std::string_view name) {
+  for (const LibraryEffect& e : effect_library(model.system))
+    if (e.name == name) return e;
+  for (const LibraryEffect& e : model.user_effects)
+    if (e.name == name) return e;
+  throw std::invalid_argument(fmt::format("unknown effect '{}' for system '{}'; expected one of: {}", name, model.system,
+                                          candidate_names(model)));
+}
 
 const std::vector<LibraryEffect>& effect_library(std::string_view system) {
   // Entries live as long as the process-wide registry, so the reference stays valid.
@@ -42,7 +90,7 @@ DynamicsPtr ModelSpec::build(const ActuatorNoise& noise) const {
   }
   std::vector<AppliedEffect> applied;
   for (const auto& [name, values] : forces) {
-    const LibraryEffect& e = find_effect(system, name);
+    const LibraryEffect e = find_candidate(*this, name);
     if (e.kind != EffectKind::Force)
       throw std::invalid_argument("effect '" + name + "' is not a force; set it through the gain or the parameters");
     applied.push_back({e.force, values});
@@ -90,6 +138,13 @@ ModelSpec ModelSpec::with(const LibraryEffect& effect, const VectorCRef& values)
           replaced = true;
         }
       if (!replaced) out.forces.emplace_back(effect.name, values);
+      if (!in_library(system, effect.name)) {
+        // A user effect: the model carries its declaration (the latest one of its name).
+        auto same = std::find_if(out.user_effects.begin(), out.user_effects.end(),
+                                 [&](const LibraryEffect& e) { return e.name == effect.name; });
+        if (same == out.user_effects.end()) out.user_effects.push_back(effect);
+        else *same = effect;
+      }
       break;
     }
     case EffectKind::ActuatorGain:
@@ -117,7 +172,7 @@ std::vector<std::string> ModelSpec::describe() const {
   if (actuator_gain != 1.0) lines.push_back(fmt::format("actuator_gain: k = {:.6g}", actuator_gain));
   if (input_delay != 0.0) lines.push_back(fmt::format("input_delay: d = {:.6g} steps", input_delay));
   for (const auto& [name, values] : forces) {
-    const LibraryEffect& e = find_effect(system, name);
+    const LibraryEffect e = find_candidate(*this, name);
     std::string text = name + ":";
     for (std::size_t i = 0; i < e.parameters.size(); ++i)
       text += fmt::format(" {} = {:.6g} {}", e.parameters[i].name, values(static_cast<Eigen::Index>(i)), e.parameters[i].unit);

@@ -301,6 +301,16 @@ void Quadrotor::generalised_force_map(const VectorCRef& x, Matrix& W, std::vecto
   for (auto& d : *d_dx) d.setZero(kStateDim, 6);
 }
 
+std::vector<GeneralisedCoordinate> Quadrotor::coordinates() const {
+  const char* axes[] = {"x", "y", "z"};
+  std::vector<GeneralisedCoordinate> out;
+  for (int i = 0; i < 3; ++i)
+    out.push_back({std::string("p") + axes[i], std::string("F_") + axes[i], i, kP + i, kV + i});
+  for (int i = 0; i < 3; ++i)
+    out.push_back({std::string("r") + axes[i], std::string("tau_") + axes[i], 3 + i, kR + i, kW + i});
+  return out;
+}
+
 void Quadrotor::input_matrix(const VectorCRef& x, const VectorCRef& u, InputMatrix& out) const {
   // b = f_u: column j is (0, R(r) e3 / m, 0, torque_j / J), independent of u. Only the thrust part
   // depends on x, through r: d b_j / dr = d(R e3)/dr / m, the same for all four columns; d b_j / du = 0.

@@ -66,6 +66,31 @@ TEST(PluginCli, HiddenDampingOfTheAcrobotIsFoundThroughThePlugin) {
   fs::remove_all(dir);
 }
 
+// A plugin system's coordinates follow the "Q_<c>" convention, so its users declare effects in a model
+// file too: a hidden torsion spring at the elbow, simulated from a model file as the world and found
+// when the diagnosis's model file declares it.
+TEST(PluginCli, AUserEffectOnAPluginSystemIsSimulatedAndFound) {
+  const fs::path dir = test::temporary_dir("plugin_user_effect");
+  const std::string declaration = "[model]\nsystem = \"acrobot\"\n\n[[user_effects]]\nname = \"elbow_spring\"\n"
+                                  "coordinate = \"theta2\"\nterms = [\"sin(q)\"]\nparameters = [\"k\"]\n";
+  std::ofstream(dir / "world.toml") << declaration << "\n[effects]\nelbow_spring = -0.4\n";
+  std::ofstream(dir / "user.toml") << declaration;
+  const fs::path data = dir / "acrobot.csv";
+  const std::string plugin = " --plugin " + quote(kAcrobot);
+  const auto simulated = test::run_cli("simulate" + plugin + " --system acrobot --world-model " + quote(dir / "world.toml") +
+                                       " --out " + quote(data));
+  ASSERT_EQ(simulated.status, 0) << simulated.err;
+  EXPECT_TRUE(contains(simulated.out, "acrobot model file")) << simulated.out;
+  const auto diagnosed = test::run_cli("diagnose" + plugin + " --system acrobot --data " + quote(data) + " --model " +
+                                       quote(dir / "user.toml") + " --json --gp-points 100 --gp-restarts 0");
+  ASSERT_EQ(diagnosed.status, 0) << diagnosed.err;
+  const json j = json::parse(diagnosed.out);
+  EXPECT_EQ(j["verdict"]["status"], "explained") << j["verdict"].dump();
+  EXPECT_EQ(j["verdict"]["effect"], "elbow_spring") << j["verdict"].dump();
+  EXPECT_NEAR(j["verdict"]["parameters"]["k"].get<double>(), -0.4, 0.15 * 0.4) << j["verdict"].dump();
+  fs::remove_all(dir);
+}
+
 TEST(PluginCli, OptionWorksBeforeTheCommandAndInNestedCommands) {
   const fs::path dir = test::temporary_dir("plugin_cli");
   const fs::path data = dir / "acrobot.csv";

@@ -132,9 +132,9 @@ int run_rollout(const RolloutOptions& o) {
   if (log.episodes.empty())
     throw std::runtime_error(fmt::format("every episode diverged at its first step; {} not written", o.out));
   write_measurements(o.out, log);
-  std::cout << fmt::format("wrote {}: {} episode(s) of the round-{} policy {} on {} ({} preset), {} rows, dt = {} s, seed {}\n",
+  std::cout << fmt::format("wrote {}: {} episode(s) of the round-{} policy {} on {} ({}), {} rows, dt = {} s, seed {}\n",
                            o.out, log.episodes.size(), policy.round, o.policy,
-                           o.world.world_file.empty() ? o.world.system : o.world.world_file, o.world.preset,
+                           o.world.world_file.empty() ? o.world.system : o.world.world_file, world_setting(o.world),
                            log.sample_count(), policy.dt, o.seed);
   if (!costs.empty()) {
     double mean = 0.0;

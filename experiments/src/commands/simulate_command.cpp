@@ -52,8 +52,8 @@ int run_simulate(const SimulateOptions& o) {
   SyntheticData data = simulate_measurements(system, settings);
   data.set.system = signature;
   write_measurements(o.out, data.set);
-  std::cout << fmt::format("wrote {}: {} {} preset, {} episodes, {} samples, dt = {} s, seed {}\n", o.out,
-                           o.world.system, o.world.preset, data.set.episodes.size(), data.set.sample_count(),
+  std::cout << fmt::format("wrote {}: {} {}, {} episodes, {} samples, dt = {} s, seed {}\n", o.out,
+                           o.world.system, world_setting(o.world), data.set.episodes.size(), data.set.sample_count(),
                            settings.dt, o.seed);
   if (data.truncated_episodes > 0)
     std::cout << fmt::format("note: {} episode(s) diverged and were cut at their last finite sample\n",

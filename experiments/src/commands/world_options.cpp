@@ -14,9 +14,13 @@ namespace gpilqg::cli {
 
 void add_world_options(CLI::App& cmd, WorldOptions& o) {
   cmd.add_option("--system", o.system, kSystemHelp)->required();
-  cmd.add_option("--world", o.world_file,
-                 "A second MuJoCo model file with the same joints and actuators to simulate instead of --system");
-  cmd.add_option("--preset", o.preset, "Parameter set: sim or real")->capture_default_str();
+  auto* world = cmd.add_option("--world", o.world_file,
+                               "A second MuJoCo model file with the same joints and actuators to simulate instead of --system");
+  auto* preset = cmd.add_option("--preset", o.preset, "Parameter set: sim or real")->capture_default_str();
+  cmd.add_option("--world-model", o.world_model,
+                 "A model file of `diagnose` (--model format: preset, parameters, effects, [[user_effects]]) as the world")
+      ->excludes(world)
+      ->excludes(preset);
   cmd.add_option("--param", o.parameters, "Override a physical parameter, NAME=VALUE (repeatable)");
   cmd.add_option("--effect", o.effects, "Add a physical effect of the library to the world, EFFECT=VALUE (repeatable)");
   cmd.add_option("--actuator-noise", o.actuator_noise,
@@ -56,6 +60,10 @@ Vector per_quantity(const std::vector<double>& values, int size, const std::stri
   return Eigen::Map<const Vector>(values.data(), size);
 }
 
+std::string world_setting(const WorldOptions& o) {
+  return o.world_model.empty() ? o.preset + " preset" : "model file " + o.world_model;
+}
+
 DynamicsPtr build_world(const WorldOptions& o, double* input_delay, const std::string& command) {
   const auto preset = parse_preset(o.preset);
   if (!preset) throw InputError("--preset '" + o.preset + "': expected 'sim' or 'real'");
@@ -73,11 +81,12 @@ DynamicsPtr build_world(const WorldOptions& o, double* input_delay, const std::s
     world.system = o.world_file;
   }
   world.preset = *preset;
-  world.parameters = parse_assignments(o.parameters, "--param");
+  if (!o.world_model.empty()) world = diagnosis::read_model_file(o.world_model, o.system);
+  for (const auto& [name, value] : parse_assignments(o.parameters, "--param")) world.parameters[name] = value;
   for (const std::string& text : o.effects) {
-    const diagnosis::EffectRequest request = diagnosis::parse_add_option(text, world.system, "--effect");
+    const diagnosis::EffectRequest request = diagnosis::parse_add_option(text, world, "--effect");
     if (!request.values) throw InputError("--effect '" + text + "': expected EFFECT=VALUE, e.g. cart_coulomb_friction=1");
-    world = world.with(find_effect(world.system, request.effect), *request.values);
+    world = world.with(find_candidate(world, request.effect), *request.values);
   }
   if (input_delay != nullptr) *input_delay = world.input_delay;
   else if (world.input_delay != 0.0)

@@ -1,8 +1,9 @@
 #pragma once
 /// @file world_options.hpp
 /// The simulated "real world" of `gpilqg simulate` and `gpilqg rollout`, from one set of options: a
-/// system's preset with parameter overrides and hidden effects of the library, or a second MuJoCo
-/// model file, with actuator noise. Per-quantity noise options take one value (every entry) or one
+/// system's preset with parameter overrides and hidden effects of the library, or a model file of the
+/// diagnosis (`--world-model F.toml`, model_file.hpp, with the effects its user declared), or a second
+/// MuJoCo model file, with actuator noise. Per-quantity noise options take one value (every entry) or one
 /// value per control or state, comma-separated.
 
 #include <map>
@@ -19,6 +20,7 @@ namespace gpilqg::cli {
 struct WorldOptions {
   std::string system;
   std::string world_file;
+  std::string world_model;              ///< a diagnosis model file (model_file.hpp), or empty
   std::string preset = "real";
   std::vector<std::string> parameters;  ///< NAME=VALUE
   std::vector<std::string> effects;     ///< EFFECT=VALUE
@@ -26,7 +28,8 @@ struct WorldOptions {
   std::vector<double> multiplicative_noise;  ///< std per control [1/sqrt(s)]
 };
 
-/// Adds --system, --world, --preset, --param, --effect, --actuator-noise and --multiplicative-noise.
+/// Adds --system, --world, --world-model, --preset, --param, --effect, --actuator-noise and
+/// --multiplicative-noise.
 void add_world_options(CLI::App& command, WorldOptions& options);
 
 /// "name=value" items of option `option` -> {name: value}; an InputError names the option and the text.
@@ -35,6 +38,9 @@ std::map<std::string, double> parse_assignments(const std::vector<std::string>& 
 /// A per-quantity option: empty -> `fallback`; one value -> that value `size` times; `size` values ->
 /// them. Negative entries or another count are an InputError naming the option.
 Vector per_quantity(const std::vector<double>& values, int size, const std::string& option, const Vector& fallback);
+
+/// How the world's parameters were chosen, for messages: "real preset" or "model file F.toml".
+std::string world_setting(const WorldOptions& options);
 
 /// The world's dynamics with its noise; the signature it must share is `system`'s (checked for --world).
 /// `input_delay` receives the world's input delay (--effect input_delay=D, control periods); a command

@@ -22,7 +22,7 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
     d.model.system = o.system;
     d.model.preset = *preset;
   }
-  for (const std::string& text : o.add) d.add.push_back(parse_add_option(text, o.system));
+  for (const std::string& text : o.add) d.add.push_back(parse_add_option(text, d.model));
   const auto integrator = parse_integrator(o.integrator);
   if (!integrator) throw InputError("--integrator '" + o.integrator + "': expected 'rk4' or 'euler'");
   d.integrator = *integrator;

@@ -154,12 +154,14 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   // Effects to add: given values first (kept as given), then the others fitted jointly on the training
   // episodes, together with the effects the model already has (refitted from their current values).
   R.model = o.model;
+  // The library and the model's declared effects; effects below point into it.
+  const std::vector<LibraryEffect> candidates = candidate_effects(o.model);
   Matrix residual = residual_before;
   const Vector weights_before = floor_weights(data, residual_before, gp_before);
   std::vector<const LibraryEffect*> to_fit;
   std::vector<std::string> given;
   for (const EffectRequest& request : o.add) {
-    const LibraryEffect& effect = find_effect(R.system, request.effect);
+    const LibraryEffect& effect = named(candidates, request.effect);
     if (!request.values) {
       to_fit.push_back(&effect);
       continue;
@@ -173,7 +175,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   if (!to_fit.empty()) {
     std::vector<RefitEffect> refit;
     for (std::size_t i = 1; i < to_fit.size(); ++i) refit.push_back({to_fit[i], R.model.current_values(*to_fit[i])});
-    for (const RefitEffect& r : model_effects(R.model)) {
+    for (const RefitEffect& r : model_effects(R.model, candidates)) {
       const bool requested = std::find(to_fit.begin(), to_fit.end(), r.effect) != to_fit.end();
       const bool kept = std::find(given.begin(), given.end(), r.effect->name) != given.end();
       if (!requested && !kept) refit.push_back(r);
@@ -181,7 +183,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual};
     const EffectFit joint = fit_jointly(*to_fit.front(), refit, context);
     R.model = R.model.with(*to_fit.front(), joint.estimate);
-    for (const EffectValues& v : joint.refitted) R.model = R.model.with(find_effect(R.system, v.effect), v.estimate);
+    for (const EffectValues& v : joint.refitted) R.model = R.model.with(named(candidates, v.effect), v.estimate);
     // One entry per requested effect, with the joint scores; the model's own effects as refitted values.
     EffectFit first = joint;
     first.refitted.clear();
@@ -255,7 +257,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
 
   // 3. Which: one effect (the verdict), or several by forward selection (--auto).
   const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual};
-  const std::vector<RefitEffect> present = o.auto_select ? model_effects(R.model) : std::vector<RefitEffect>{};
+  const std::vector<RefitEffect> present = o.auto_select ? model_effects(R.model, candidates) : std::vector<RefitEffect>{};
   if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_threshold, o.progress, present, o.gp.threads);
   // The GP sees (x_t, u_t) only: the residual of an effect of the input history (input_delay) looks
   // like noise to it. An effect that removes a large and significant share of the held-out residual
@@ -299,7 +301,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     for (const SelectionStep& s : R.selection->steps)
       R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + s.fit.effect;
   } else if (R.verdict.status == "explained") {
-    proposed = R.model.with(find_effect(R.system, R.verdict.effect->effect), R.verdict.effect->estimate);
+    proposed = R.model.with(named(candidates, R.verdict.effect->effect), R.verdict.effect->estimate);
     R.model_next = proposed;
     with_effect = &proposed;
     base_gp = &R.gp;

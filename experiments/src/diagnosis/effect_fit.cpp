@@ -388,7 +388,8 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_t
   const SystemEntryPtr system = find_system(context.model.system);
   // Candidates: the library without the effects being refitted and their declared aliases.
   std::vector<const LibraryEffect*> candidates;
-  for (const LibraryEffect& effect : effect_library(context.model.system)) {
+  const std::vector<LibraryEffect> library = candidate_effects(context.model);
+  for (const LibraryEffect& effect : library) {
     bool chosen = false;
     for (const RefitEffect& r : refit)
       chosen = chosen || r.effect->name == effect.name || same_physics(*system, r.effect->name, effect.name);

@@ -6,9 +6,15 @@
 
 namespace gpilqg::diagnosis {
 
-std::vector<RefitEffect> model_effects(const ModelSpec& model) {
+const LibraryEffect& named(const std::vector<LibraryEffect>& candidates, std::string_view name) {
+  for (const LibraryEffect& effect : candidates)
+    if (effect.name == name) return effect;
+  throw std::invalid_argument("no candidate effect is called '" + std::string(name) + "'");
+}
+
+std::vector<RefitEffect> model_effects(const ModelSpec& model, const std::vector<LibraryEffect>& candidates) {
   std::vector<RefitEffect> out;
-  for (const LibraryEffect& effect : effect_library(model.system)) {
+  for (const LibraryEffect& effect : candidates) {
     bool present = false;
     switch (effect.kind) {
       case EffectKind::Force:
@@ -32,9 +38,9 @@ std::vector<RefitEffect> model_effects(const ModelSpec& model) {
 namespace {
 
 /// M_0 with the effect of `fit` and those it refitted at their joint estimates.
-ModelSpec model_after(const ModelSpec& base, const EffectFit& fit) {
-  ModelSpec model = base.with(find_effect(base.system, fit.effect), fit.estimate);
-  for (const EffectValues& v : fit.refitted) model = model.with(find_effect(base.system, v.effect), v.estimate);
+ModelSpec model_after(const ModelSpec& base, const EffectFit& fit, const std::vector<LibraryEffect>& candidates) {
+  ModelSpec model = base.with(named(candidates, fit.effect), fit.estimate);
+  for (const EffectValues& v : fit.refitted) model = model.with(named(candidates, v.effect), v.estimate);
   return model;
 }
 
@@ -48,15 +54,15 @@ bool interval_contains(const EffectValues& v, const Vector& value) {
 /// longer needed: a later effect explains what it had soaked up. It is dropped and the others are
 /// refitted jointly, until none is left to drop. Effects M_0 had already are never dropped.
 EffectFit without_redundant(EffectFit fit, const FitContext& context, const FitContext& step_context,
-                            std::vector<std::string>& removed) {
-  const std::vector<RefitEffect> given = model_effects(context.model);
+                            const std::vector<LibraryEffect>& candidates, std::vector<std::string>& removed) {
+  const std::vector<RefitEffect> given = model_effects(context.model, candidates);
   const auto in_m0 = [&](const std::string& name) {
     return std::any_of(given.begin(), given.end(), [&](const RefitEffect& r) { return r.effect->name == name; });
   };
   for (;;) {
     const LibraryEffect* drop = nullptr;
     for (const EffectValues& v : fit.refitted) {
-      const LibraryEffect& effect = find_effect(context.model.system, v.effect);
+      const LibraryEffect& effect = named(candidates, v.effect);
       if (!in_m0(v.effect) && interval_contains(v, context.model.current_values(effect))) {
         drop = &effect;
         break;
@@ -66,8 +72,8 @@ EffectFit without_redundant(EffectFit fit, const FitContext& context, const FitC
     removed.push_back(drop->name);
     std::vector<RefitEffect> keep;
     for (const EffectValues& v : fit.refitted)
-      if (v.effect != drop->name) keep.push_back({&find_effect(context.model.system, v.effect), v.estimate});
-    fit = fit_jointly(find_effect(context.model.system, fit.effect), keep, step_context, fit.estimate);
+      if (v.effect != drop->name) keep.push_back({&named(candidates, v.effect), v.estimate});
+    fit = fit_jointly(named(candidates, fit.effect), keep, step_context, fit.estimate);
   }
 }
 
@@ -77,7 +83,8 @@ Selection select_effects(const FitContext& context, const SelectionOptions& o, s
   if (context.data == nullptr) throw std::invalid_argument("select_effects: no data");
   Selection S;
   S.model = context.model;
-  std::vector<RefitEffect> chosen = model_effects(context.model);
+  const std::vector<LibraryEffect> candidates = candidate_effects(context.model);
+  std::vector<RefitEffect> chosen = model_effects(context.model, candidates);
   FitContext step_context = context;  // model stays M_0; residual becomes M_{k-1}'s
   for (int k = 1;; ++k) {
     if (k > o.max_steps) {
@@ -101,8 +108,8 @@ Selection select_effects(const FitContext& context, const SelectionOptions& o, s
       S.rejected = std::move(ranking);
       break;
     }
-    const EffectFit added = without_redundant(best, context, step_context, removed);
-    SelectionStep step{added, model_after(context.model, added), std::move(ranking), removed};
+    const EffectFit added = without_redundant(best, context, step_context, candidates, removed);
+    SelectionStep step{added, model_after(context.model, added, candidates), std::move(ranking), removed};
     if (o.progress) o.progress(fmt::format("step {}: added {} ({:.1f}% of the held-out residual left)", k, added.effect,
                                            100.0 * added.explained));
     // The chosen effects and their new starts, in the order they were chosen.
@@ -110,7 +117,7 @@ Selection select_effects(const FitContext& context, const SelectionOptions& o, s
     for (const RefitEffect& r : chosen)
       for (const EffectValues& v : added.refitted)
         if (v.effect == r.effect->name) next.push_back({r.effect, v.estimate});
-    next.push_back({&find_effect(context.model.system, added.effect), added.estimate});
+    next.push_back({&named(candidates, added.effect), added.estimate});
     chosen = std::move(next);
     step_context.residual = context.data->x_next - model_predictions(step.model, context);
     S.model = step.model;

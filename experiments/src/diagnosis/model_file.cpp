@@ -2,12 +2,14 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
+#include "user_effects_file.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -35,7 +37,7 @@ void check_values(const ModelSpec& model, const LibraryEffect& effect, const Vec
 ModelSpec read_model_file(const std::filesystem::path& file, const std::string& system) {
   const toml::table root = TomlFields::parse(file);
   const TomlFields fields(root, file);
-  fields.only_keys("", {"model", "parameters", "effects"});
+  fields.only_keys("", {"model", "parameters", "user_effects", "effects"});
   fields.require_section("model");
   fields.only_keys("model", {"system", "preset"});
   ModelSpec model;
@@ -70,16 +72,18 @@ ModelSpec read_model_file(const std::filesystem::path& file, const std::string& 
   } else if (fields.has("parameters")) {
     fields.fail("parameters", "is not a table; expected [parameters] with name = value entries");
   }
+  model.user_effects = read_user_effects(root, file, system);
 
   if (const toml::table* effects = root["effects"].as_table()) {
     for (const auto& [key, node] : *effects) {
       const std::string name(key.str());
       const std::string path = "effects." + toml_key(name);
-      const LibraryEffect* effect = nullptr;
+      std::optional<LibraryEffect> effect;
       try {
-        effect = &find_effect(system, name);
+        effect = find_candidate(model, name);
       } catch (const std::invalid_argument&) {
-        fields.fail(path, fmt::format("unknown effect '{}'; expected one of: {}", name, effect_names(system)));
+        fields.fail(path, fmt::format("unknown effect '{}'; expected one of: {} (or a name of [[user_effects]])", name,
+                                      candidate_names(model)));
       }
       Vector values(static_cast<Eigen::Index>(effect->parameters.size()));
       if (node.is_table()) {
@@ -111,12 +115,13 @@ std::string model_file_text(const ModelSpec& model, const std::vector<std::strin
     out += "\n[parameters]\n";
     for (const auto& [name, value] : model.parameters) out += fmt::format("{} = {}\n", toml_key(name), value);
   }
+  out += user_effects_text(model);
   if (model.actuator_gain != 1.0 || model.input_delay != 0.0 || !model.forces.empty()) {
     out += "\n[effects]\n";
     if (model.actuator_gain != 1.0) out += fmt::format("actuator_gain = {}\n", model.actuator_gain);
     if (model.input_delay != 0.0) out += fmt::format("input_delay = {}   # control periods\n", model.input_delay);
     for (const auto& [name, values] : model.forces) {
-      const LibraryEffect& effect = find_effect(model.system, name);
+      const LibraryEffect effect = find_candidate(model, name);
       std::string table;
       for (std::size_t i = 0; i < effect.parameters.size(); ++i)
         table += fmt::format("{}{} = {}", i == 0 ? "" : ", ", effect.parameters[i].name, values(static_cast<Eigen::Index>(i)));
@@ -131,14 +136,21 @@ void write_model_file(const std::filesystem::path& file, const ModelSpec& model,
 }
 
 EffectRequest parse_add_option(const std::string& text, const std::string& system, const std::string& option) {
+  ModelSpec model;
+  model.system = system;
+  return parse_add_option(text, model, option);
+}
+
+EffectRequest parse_add_option(const std::string& text, const ModelSpec& model, const std::string& option) {
+  const std::string& system = model.system;
   const auto eq = text.find('=');
   EffectRequest request;
   request.effect = text.substr(0, eq);
-  const LibraryEffect* effect = nullptr;
+  std::optional<LibraryEffect> effect;
   try {
-    effect = &find_effect(system, request.effect);
+    effect = find_candidate(model, request.effect);
   } catch (const std::invalid_argument&) {
-    throw InputError(fmt::format("{} '{}': unknown effect '{}' for system '{}'; expected EFFECT or EFFECT=VALUE with EFFECT one of: {}", option, text, request.effect, system, effect_names(system)));
+    throw InputError(fmt::format("{} '{}': unknown effect '{}' for system '{}'; expected EFFECT or EFFECT=VALUE with EFFECT one of: {}", option, text, request.effect, system, candidate_names(model)));
   }
   if (eq == std::string::npos) return request;
   const std::string value_text = text.substr(eq + 1);
@@ -156,8 +168,7 @@ EffectRequest parse_add_option(const std::string& text, const std::string& syste
   if (!std::isfinite(value))
     throw InputError(fmt::format("{} '{}': the value is not finite; expected a finite number", option, text));
   request.values = Vector::Constant(1, value);
-  ModelSpec probe;
-  probe.system = system;
+  const ModelSpec& probe = model;
   try {
     static_cast<void>(probe.with(*effect, *request.values));
   } catch (const std::invalid_argument& e) {

@@ -20,6 +20,10 @@
 /// The cart-pole friction and damping effects apply to the cart-pole only; the quadrotor's external
 /// forces act at the centre of mass in the world frame. `param:<name>` exists for every physical
 /// parameter of the system except gravity.
+///
+/// Beside the library, a model carries the effects its user declared (ModelSpec::user_effects, the
+/// model file's [[user_effects]]): basis forces on one coordinate (basis_force.hpp). The diagnosis fits,
+/// ranks and adds the model's candidates, candidate_effects(model): the library, then those.
 
 #include <map>
 #include <string>
@@ -27,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "gpilqg/core/basis_force.hpp"
 #include "gpilqg/core/effects.hpp"
 #include "gpilqg/core/systems.hpp"
 
@@ -64,14 +69,26 @@ const LibraryEffect& find_effect(std::string_view system, std::string_view name)
 /// The names of effect_library(system), comma-separated, for error messages.
 std::string effect_names(std::string_view system);
 
+/// The library entry (kind Force, linear) of a force the user declares for `system` (a BasisForceEffect).
+/// Throws DeclarationError (basis_force.hpp) for an invalid declaration, and with field "name" when
+/// the name is one of the library's (naming it and its formula), or the system has no generalised-force map.
+LibraryEffect user_effect_entry(std::string_view system, const BasisForceDeclaration& declaration);
+
+/// The declaration of a user-declared effect, or null for any other effect.
+const BasisForceDeclaration* user_declaration(const LibraryEffect& effect);
+
 /// A model to compare with measurements: the preset's system with recalibrated parameters, an
-/// actuator gain, and force effects of the library with their parameter values.
+/// actuator gain, force effects of the library or declared by the user with their parameter values,
+/// and the user-declared effects the diagnosis may add.
 struct ModelSpec {
   std::string system = "cartpole";
   Preset preset = Preset::Simulator;
   std::map<std::string, double> parameters;        ///< recalibrations: name -> value (overrides the preset)
   double actuator_gain = 1.0;                      ///< k
-  std::vector<std::pair<std::string, Vector>> forces;  ///< library force effects -> parameter values, in order
+  std::vector<std::pair<std::string, Vector>> forces;  ///< force effects (library or user) -> parameter values, in order
+  /// Effects the user declared (user_effect_entry), in declaration order, whether or not `forces` uses
+  /// them: candidates of the diagnosis beside the library. Names differ from the library's and each other's.
+  std::vector<LibraryEffect> user_effects;
   /// d [control periods]: the applied input is u(t - d). Not part of the Dynamics (which maps the
   /// applied input to xdot): whoever drives the model with measured or commanded inputs applies it
   /// (delay_controls, input_delay.hpp): the diagnosis's predictions, the simulated world.
@@ -88,13 +105,25 @@ struct ModelSpec {
   Vector current_values(const LibraryEffect& effect) const;
 
   /// This model with `effect` at `values` (a force replaces its previous values, the gain and a
-  /// parameter are set). Throws std::invalid_argument for a wrong number of values, a non-finite
-  /// value or one outside the parameter's physical bounds.
+  /// parameter are set). A force that is not in the system's library is a user effect: it is added to
+  /// user_effects (or replaces the one of its name). Throws std::invalid_argument for a wrong number of
+  /// values, a non-finite value or one outside the parameter's physical bounds.
   ModelSpec with(const LibraryEffect& effect, const VectorCRef& values) const;
 
   /// One line per difference from the preset, e.g. "cart_coulomb_friction: mu = 1.98 N"; empty for
   /// the bare preset.
   std::vector<std::string> describe() const;
 };
+
+/// The candidates the diagnosis fits for `model` (ranking, --add, forward selection): the system's
+/// library (effect_library), then the model's user effects in declaration order.
+std::vector<LibraryEffect> candidate_effects(const ModelSpec& model);
+
+/// The candidate of `model` called `name` (a copy: it stays valid when the model changes). Throws
+/// std::invalid_argument naming `name` and the system and listing every candidate's name.
+LibraryEffect find_candidate(const ModelSpec& model, std::string_view name);
+
+/// The names of candidate_effects(model), comma-separated, for error messages.
+std::string candidate_names(const ModelSpec& model);
 
 }  // namespace gpilqg

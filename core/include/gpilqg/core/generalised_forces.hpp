@@ -7,7 +7,13 @@
 /// which in first-order form adds W(x) Q to the state derivative: xdot = f(x, u) + W(x) Q, with
 /// W = [0; M^-1] laid out on the velocity rows. This is how the physical-effects library
 /// (effects.hpp) adds friction, drag and external forces to a system without knowing its equations.
+///
+/// Each force component Q_k acts on one generalised coordinate q_k, with position x(position) and
+/// velocity x(velocity) in the state (GeneralisedCoordinate). User-declared effects (basis_force.hpp)
+/// name a coordinate and are functions of (q_k, q_dot_k, u).
 
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "gpilqg/core/dynamics.hpp"
@@ -15,6 +21,15 @@
 #include "gpilqg/core/types.hpp"
 
 namespace gpilqg {
+
+/// The generalised coordinate that one force component acts on.
+struct GeneralisedCoordinate {
+  std::string name;   ///< e.g. "x", "theta", a MuJoCo joint's name, the quadrotor's "px" or "rx"
+  std::string force;  ///< the force component's name, e.g. "Q_x", "F_x", "tau_x"
+  int component = 0;  ///< index of the component in generalised_forces()
+  int position = 0;   ///< state index of q
+  int velocity = 0;   ///< state index of q_dot
+};
 
 class GeneralisedForceInput {
  public:
@@ -32,6 +47,23 @@ class GeneralisedForceInput {
                                      DynamicsWorkspace&) const {
     generalised_force_map(x, W, d_dx);
   }
+
+  /// The coordinates the force components act on, for systems whose components do not follow the
+  /// naming convention of generalised_coordinates() (the quadrotor: F_x acts on px and vx, tau_x on
+  /// rx and wx). Empty by default: the convention applies.
+  virtual std::vector<GeneralisedCoordinate> coordinates() const { return {}; }
 };
+
+/// The generalised coordinates of `system`, in the order of its force components: its own
+/// GeneralisedForceInput::coordinates() when not empty, else by the naming convention the built-in
+/// cart-pole, MuJoCo models and the example plugin share: the component "Q_<c>" acts on the
+/// coordinate "<c>" with the states "<c>" (q) and "<c>_dot" (q_dot). Components without such states
+/// have no coordinate and are left out. Empty when the system has no generalised-force map.
+std::vector<GeneralisedCoordinate> generalised_coordinates(const Dynamics& system);
+
+/// The coordinate of `system` called `name` (its coordinate name, e.g. "x", or its force component's,
+/// e.g. "Q_x"). Throws std::invalid_argument naming `name` and listing the valid names (or saying that
+/// the system has no generalised-force map).
+GeneralisedCoordinate find_coordinate(const Dynamics& system, std::string_view name);
 
 }  // namespace gpilqg

@@ -40,6 +40,10 @@ inline constexpr long kMaxInducing = 10'000;
 inline constexpr long kMaxFrequencies = 4'096;
 /// Neighbours per point of the compact-support GP's sparse kernel matrix.
 inline constexpr long kMaxNeighbours = 10'000;
+/// Effects a model file declares ([[user_effects]]): each is a candidate the diagnosis fits.
+inline constexpr long kMaxUserEffects = 1'000;
+/// Terms of one declared effect (its parameters, fitted together).
+inline constexpr long kMaxBasisTerms = 100;
 /// Worker threads of one command.
 inline constexpr long kMaxThreads = 1'024;
 /// Memory a command may plan to use for the arrays whose size the user controls (horizons x state

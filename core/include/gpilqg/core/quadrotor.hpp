@@ -70,6 +70,10 @@ class Quadrotor final : public Dynamics, public GeneralisedForceInput {
   /// tau / inertia, so W = [0; I/m; 0; I/inertia] (12 x 6) is constant and every dW/dx_j is zero.
   const std::vector<Quantity>& generalised_forces() const override;
   void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const override;
+  /// F_x, F_y, F_z act on the coordinates px, py, pz (q = p_i, q_dot = v_i); tau_x, tau_y, tau_z on
+  /// rx, ry, rz (q = r_i, the rotation vector's component, q_dot = w_i, the body rate: r_dot = w only
+  /// near r = 0).
+  std::vector<GeneralisedCoordinate> coordinates() const override;
 
  private:
   QuadrotorParameters p_;

@@ -31,6 +31,7 @@
 /// effects whose contribution is real but negligible out of the model.
 
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -38,9 +39,15 @@
 
 namespace gpilqg::diagnosis {
 
-/// The effects `model` has beyond its preset, at their current values: its forces (in order), the
-/// actuator gain when it is not 1, its recalibrated parameters. These are refitted with a new effect.
-std::vector<RefitEffect> model_effects(const ModelSpec& model);
+/// The effect of `candidates` (candidate_effects of a model) called `name`; std::invalid_argument
+/// when there is none.
+const LibraryEffect& named(const std::vector<LibraryEffect>& candidates, std::string_view name);
+
+/// The effects `model` has beyond its preset, at their current values: its forces (library and
+/// user-declared), the actuator gain when it is not 1, its recalibrated parameters, its input delay.
+/// These are refitted with a new effect. The pointers point into `candidates`, which must hold
+/// candidate_effects(model) (or a superset) and outlive the result.
+std::vector<RefitEffect> model_effects(const ModelSpec& model, const std::vector<LibraryEffect>& candidates);
 
 struct SelectionOptions {
   double alias_threshold = 0.95;
