@@ -162,7 +162,7 @@ TEST(Effects, LibraryHoldsTheFixedNames) {
                                                          "external_force_x", "quadratic_drag", "actuator_gain",
                                                          "param:cart_mass", "param:pole_mass", "param:pole_length"}));
   EXPECT_EQ(names("quadrotor"), (std::vector<std::string>{"external_force_x", "external_force_y", "external_force_z",
-                                                          "quadratic_drag", "actuator_gain", "param:mass", "param:kv",
+                                                          "quadratic_drag", "actuator_gain", "input_delay", "param:mass", "param:kv",
                                                           "param:km", "param:inertia", "param:rho"}));
 }
 
