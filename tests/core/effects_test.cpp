@@ -160,10 +160,11 @@ TEST(Effects, LibraryHoldsTheFixedNames) {
   EXPECT_EQ(names("cartpole"), (std::vector<std::string>{"cart_viscous_friction", "cart_coulomb_friction",
                                                          "pole_viscous_damping", "pole_coulomb_friction",
                                                          "external_force_x", "quadratic_drag", "actuator_gain",
-                                                         "param:cart_mass", "param:pole_mass", "param:pole_length"}));
+                                                         "input_delay", "param:cart_mass", "param:pole_mass",
+                                                         "param:pole_length"}));
   EXPECT_EQ(names("quadrotor"), (std::vector<std::string>{"external_force_x", "external_force_y", "external_force_z",
-                                                          "quadratic_drag", "actuator_gain", "input_delay", "param:mass", "param:kv",
-                                                          "param:km", "param:inertia", "param:rho"}));
+                                                          "quadratic_drag", "actuator_gain", "input_delay", "param:mass",
+                                                          "param:kv", "param:km", "param:inertia", "param:rho"}));
 }
 
 TEST(Effects, BadInputNamesTheProblemAndTheChoices) {
