@@ -7,6 +7,7 @@
 #include <random>
 #include <sstream>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace gpilqg::test {
 
@@ -20,7 +21,21 @@ std::filesystem::path temporary_dir(const std::string& label) {
   if (info != nullptr) name += std::string("_") + info->test_suite_name() + "_" + info->name();
   for (char& c : name)
     if (c == '/') c = '_';
-  auto dir = std::filesystem::temp_directory_path() / "gpilqg_tests" / name;
+  // One folder per test process, so that test programs running at the same time (ctest -j, two
+  // builds on one machine) never write into each other's files; folders of processes that no longer
+  // run are removed the first time.
+  const auto root = std::filesystem::temp_directory_path() / "gpilqg_tests";
+  static const bool cleaned = [&root] {
+    std::error_code ignored;
+    for (const auto& entry : std::filesystem::directory_iterator(root, ignored)) {
+      const std::string pid = entry.path().filename().string();
+      if (pid.find_first_not_of("0123456789") == std::string::npos && !std::filesystem::exists("/proc/" + pid))
+        std::filesystem::remove_all(entry.path(), ignored);
+    }
+    return true;
+  }();
+  static_cast<void>(cleaned);
+  auto dir = root / std::to_string(::getpid()) / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

@@ -19,7 +19,8 @@ std::filesystem::path reference_dir();
 std::filesystem::path data_dir();
 /// The repository root.
 std::filesystem::path source_dir();
-/// A fresh empty temporary folder for one test, removed by the caller or left for inspection.
+/// A fresh empty temporary folder for one test, <tmp>/gpilqg_tests/<pid>/<label>_<suite>_<test>: left
+/// for inspection, removed by the first test of a later process once this one has ended.
 std::filesystem::path temporary_dir(const std::string& label);
 
 /// Reads a headerless numeric CSV (as in tests/reference) into a matrix.
