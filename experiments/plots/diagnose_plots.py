@@ -7,6 +7,7 @@ writes PNG files into a folder:
   ranking.png                explained fraction of every effect with its 95% interval (and the parameter)
   residual_vs_input.png      residual against its most relevant input, before and after the effect
   residual_whiteness.png     autocorrelation of the held-out residual per state with the 95% band
+  selection_path.png         --auto: held-out RMSE / noise floor per state after each added effect
   free_run.png               measured states against the free-run simulations (sim, sim+effect,
                              sim+GP) of the first held-out episodes, fit % in the legend (MATLAB `compare`)
 
@@ -244,6 +245,45 @@ def free_run(f, out, states, shown, episodes=3):
     plt.close(fig)
 
 
+def selection_path(f, out, states):
+    """--auto: what each step of the forward selection bought, in units of the noise floor."""
+    g = f["selection"]
+    effects = names(g.attrs["effect"])
+    rmse = g["heldout_rmse"][()]  # (steps + 1) x n
+    floor = np.maximum(f["compare/states"]["noise_floor"][()], 1e-300)
+    ratio = rmse / floor
+    moved = [i for i in range(len(states)) if ratio[0, i] > 1.05 or ratio[-1, i] > 1.05] or list(range(len(states)))
+    fig, ax = plt.subplots(figsize=(max(6, 1.9 * len(effects) + 3), 4.2))
+    steps = np.arange(len(effects) + 1)
+    for i in moved:
+        ax.plot(steps, ratio[:, i], marker="o", label=states[i])
+    ax.axhline(1.0, color="k", lw=1, ls="--", label="noise floor")
+    labels = ["as given"]
+    for k, effect in enumerate(effects):
+        step = g[f"step_{k + 1}"]
+        value = step["estimate"][0]
+        label = f"+ {effect}\n{names(step.attrs['parameter_name'])[0].split('.')[-1]} = {value:.3g}"
+        label += f"\n{100 * g['explained'][k]:.0f}% of the rest, z = {g['z_score'][k]:.0f}"
+        if "removed" in step.attrs:
+            label += "\n- " + ", ".join(names(step.attrs["removed"]))
+        labels.append(label)
+    ax.set_xticks(steps)
+    ax.set_xticklabels(labels, fontsize=7)
+    ax.set_yscale("log")
+    ax.set_ylabel("held-out RMSE / noise floor")
+    final = g[f"step_{len(effects)}"] if effects else None
+    title = "Effects added one at a time, all refitted jointly (--auto)"
+    if final is not None:
+        values = ", ".join(f"{n} = {v:.3g}" for n, v in zip(names(final.attrs["parameter_name"]), final["estimate"][()]))
+        title += f"\nfinal joint values: {values}"
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=7, loc="upper right")
+    fig.text(0.01, 0.01, "stop: " + text(g.attrs["stop_reason"]), fontsize=6.5, wrap=True)
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    fig.savefig(os.path.join(out, "selection_path.png"), dpi=110)
+    plt.close(fig)
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit("usage: diagnose_plots.py REPORT.h5 OUT_DIR")
@@ -263,6 +303,9 @@ def main():
         count = 4
         if "whiteness" in f:
             residual_whiteness(f, out, states)
+            count += 1
+        if "selection" in f and "effect" in f["selection"].attrs:
+            selection_path(f, out, states)
             count += 1
         if "free_run" in f:  # every state up to 6 (the worst ones first beyond that)
             free_run(f, out, states, sorted(worst_states(f, min(6, len(states)))))
