@@ -179,6 +179,20 @@ def test_diagnose_equals_the_command_lines_json():
         gpilqg.diagnose("cartpole", data, heldout=1.5)
 
 
+def test_diagnose_auto_equals_the_command_lines_selection(tmp_path):
+    data = tmp_path / "two.csv"
+    status, _, err = cli("simulate", "--system", "cartpole", "--preset", "sim", "--effect", "cart_coulomb_friction=1.5",
+                         "--effect", "external_force_x=0.8", "--out", data)
+    assert status == 0, err
+    status, out, err = cli("diagnose", "--system", "cartpole", "--data", data, "--auto", "--horizons", "1,5", "--json")
+    assert status == 0, err
+    expected = json.loads(out)
+    report = gpilqg.diagnose("cartpole", data, auto=True, horizons=[1, 5])
+    assert report["selection"] == expected["selection"]
+    assert sorted(step["effect"] for step in report["selection"]["steps"]) == ["cart_coulomb_friction", "external_force_x"]
+    assert [k["k"] for k in report["k_step"]] == [1, 5]
+
+
 def test_diagnose_a_python_system_finds_its_missing_parameter(tmp_path, python_cartpole):
     # Data of the C++ cart-pole's real preset (pole 1.3 m); the Python cart-pole's sim preset has 1 m.
     status, _, err = cli("simulate", "--system", "cartpole", "--preset", "real", "--episodes", "6", "--steps", "150",
