@@ -27,7 +27,8 @@ void DiagnosisOptions::validate() const {
   require(bins >= 1 && max_lag >= 0, "'bins' must be >= 1 and 'max_lag' >= 0");
   require(alias_threshold > 0.0 && alias_threshold <= 1.0, "'alias_threshold' must be in (0, 1]");
   require(structure_threshold >= 0.0 && floor_tolerance >= 1.0, "'structure_threshold' >= 0, 'floor_tolerance' >= 1");
-  require(min_explained >= 0.0 && min_z >= 0.0 && relative_to_gp >= 0.0, "thresholds must be >= 0");
+  require(min_explained >= 0.0 && min_step_explained >= 0.0 && min_z >= 0.0 && relative_to_gp >= 0.0,
+          "thresholds must be >= 0");
 }
 
 namespace {
@@ -269,7 +270,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   if (o.auto_select && !R.model_diverges) {
     SelectionOptions so;
     so.alias_threshold = o.alias_threshold;
-    so.min_explained = o.min_explained;
+    so.min_explained = o.min_step_explained;
     so.min_z = o.min_z;
     so.threads = o.gp.threads;
     so.progress = o.progress;

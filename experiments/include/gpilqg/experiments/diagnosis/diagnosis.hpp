@@ -81,6 +81,11 @@ struct DiagnosisOptions {
   /// --auto: add several effects by forward selection with joint refits (effect_selection.hpp); the
   /// final model becomes model_next.
   bool auto_select = false;
+  /// --auto: a step after the first adds its effect when it removes at least this share of the held-out
+  /// residual left (and z >= min_z). Lower than min_explained: once the large effects are in, a real one
+  /// can be a small share of a remainder that noise dominates; z is the test, this only keeps
+  /// negligible effects out.
+  double min_step_explained = 0.05;
   /// Optional: one line after the residual GP and after every fitted effect; it may throw to stop.
   std::function<void(const std::string&)> progress;
   /// Throws std::invalid_argument naming the field.

@@ -11,8 +11,10 @@
 ///  2. each joint fit is scored on the held-out episodes against M_{k-1}: the fraction of M_{k-1}'s
 ///     weighted held-out squared residual it removes, "explained", and its z score from batch means of
 ///     the per-sample reduction (effect_fit.hpp, step 4);
-///  3. the candidate with the largest held-out reduction is added when it is significant and large,
-///     z >= min_z and explained >= min_explained (the single-effect verdict's thresholds, 3 and 10%);
+///  3. the candidate with the largest held-out reduction is added when it is significant and not
+///     negligible, z >= min_z (3, the verdict's) and explained >= min_explained (5%: once the large
+///     effects are in, a real one can be a small share of a remainder that noise dominates). Step 1 is
+///     the verdict (10%, and half of what the GP explains);
 ///     M_k is then M_0 with the chosen effects at their joint estimates. Otherwise selection stops;
 ///  4. a backward check: an effect chosen at an earlier step whose joint 95% interval now contains its
 ///     value in M_0 (a force of 0, a gain of 1, the preset's parameter, no delay) is dropped and the
@@ -27,7 +29,7 @@
 /// (a missing effect makes them so), and the effective sample size is unknown, so the penalty is
 /// uncalibrated and a spurious effect gets in on long records. Held-out whole episodes penalise
 /// complexity directly: an effect that fits the training noise does not lower the held-out error. The
-/// batch-means z score accounts for the serial correlation that remains, and explained >= 10% keeps
+/// batch-means z score accounts for the serial correlation that remains, and explained >= 5% keeps
 /// effects whose contribution is real but negligible out of the model.
 
 #include <string>
@@ -51,7 +53,7 @@ std::vector<RefitEffect> model_effects(const ModelSpec& model, const std::vector
 
 struct SelectionOptions {
   double alias_threshold = 0.95;
-  double min_explained = 0.1;   ///< step 3: explained >= this ...
+  double min_explained = 0.05;  ///< step 3: explained >= this ...
   double min_z = 3.0;           ///< ... and z >= this
   int max_steps = 10;           ///< at most this many effects
   int threads = 1;              ///< candidates fitted at once
