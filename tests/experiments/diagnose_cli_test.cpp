@@ -11,6 +11,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <set>
 
 #include "diagnosis_support.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -294,6 +295,41 @@ TEST(DiagnosisPieces, ModelFileRoundTrips) {
   ASSERT_TRUE(request.values.has_value());
   EXPECT_EQ((*request.values)(0), 0.25);
   EXPECT_FALSE(diagnosis::parse_add_option("quadratic_drag", "cartpole").values.has_value());
+}
+
+}  // namespace
+}  // namespace gpilqg
+
+namespace gpilqg {
+namespace {
+
+// `--auto` through the command line: the path in the JSON and the HDF5 report, the final model written by
+// --write-model with every effect found, its plot.
+TEST(DiagnoseCli, AutoFindsTwoEffectsWritesTheFinalModelAndPlotsThePath) {
+  const fs::path dir = test::temporary_dir("diagnose_auto");
+  const fs::path data = dir / "two.csv", model = dir / "model.toml", report = dir / "report.h5";
+  ASSERT_EQ(test::run_cli("simulate --system cartpole --preset sim --effect cart_coulomb_friction=1.5 --effect "
+                          "external_force_x=0.8 --episodes 8 --steps 150 --out " + quote(data)).status, 0);
+  const bool plots = std::system("/usr/bin/python3 -c 'import matplotlib, h5py' >/dev/null 2>&1") == 0;
+  const auto result = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --auto --json --write-model " +
+                                    quote(model) + " --out " + quote(report) +
+                                    (plots ? " --plots " + quote(dir / "p") : std::string()) + kFast);
+  ASSERT_EQ(result.status, 0) << result.err;
+  const json j = json::parse(result.out);
+  ASSERT_TRUE(j["selection"].is_object());
+  std::set<std::string> found;
+  for (const json& step : j["selection"]["steps"]) found.insert(step["effect"].get<std::string>());
+  EXPECT_EQ(found, (std::set<std::string>{"cart_coulomb_friction", "external_force_x"})) << j["selection"].dump(1);
+  EXPECT_TRUE(has_no_nan(j));
+  const ModelSpec written = diagnosis::read_model_file(model, "cartpole");
+  EXPECT_NEAR(written.current_values(find_effect("cartpole", "cart_coulomb_friction"))(0), 1.5, 0.15 * 1.5);
+  EXPECT_NEAR(written.current_values(find_effect("cartpole", "external_force_x"))(0), 0.8, 0.15 * 0.8);
+  H5::H5File h5(report.string(), H5F_ACC_RDONLY);
+  EXPECT_EQ(h5.openDataSet("/selection/heldout_rmse").getSpace().getSimpleExtentNpoints(),
+            static_cast<hssize_t>((j["selection"]["steps"].size() + 1) * 4));
+  if (plots) {
+    EXPECT_GT(fs::file_size(dir / "p" / "selection_path.png"), 1000u);
+  }
 }
 
 }  // namespace
