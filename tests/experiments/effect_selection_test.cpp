@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 
 #include <Eigen/Dense>
@@ -16,6 +18,7 @@
 #include "gpilqg/core/input_delay.hpp"
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 
 namespace gpilqg {
@@ -80,7 +83,7 @@ void expect_found(const DiagnosisReport& r, const Truth& truth) {
   }
   // The final model is what the next round starts from (and what --write-model writes).
   for (const auto& [effect, value] : truth) {
-    const Vector current = r.model_next.current_values(find_effect(r.system, effect));
+    const Vector current = r.model_next.current_values(find_candidate(r.model_next, effect));
     EXPECT_DOUBLE_EQ(current(0), found.at(effect)) << effect;
   }
 }
@@ -130,6 +133,23 @@ INSTANTIATE_TEST_SUITE_P(
                      {"actuator_gain:elbow_motor", 0.8}},
                     8, 200, 0.01, 1}),
     [](const auto& info) { return info.param.name; });
+
+// A force the user declares in the model file (a cubic spring on the cart, `q^3` on `x`) is a candidate
+// of the selection like a library effect, and is refitted jointly with one.
+TEST(EffectSelection, AUserDeclaredEffectIsFoundWithALibraryEffect) {
+  const std::filesystem::path dir = test::temporary_dir("selection_user_effect");
+  const std::string declaration =
+      "[model]\nsystem = \"cartpole\"\n\n[[user_effects]]\nname = \"cart_spring\"\ncoordinate = \"x\"\n"
+      "terms = [\"q^3\"]\nparameters = [\"k3\"]\n";
+  std::ofstream(dir / "model.toml") << declaration;
+  std::ofstream(dir / "world.toml") << declaration << "\n[effects]\ncart_spring = -30.0\ncart_coulomb_friction = 1.0\n";
+  const ModelSpec world = diagnosis::read_model_file(dir / "world.toml", "cartpole");
+  const MeasurementSet data = data_of(world, 16, 8, 150, 0.02);
+  diagnosis::DiagnosisOptions o = auto_options("cartpole");
+  o.model = diagnosis::read_model_file(dir / "model.toml", "cartpole");
+  const DiagnosisReport r = diagnosis::diagnose(data, o);
+  expect_found(r, {{"cart_spring", -30.0}, {"cart_coulomb_friction", 1.0}});
+}
 
 TEST(EffectSelection, NothingHiddenAddsNothing) {
   const MeasurementSet data = data_of(world_with("cartpole", {}), 7, 8, 150, 0.02);
