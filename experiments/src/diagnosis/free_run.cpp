@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 
+#include "gpilqg/control/rollout.hpp"
 #include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
 
@@ -24,23 +25,13 @@ FreeRunTrajectory free_run(const FreeRunModel& model, const Episode& episode) {
     throw std::invalid_argument(fmt::format("free run of '{}': the control source returned {} x {} controls for {} x {}",
                                             model.name, u.rows(), u.cols(), episode.u.rows(), episode.u.cols()));
 
+  // The project's one rollout loop (control/rollout.hpp): it stops at the first diverged state.
   FreeRunTrajectory out;
   out.model = model.name;
-  Matrix predicted(T, n);
-  predicted.row(0) = episode.x.row(0);
-  Vector x = episode.x.row(0).transpose(), next(n);
-  const auto workspace = phi.make_workspace();
-  for (Eigen::Index t = 0; t + 1 < T; ++t) {
-    phi.step(x, u.row(t).transpose(), next, nullptr, *workspace);
-    if (prediction_diverged(next)) {
-      out.diverged = true;
-      break;
-    }
-    x = next;
-    predicted.row(t + 1) = x.transpose();
-    ++out.steps;
-  }
-  out.predicted = predicted.topRows(out.steps + 1);
+  const RolloutResult run = rollout(phi, episode.x.row(0).transpose(), u.topRows(T - 1).transpose());
+  out.steps = run.steps_completed;
+  out.diverged = !run.finite;
+  out.predicted = run.trajectory.x.leftCols(out.steps + 1).transpose();
   out.fit_percent = Vector::Zero(n);
   if (out.steps > 0)
     for (int i = 0; i < n; ++i)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gpilqg/experiments/diagnosis/whiteness.hpp"
 #include "gpilqg/gp/backend_registry.hpp"
 
 namespace gpilqg::diagnosis {
@@ -163,11 +164,12 @@ double lagged_sum(const Vector& a, const Vector& b, const std::vector<int>& epis
   return sum;
 }
 
-Vector autocorrelation(const Vector& a, const std::vector<int>& episode, int max_lag) {
+/// The within-episode autocorrelation at lags -max_lag..max_lag (whiteness.hpp's one-sided
+/// autocorrelation, mirrored: rho(-k) = rho(k)).
+Vector two_sided_autocorrelation(const Vector& a, const std::vector<int>& episode, int max_lag) {
+  const Vector one_sided = autocorrelation(a, episode, max_lag);
   Vector out(2 * max_lag + 1);
-  const double zero = a.squaredNorm();
-  for (int tau = -max_lag; tau <= max_lag; ++tau)
-    out(tau + max_lag) = zero > 0.0 ? lagged_sum(a, a, episode, tau) / zero : 0.0;
+  for (int k = 0; k <= max_lag; ++k) out(max_lag + k) = out(max_lag - k) = one_sided(k);
   return out;
 }
 
@@ -185,11 +187,11 @@ CrossCorrelation cross_correlation(const Transitions& data, const Matrix& residu
   std::vector<Vector> u_centred, u_auto;
   for (int j = 0; j < m; ++j) {
     u_centred.push_back(data.u.col(j).array() - data.u.col(j).mean());
-    u_auto.push_back(autocorrelation(u_centred.back(), data.episode, max_lag));
+    u_auto.push_back(two_sided_autocorrelation(u_centred.back(), data.episode, max_lag));
   }
   for (int i = 0; i < n; ++i) {
     const Vector r = residual.col(i).array() - residual.col(i).mean();
-    const Vector r_auto = autocorrelation(r, data.episode, max_lag);
+    const Vector r_auto = two_sided_autocorrelation(r, data.episode, max_lag);
     for (int j = 0; j < m; ++j) {
       const double scale = std::sqrt(r.squaredNorm() * u_centred[static_cast<std::size_t>(j)].squaredNorm());
       Vector& values = out.values[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
