@@ -18,6 +18,7 @@ packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev python3-h5py python3-matplotlib
   libmujoco-dev
   pybind11-dev python3-pybind11 python3-pytest python3-sklearn python3-pandas libmatio-dev
+  openmpi-bin libopenmpi-dev
 )
 sudo_cmd=""
 if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi

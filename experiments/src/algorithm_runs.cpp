@@ -14,10 +14,6 @@
 namespace gpilqg {
 namespace {
 
-/// Threads for the work inside one algorithm's iteration: the GPs' outputs are fitted concurrently,
-/// and PDDP's belief step shares its output pairs (the results do not depend on it).
-constexpr int kThreads = kGpFitThreads;
-
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -103,11 +99,15 @@ gp::FitOptions fit_options(const TaskContext& c, std::uint64_t seed, const std::
 
 }  // namespace
 
+void attach_fixed_model(AlgorithmRun& run, const std::shared_ptr<const StepModel>& model) {
+  for (auto& record : run.iterations) record.plan.model = model;
+  run.final_model = model;
+}
+
 AlgorithmRun run_fixed_model(const TaskContext& c, const std::string& name, std::shared_ptr<const StepModel> model,
                              std::uint64_t seed) {
   if (auto restored = c.journal != nullptr ? c.journal->restore(c, seed, name) : std::nullopt) {
-    for (auto& record : restored->iterations) record.plan.model = model;
-    restored->final_model = std::move(model);
+    attach_fixed_model(*restored, model);
     return std::move(*restored);
   }
   AlgorithmRun run;
@@ -138,6 +138,7 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     inputs.previous_u_bar = warm_start(previous);
     inputs.fit = fit_options(c, seed, name, data.size());
     inputs.variant = c.config.gp_variant;
+    inputs.threads = c.threads;
     GpRound round = plan_gp_ilqg_round(task, c.models.simulator, inputs);
     record.fit_seconds = round.fit_seconds;
     record.hyperparameters = std::move(round.hyperparameters);
@@ -160,7 +161,7 @@ DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uin
     const Matrix increments = data.x_next - data.x;
     const auto backend = gp::make_backend(c.config.pddp_backend, c.config.gp.backend_settings);
     const auto dynamics = gp::GpBeliefDynamics::fit(n, m, c.config.dt, inputs, increments, *backend,
-                                                    fit_options(c, seed, name, data.size()), nullptr, kThreads);
+                                                    fit_options(c, seed, name, data.size()), nullptr, c.threads);
     record.fit_seconds = seconds_since(start);
 
     PddpProblem problem;

@@ -25,6 +25,8 @@ int run_reporting_errors(const std::function<int()>& command, std::ostream& err)
   } catch (const FileWriteError& e) {
     err << "error: " << e.what() << '\n';
     return kExitInternalFailure;
+  } catch (const ReportedElsewhere& e) {
+    return e.exit_status();
   } catch (const std::exception& e) {
     err << "internal error: " << e.what() << '\n';
     return kExitInternalFailure;

@@ -29,7 +29,7 @@ GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const Step
   const gp::ResidualModel* previous = in.previous_model.get();
   gp::ResidualModelOptions options;
   options.fit = in.fit;
-  options.threads = kGpFitThreads;
+  options.threads = std::max(1, in.threads);
   auto model = std::make_shared<const gp::ResidualModel>(gp::ResidualModel::fit(
       simulator, all, *in.backend, options, nullptr, previous != nullptr ? &validation : nullptr, previous));
   round.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,78 +1,19 @@
 #include "gpilqg/experiments/run_experiment.hpp"
 
-#include <fmt/format.h>
-
+#include "gpilqg/experiments/run_units.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 
 namespace gpilqg {
-namespace {
-
-/// Data carried into a transfer task keeps its rows but belongs to no iteration of the new task.
-TransitionData carried(const TransitionData& data) {
-  TransitionData out = data;
-  std::fill(out.iteration.begin(), out.iteration.end(), -1);
-  return out;
-}
-
-const AlgorithmRun* find_run(const std::vector<AlgorithmRun>& runs, const std::string& name) {
-  for (const auto& run : runs)
-    if (run.name == name) return &run;
-  return nullptr;
-}
-
-}  // namespace
 
 RunResults run_experiment(const RunConfig& config, const RunOptions& options) {
-  RunResults results;
-  results.config = config;
-  results.options = options;
-  results.options.journal = nullptr;  // the journal does not outlive the run
   const RunModels models = make_run_models(config);
-  const std::vector<std::string> backends = options.backends.empty() ? std::vector<std::string>{config.gp.backend} : options.backends;
-  const auto gp_name = [&](const std::string& backend) {
-    return options.backends.empty() ? std::string("gp_ilqg") : "gp_ilqg_" + backend;
-  };
-
-  results.tasks.resize(config.tasks.size());
-  for (std::size_t s = 0; s < options.seeds.size(); ++s) {
-    const std::uint64_t seed = options.seeds[s];
-    std::vector<AlgorithmRun> previous_task;
-    for (std::size_t t = 0; t < config.tasks.size(); ++t) {
-      const RunTask& task = config.tasks[t];
-      const QuadraticCost cost = make_task_cost(config, task);
-      const auto prefix = fmt::format("[seed {} ({}/{})] ", seed, s + 1, options.seeds.size());
-      TaskContext context{config, task, static_cast<int>(t), models, cost, nullptr, options.journal};
-      if (options.progress) context.progress = [&](const std::string& line) { options.progress(prefix + line); };
-      const auto carried_data = [&](const std::string& name) {
-        const AlgorithmRun* earlier = task.transfer ? find_run(previous_task, name) : nullptr;
-        return earlier != nullptr ? carried(earlier->data) : TransitionData{};
-      };
-
-      std::vector<AlgorithmRun> runs;
-      runs.push_back(run_fixed_model(context, "ilqg_real", models.world, seed));
-      runs.push_back(run_fixed_model(context, "ilqg_sim", models.simulator, seed));
-      for (const auto& backend_name : backends) {
-        const auto backend = gp::make_backend(backend_name, config.gp.backend_settings);
-        const std::string name = gp_name(backend_name);
-        runs.push_back(run_gp_ilqg(context, name, *backend, carried_data(name), seed));
-      }
-      if (config.pddp) {
-        runs.push_back(run_pddp_on_data_of(context, *find_run(runs, gp_name(backends.front())), seed));
-        if (config.pddp_own) runs.push_back(run_pddp_own(context, carried_data("pddp_own"), seed));
-      }
-
-      TaskResults& out = results.tasks[t];
-      if (s == 0) {
-        for (const auto& run : runs) out.algorithms.push_back(run.name);
-        const AlgorithmRun& gp = *find_run(runs, gp_name(backends.front()));
-        if (gp.data.size() > 0 && gp.final_model && dynamic_cast<const gp::ResidualModel*>(gp.final_model.get()))
-          out.slice = model_slice(*models.world, *gp.final_model, gp.data);
-      }
-      previous_task = runs;
-      out.seeds.push_back(std::move(runs));
-    }
-  }
-  return results;
+  const std::vector<RunUnit> units = plan_run_units(config, options);
+  std::vector<AlgorithmRun> runs;
+  runs.reserve(units.size());
+  const CompletedRun completed = [&runs](int index) { return runs.at(static_cast<std::size_t>(index)); };
+  for (int i = 0; i < static_cast<int>(units.size()); ++i)
+    runs.push_back(run_unit(config, options, models, units, i, completed));
+  return assemble_run_results(config, options, models, units, std::move(runs));
 }
 
 ModelSlice model_slice(const StepModel& world, const StepModel& model, const TransitionData& data) {

@@ -58,6 +58,9 @@ class RunJournal {
   virtual void save(const TaskContext& context, std::uint64_t seed, const AlgorithmRun& run) = 0;
 };
 
+/// A fixed-model run restored from a journal gets its model back (a journal keeps no fixed model).
+void attach_fixed_model(AlgorithmRun& run, const std::shared_ptr<const StepModel>& model);
+
 /// ilqg_real (world) or ilqg_sim (simulator): one iLQG plan, evaluated once, repeated.
 AlgorithmRun run_fixed_model(const TaskContext& context, const std::string& name,
                              std::shared_ptr<const StepModel> model, std::uint64_t seed);

@@ -26,10 +26,23 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// An error that another process reports: a rank of an MPI job whose failure rank 0 prints ends
+/// with the same exit status and prints nothing, so the message appears once.
+class ReportedElsewhere : public std::exception {
+ public:
+  explicit ReportedElsewhere(int exit_status) : exit_status_(exit_status) {}
+  int exit_status() const { return exit_status_; }
+  const char* what() const noexcept override { return "an error reported by another process"; }
+
+ private:
+  int exit_status_;
+};
+
 /// Runs `command` and turns exceptions into the exit-status contract, writing to `err`:
 /// DataError, InputError and std::invalid_argument -> "error: <message>", exit 2;
 /// a result file the disk refused (AtomicWriteError, FileWriteError: full disk, file-size limit,
 /// I/O error) -> "error: <file>: <problem>; the previous file is unchanged", exit 1;
+/// ReportedElsewhere -> nothing, its exit status;
 /// any other exception -> "internal error: <message>", exit 1.
 int run_reporting_errors(const std::function<int()>& command, std::ostream& err);
 

@@ -30,6 +30,7 @@ struct GpRoundInputs {
   Matrix previous_u_bar;  ///< the previous round's nominal controls, m x T (empty: task.u_init)
   gp::FitOptions fit;     ///< seed, restarts and evaluations of the hyperparameter fit
   DdpVariant variant = DdpVariant::RobustILQG;  ///< with data: RobustILQG (the paper) or ILQG (GP mean)
+  int threads = 2;        ///< threads fitting the GP's outputs concurrently (the results do not depend on it)
 };
 
 struct GpRound {
@@ -37,9 +38,6 @@ struct GpRound {
   double fit_seconds = 0.0;
   std::vector<Vector> hyperparameters;  ///< per state: [log l (n+m); log sf; log sn] (empty: no GP)
 };
-
-/// Threads used to fit the GP's outputs concurrently (the results do not depend on it).
-inline constexpr int kGpFitThreads = 2;
 
 /// The round (see the file comment). Throws std::invalid_argument for inconsistent inputs (data of
 /// another size than the simulator's, a previous u_bar of another shape).

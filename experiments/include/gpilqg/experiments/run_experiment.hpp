@@ -23,6 +23,9 @@ struct RunOptions {
   /// Keeps every completed iteration and restores what an interrupted run had (run_checkpoint.hpp);
   /// null: nothing is kept. Not owned.
   RunJournal* journal = nullptr;
+  /// Threads inside one unit of work (GP outputs fitted concurrently, PDDP's belief step); the
+  /// results do not depend on it. Under MPI each rank uses its share of the node's cores.
+  int threads = 2;
 };
 
 /// A 1-D picture of the learned model (the paper's Figure 1): one state output of the GP-corrected

@@ -52,6 +52,9 @@ struct TaskContext {
   const Cost& cost;
   std::function<void(const std::string&)> progress;
   RunJournal* journal = nullptr;  ///< where completed iterations are kept for --resume (null: nowhere)
+  /// Threads for the work inside one iteration: the GP's outputs are fitted concurrently and PDDP's
+  /// belief step shares its output pairs. The results do not depend on it.
+  int threads = 2;
 };
 
 /// What every DDP solve of one task shares, whoever poses it (`gpilqg run`'s tasks, `gpilqg plan`'s

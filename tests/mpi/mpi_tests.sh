@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# The MPI tests (issue "Beyond one machine"): `mpirun -np 2` on this machine against one process.
+#
+#   bash mpi_tests.sh GPILQG MPIEXEC CASE
+#
+# CASE is one of
+#   equal    a run spread over 2 and 3 ranks writes the single-process result (same_results.py)
+#   resume   rank 1 is killed (SIGKILL) mid-run; the checkpoint keeps every finished iteration; a
+#            resume in which one unit's file is damaged fails naming the rank and the unit, keeping
+#            the other ranks' work; after removing that file, a resume over 2 ranks completes and
+#            equals the single-process result
+# Each case works in its own temporary folder.
+set -euo pipefail
+gpilqg="$1"; mpiexec="$2"; case_name="$3"
+here="$(cd "$(dirname "$0")" && pwd)"
+work="$(mktemp -d "${TMPDIR:-/tmp}/gpilqg_mpi_${case_name}.XXXXXX")"
+trap '[ -n "${GPILQG_TEST_KEEP:-}" ] && echo "kept $work" || rm -rf "$work"' EXIT
+cd "$work"
+python=/usr/bin/python3
+
+# Open MPI refuses root unless told; --oversubscribe lets 3 ranks share 2 cores.
+if [ "$(id -u)" -eq 0 ]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
+export OMPI_MCA_btl_vader_single_copy_mechanism=none  # containers often forbid the ptrace it needs
+mpi() { local np="$1"; shift; "$mpiexec" -np "$np" --oversubscribe "$@"; }
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# The tiny run of the C++ tests (tests/experiments/tiny_run_config.hpp): two tasks (the second a
+# transfer task), every algorithm, in about a second.
+sed -n '/kTinyRun = R"(/,/^)";/p' "$here/../experiments/tiny_run_config.hpp" | sed '1d;$d' > tiny.toml
+[ -s tiny.toml ] || fail "could not extract the tiny run config"
+
+single() { "$gpilqg" run cartpole --config tiny.toml --seeds "$1" --out single.h5 --no-plots > single.log 2>&1; }
+
+case "$case_name" in
+equal)
+  single 3
+  for np in 2 3; do
+    mpi "$np" "$gpilqg" run cartpole --config tiny.toml --seeds 3 --out "mpi$np.h5" --no-plots > "mpi$np.log" 2>&1 \
+      || { cat "mpi$np.log"; fail "mpirun -np $np exited $?"; }
+    grep -q "^rank 1: [1-9][0-9]* units" "mpi$np.log" || { cat "mpi$np.log"; fail "rank 1 ran no unit with -np $np"; }
+    $python "$here/same_results.py" single.h5 "mpi$np.h5" || fail "-np $np differs from the single-process result"
+    [ ! -e "mpi$np.h5.checkpoint" ] || fail "the checkpoint of a finished run was left behind"
+  done
+  ;;
+resume)
+  cat tiny.toml > slow.toml
+  sed -i 's/^iterations = 2/iterations = 4/; s/^exact_points = 40/exact_points = 120/' slow.toml
+  "$gpilqg" run cartpole --config slow.toml --seeds 4 --out single.h5 --no-plots > single.log 2>&1
+  mpi 2 "$gpilqg" run cartpole --config slow.toml --seeds 4 --out mpi.h5 --no-plots > killed.log 2>&1 &
+  launcher=$!
+  # Rank 1 dies as soon as some units have finished, in the middle of the run.
+  victim=""
+  for _ in $(seq 1 3000); do
+    if [ "$(ls mpi.h5.checkpoint 2>/dev/null | grep -c '^seed-')" -ge 6 ]; then
+      for pid in $(pgrep -f "run cartpole --config slow.toml" || true); do
+        if tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=1"; then victim=$pid; fi
+      done
+      [ -n "$victim" ] && break
+    fi
+    sleep 0.01
+  done
+  [ -n "$victim" ] || { wait "$launcher" || true; cat killed.log; fail "found no rank 1 to kill"; }
+  kill -9 "$victim"
+  if wait "$launcher"; then fail "mpirun exited 0 although rank 1 was killed"; fi
+  [ ! -e mpi.h5 ] || fail "a killed run wrote a result file"
+  kept=$(ls mpi.h5.checkpoint | grep -c '^seed-')
+  [ "$kept" -ge 6 ] || fail "the checkpoint keeps $kept unit files"
+  [ -e mpi.h5.checkpoint/manifest.h5 ] || fail "the checkpoint lost its manifest"
+
+  # A damaged unit file: the resume fails on the rank that meets it, naming rank and unit.
+  damaged=$(ls mpi.h5.checkpoint | grep '^seed-1_task-0_ilqg_real.h5$' || ls mpi.h5.checkpoint | grep '^seed-' | head -1)
+  echo "not HDF5" > "mpi.h5.checkpoint/$damaged"
+  set +e
+  mpi 2 "$gpilqg" run cartpole --config slow.toml --seeds 4 --out mpi.h5 --no-plots --resume > damaged.log 2>&1
+  status=$?
+  set -e
+  [ "$status" -ne 0 ] || fail "a resume over a damaged unit file exited 0"
+  grep -q "^error: rank [01] of 2 failed on seed [0-9], task [a-z]*, [a-z_]*: " damaged.log \
+    || { cat damaged.log; fail "no message naming the rank and the unit"; }
+  grep -q "continue with --resume" damaged.log || { cat damaged.log; fail "the message does not say how to continue"; }
+  [ "$(grep -c '^error: ' damaged.log)" -eq 1 ] || { cat damaged.log; fail "the error was reported more than once"; }
+  [ -e mpi.h5.checkpoint/manifest.h5 ] || fail "the failed resume lost the checkpoint"
+
+  rm "mpi.h5.checkpoint/$damaged"
+  mpi 2 "$gpilqg" run cartpole --config slow.toml --seeds 4 --out mpi.h5 --no-plots --resume > resumed.log 2>&1 \
+    || { cat resumed.log; fail "the resume exited $?"; }
+  grep -q "resumed after iteration" resumed.log || { cat resumed.log; fail "nothing was resumed"; }
+  $python "$here/same_results.py" single.h5 mpi.h5 || fail "the resumed run differs from the single-process result"
+  ;;
+*)
+  fail "unknown case '$case_name'"
+  ;;
+esac
+echo "PASS: $case_name"
