@@ -167,25 +167,27 @@ std::size_t index_of(const std::vector<std::string>& names, const std::string& n
   throw std::logic_error("run results: no algorithm '" + name + "'");
 }
 
-void write_file(const std::filesystem::path& file, const RunResults& results) {
-  Hdf5Writer h5(file);
+}  // namespace
+
+void write_run_results_to(Hdf5Writer& h5, const std::string& root, const RunResults& results) {
+  const std::string here = root.empty() ? "/" : root;
   const RunConfig& c = results.config;
   const SystemSignature signature = system_signature(c.system);
   std::vector<std::string> state_names;
   for (const auto& q : signature.states) state_names.push_back(q.name);
 
-  h5.attribute("/", "schema_version", std::int64_t{1});
-  h5.attribute("/", "gpilqg_version", std::string(kVersionString));
-  h5.attribute("/", "config", c.text);
-  h5.attribute("/", "seed", static_cast<std::int64_t>(results.options.seeds.front()));
-  h5.attribute("/", "created", utc_timestamp());
-  h5.attribute("/", "system", c.system);
+  h5.attribute(here, "schema_version", std::int64_t{1});
+  h5.attribute(here, "gpilqg_version", std::string(kVersionString));
+  h5.attribute(here, "config", c.text);
+  h5.attribute(here, "seed", static_cast<std::int64_t>(results.options.seeds.front()));
+  h5.attribute(here, "created", utc_timestamp());
+  h5.attribute(here, "system", c.system);
   std::vector<double> seeds(results.options.seeds.begin(), results.options.seeds.end());
-  h5.write_vector("/seeds", seeds);
+  h5.write_vector(root + "/seeds", seeds);
 
   for (std::size_t t = 0; t < c.tasks.size(); ++t) {
     const TaskResults& task = results.tasks[t];
-    const std::string group = "/" + c.tasks[t].name;
+    const std::string group = root + "/" + c.tasks[t].name;
     h5.attribute(group, "algorithms", task.algorithms);
     h5.attribute(group, "transfer", std::int64_t{c.tasks[t].transfer ? 1 : 0});
     h5.attribute(group, "horizon", std::int64_t{c.tasks[t].horizon});
@@ -199,13 +201,15 @@ void write_file(const std::filesystem::path& file, const RunResults& results) {
     if (compared) h5.link(group + "/gp_ilqg", group + "/" + main_gp);
     write_slice(h5, group, task.slice, signature);
   }
-  h5.close();
 }
 
-}  // namespace
 
 void write_run_results(const std::filesystem::path& file, const RunResults& results) {
-  write_atomically(file, [&](const std::filesystem::path& temporary) { write_file(temporary, results); });
+  write_atomically(file, [&](const std::filesystem::path& temporary) {
+    Hdf5Writer h5(temporary);
+    write_run_results_to(h5, "", results);
+    h5.close();
+  });
 }
 
 }  // namespace gpilqg

@@ -1,5 +1,7 @@
 #include "gpilqg/gp/fit.hpp"
 
+#include "gpilqg/gp/hyperparameters.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -63,14 +65,24 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
   const auto start_time = std::chrono::steady_clock::now();
   options.validate();
   const int p = objective.parameter_count();
-  if (options.warm_start.size() != 0 && options.warm_start.size() != p)
+  const int shared = Hyperparameters::count(objective.input_dim());
+  if (options.warm_start.size() != 0 && options.warm_start.size() != p && options.warm_start.size() < shared)
     throw std::invalid_argument("fit_parameters: warm start has " + std::to_string(options.warm_start.size()) +
-                                " entries; expected the backend's " + std::to_string(p) + " parameters");
+                                " entries; expected the backend's " + std::to_string(p) + " parameters, or at least the " +
+                                std::to_string(shared) + " shared hyperparameters");
   const ParameterBounds bounds = objective.bounds();
 
   std::vector<Vector> starts;
-  if (options.warm_start.size() == p) starts.push_back(clip(options.warm_start, bounds));
   const Vector initial = clip(objective.initial_parameters(), bounds);
+  if (options.warm_start.size() == p) {
+    starts.push_back(clip(options.warm_start, bounds));
+  } else if (options.warm_start.size() != 0) {
+    // A previous fit with another number of backend-specific parameters (FITC's pseudo-inputs when
+    // it had fewer points than inducing inputs): its kernel hyperparameters, this data's extras.
+    Vector start = initial;
+    start.head(shared) = options.warm_start.head(shared);
+    starts.push_back(clip(start, bounds));
+  }
   starts.push_back(initial);
   if (options.optimise) {
     std::mt19937_64 rng(options.seed);

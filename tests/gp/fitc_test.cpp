@@ -399,6 +399,34 @@ TEST(FitcBackendTest, ObjectiveBoundsAndInitialValuesAreConsistent) {
   EXPECT_EQ((FitcLayout{3, 20}.inducing_inputs(initial)), o.train.inputs);
 }
 
+/// GP-ILQG refits warm-started from the previous iteration's model. While the data are fewer than the
+/// inducing inputs, FITC's parameter vector grows with them (min(M, N) pseudo-inputs); the refit then
+/// starts from the previous kernel hyperparameters with this data's pseudo-inputs.
+TEST(FitcBackendTest, AWarmStartWithFewerPseudoInputsContributesItsKernelHyperparameters) {
+  const OracleData o = load_oracle();  // N = 20, D = 3
+  FitcOptions fitc;
+  fitc.inducing = 50;
+  const FitcBackend backend(fitc);
+  const TrainingSet few = o.train.subset({0, 1, 2, 3, 4, 5, 6, 7});
+  FitOptions options;
+  options.restarts = 0;
+  const FitResult first = backend.fit(few, options);
+  ASSERT_EQ(first.model->parameters().size(), 5 + 8 * 3);
+
+  options.warm_start = first.model->parameters();
+  options.optimise = false;  // condition on the first start: the warm start as carried over
+  const FitResult refit = backend.fit(o.train, options);
+  const Vector theta = refit.model->parameters();
+  ASSERT_EQ(theta.size(), 5 + 20 * 3);
+  const ParameterBounds bounds = backend.objective(o.train, options)->bounds();
+  const Vector carried = first.model->parameters().head(5).cwiseMax(bounds.lower.head(5)).cwiseMin(bounds.upper.head(5));
+  EXPECT_EQ(theta.head(5), carried) << "the kernel hyperparameters are carried over (within this data's bounds)";
+  EXPECT_EQ((FitcLayout{3, 20}.inducing_inputs(theta)), o.train.inputs) << "this data's pseudo-inputs";
+
+  options.warm_start = Vector::Zero(4);  // shorter than the shared hyperparameters: a caller's error
+  EXPECT_THROW(backend.fit(o.train, options), std::invalid_argument);
+}
+
 TEST(FitcBackendTest, PredictionRequestsComputeOnlyWhatIsAsked) {
   const OracleData o = load_oracle();
   const auto model = FitcBackend().condition(o.train, oracle_theta(o));

@@ -9,6 +9,9 @@
 #            resume in which one unit's file is damaged fails naming the rank and the unit, keeping
 #            the other ranks' work; after removing that file, a resume over 2 ranks completes and
 #            equals the single-process result
+#   sweep    a 2 x 2 sweep (gp.backend x loop.rollouts, 2 seeds) over 2 ranks equals the single-process
+#            sweep; a grid point equals `gpilqg run` with that point's config; the summary figure is
+#            written; a grid field the run config does not have is refused naming it
 # Each case works in its own temporary folder.
 set -euo pipefail
 gpilqg="$1"; mpiexec="$2"; case_name="$3"
@@ -86,6 +89,23 @@ resume)
     || { cat resumed.log; fail "the resume exited $?"; }
   grep -q "resumed after iteration" resumed.log || { cat resumed.log; fail "nothing was resumed"; }
   $python "$here/same_results.py" single.h5 mpi.h5 || fail "the resumed run differs from the single-process result"
+  ;;
+sweep)
+  printf 'system = "cartpole"\nconfig = "tiny.toml"\nseeds = 2\n[grid]\n"gp.backend" = ["exact", "fitc"]\n"loop.rollouts" = [1, 2]\n' > sweep.toml
+  "$gpilqg" sweep sweep.toml --out single.h5 --no-plots > single.log 2>&1 || { cat single.log; fail "the single-process sweep failed"; }
+  mpi 2 "$gpilqg" sweep sweep.toml --out mpi.h5 --plots figures > mpi.log 2>&1 || { cat mpi.log; fail "mpirun sweep exited $?"; }
+  $python "$here/same_results.py" single.h5 mpi.h5 || fail "the sweep over 2 ranks differs from the single-process sweep"
+  [ -s figures/sweep_cost.png ] || fail "no summary figure"
+  # Point 3 (fitc, 2 rollouts): the run config with those two fields, run directly.
+  sed 's/^\[gp\]$/[gp]\nbackend = "fitc"/; s/^rollouts = 1$/rollouts = 2/' tiny.toml > point3.toml
+  "$gpilqg" run cartpole --config point3.toml --seeds 2 --out point3.h5 --no-plots > point3.log 2>&1
+  $python "$here/same_results.py" mpi.h5:/point_3 point3.h5 || fail "grid point 3 differs from gpilqg run with its config"
+  printf 'system = "cartpole"\n[grid]\n"gp.bakend" = ["exact"]\n' > typo.toml
+  set +e
+  "$gpilqg" sweep typo.toml --no-plots > typo.log 2>&1
+  status=$?
+  set -e
+  [ "$status" -eq 2 ] && grep -q "^error: .*typo.toml.*gp.bakend" typo.log || { cat typo.log; fail "an unknown grid field was not refused by name"; }
   ;;
 *)
   fail "unknown case '$case_name'"

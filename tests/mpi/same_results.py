@@ -1,7 +1,10 @@
 #!/usr/bin/python3
 """Exit 0 when two gpilqg result files hold the same numbers, else print the differences and exit 1.
 
-usage: /usr/bin/python3 same_results.py A.h5 B.h5
+usage: /usr/bin/python3 same_results.py A.h5[:GROUP] B.h5[:GROUP]
+
+With GROUP, the comparison is of that group (a grid point of a sweep, "/point_3") against the other
+file's group or root; the sweep's own attributes of a point (grid_values, label) are not compared.
 
 Every group, dataset and attribute must be present in both, with the same shape and bit-identical
 values, except what measures wall-clock time (the time_* datasets, iter_<k>/solve_time) and the
@@ -20,8 +23,11 @@ def is_wall_clock(name):
     return name.rsplit("/", 1)[-1] in WALL_CLOCK
 
 
+SWEEP_ONLY = ("created", "grid_values", "label")
+
+
 def attributes(obj):
-    return {k: v for k, v in obj.attrs.items() if k != "created"}
+    return {k: v for k, v in obj.attrs.items() if k not in SWEEP_ONLY}
 
 
 def same_value(a, b):
@@ -41,7 +47,7 @@ def compare(a, b):
     if sorted(names_a) != sorted(names_b):
         problems.append(f"objects differ: only in A {sorted(set(names_a) - set(names_b))}, "
                         f"only in B {sorted(set(names_b) - set(names_a))}")
-    for name in ["/"] + sorted(set(names_a) & set(names_b)):
+    for name in ["."] + sorted(set(names_a) & set(names_b)):
         x, y = a[name], b[name]
         ax, ay = attributes(x), attributes(y)
         if sorted(ax) != sorted(ay):
@@ -58,8 +64,9 @@ def compare(a, b):
 def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
-    with h5py.File(sys.argv[1], "r") as a, h5py.File(sys.argv[2], "r") as b:
-        problems = compare(a, b)
+    (file_a, _, group_a), (file_b, _, group_b) = (arg.partition(":") for arg in sys.argv[1:3])
+    with h5py.File(file_a, "r") as a, h5py.File(file_b, "r") as b:
+        problems = compare(a[group_a or "/"], b[group_b or "/"])
     for p in problems:
         print(p)
     sys.exit(1 if problems else 0)

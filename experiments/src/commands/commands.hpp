@@ -31,6 +31,9 @@ void add_diagnose_command(CLI::App& app, CommandAction& action);
 /// `gpilqg run SYSTEM [--config F] [--seeds N] [--iterations K] [--backends LIST] [--out F.h5] [--plots DIR]`
 void add_run_command(CLI::App& app, CommandAction& action);
 
+/// `gpilqg sweep SWEEP.toml [--out F.h5] [--plots DIR] [--resume]`
+void add_sweep_command(CLI::App& app, CommandAction& action);
+
 /// `gpilqg profile DATA --backends LIST [--sizes LIST] [--json] [--out F.h5] [--plots DIR]`
 void add_profile_command(CLI::App& app, CommandAction& action);
 

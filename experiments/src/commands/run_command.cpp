@@ -13,8 +13,8 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "output_options.hpp"
-#include "parallel/distributed_run.hpp"
 #include "parallel/mpi_session.hpp"
+#include "parallel/run_session.hpp"
 #include "stop_signal.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -69,62 +69,6 @@ void print_summary(const RunResults& results) {
   }
 }
 
-/// The run's checkpoint (created, or opened with --resume) on every rank. Rank 0 creates or checks
-/// it first; the other ranks then open it, which fails when the folder is not on a file system they
-/// see. An error on any rank stops every rank before the work starts, reported once.
-RunCheckpoint open_checkpoint(const MpiSession& mpi, const std::filesystem::path& folder, const RunConfig& config,
-                              const RunOptions& options, bool resume) {
-  if (!mpi.distributed()) {
-    RunCheckpoint checkpoint = resume ? RunCheckpoint::resume(folder, config, options) : RunCheckpoint::create(folder, config, options);
-    remove_stale_temporaries_in(folder);
-    return checkpoint;
-  }
-  std::optional<RunCheckpoint> checkpoint;
-  std::exception_ptr root_error;
-  if (mpi.is_root()) {
-    try {
-      checkpoint = resume ? RunCheckpoint::resume(folder, config, options) : RunCheckpoint::create(folder, config, options);
-      remove_stale_temporaries_in(folder);
-    } catch (...) {
-      root_error = std::current_exception();
-    }
-  }
-  if (mpi.first_error(root_error ? "rank 0 could not open the checkpoint" : "")) {
-    if (root_error) std::rethrow_exception(root_error);
-    throw ReportedElsewhere(kExitBadInput);
-  }
-  std::string error;
-  if (!mpi.is_root()) {
-    try {
-      checkpoint = RunCheckpoint::resume(folder, config, options);
-    } catch (const std::exception& e) {
-      error = fmt::format("rank {} on {} cannot open the checkpoint rank 0 prepared ({}); the result's folder must be on a "
-                          "file system that every rank sees",
-                          mpi.rank(), mpi.host(), e.what());
-    }
-  }
-  if (const auto failed = mpi.first_error(error)) {
-    if (mpi.is_root()) throw InputError(failed->second);
-    throw ReportedElsewhere(kExitBadInput);
-  }
-  return std::move(*checkpoint);
-}
-
-/// Which rank ran what, and for how long: the numbers behind a cluster's time estimate (docs/cluster.md).
-void print_unit_times(const DistributedRun& run, int ranks) {
-  std::vector<double> busy(static_cast<std::size_t>(ranks), 0.0);
-  std::vector<int> count(static_cast<std::size_t>(ranks), 0);
-  for (std::size_t i = 0; i < run.distribution.ranks.size(); ++i) {
-    const int r = run.distribution.ranks[i];
-    if (r < 0) continue;
-    busy[static_cast<std::size_t>(r)] += run.distribution.seconds[i];
-    ++count[static_cast<std::size_t>(r)];
-  }
-  for (int r = 0; r < ranks; ++r)
-    std::cerr << fmt::format("rank {}: {} units, {:.1f} s of work\n", r, count[static_cast<std::size_t>(r)],
-                             busy[static_cast<std::size_t>(r)]);
-}
-
 int run_command(const RunArguments& a) {
   const MpiSession mpi;
   const std::filesystem::path out = a.out.empty() ? std::filesystem::path("out") / ("run_" + a.system + ".h5") : std::filesystem::path(a.out);
@@ -153,14 +97,14 @@ int run_command(const RunArguments& a) {
   // Every completed iteration goes to the checkpoint folder beside the result (run_checkpoint.hpp);
   // Ctrl-C stops at the next iteration boundary, leaving any previous result file as it was.
   const std::filesystem::path folder = RunCheckpoint::folder_for(out);
-  RunCheckpoint checkpoint = open_checkpoint(mpi, folder, config, options, a.resume);
+  RunCheckpoint checkpoint = std::move(open_checkpoints(mpi, {{folder, &config, &options}}, a.resume).front());
   const StopSignalGuard stop_signal;
   checkpoint.set_stop_requested(&StopSignalGuard::stop_requested);
   options.journal = &checkpoint;
   const auto interrupted = [&](const std::string& what) {
     std::cerr << fmt::format("interrupted: {}\n{}continue with the same command and --resume\n", what,
                              std::filesystem::exists(out) ? fmt::format("{} is unchanged; ", out.string()) : "");
-    return kExitSignalBase + (StopSignalGuard::signal_number() > 0 ? StopSignalGuard::signal_number() : SIGTERM);
+    return StopSignalGuard::exit_status();
   };
   RunResults results;
   if (!mpi.distributed()) {
@@ -170,24 +114,11 @@ int run_command(const RunArguments& a) {
       return interrupted(e.what());
     }
   } else {
-    DistributedRun run = run_distributed(mpi, config, options, checkpoint, &StopSignalGuard::stop_requested);
-    const Distribution& d = run.distribution;
-    if (d.outcome == Distribution::Outcome::Failed && !mpi.is_root()) throw ReportedElsewhere(d.failure_exit);
-    if (d.outcome == Distribution::Outcome::Interrupted)
-      return mpi.is_root() ? interrupted(fmt::format("every rank stopped at its next iteration boundary; progress is in {}",
-                                                     folder.string()))
-                           : kExitSignalBase + (StopSignalGuard::signal_number() > 0 ? StopSignalGuard::signal_number() : SIGTERM);
-    if (d.outcome == Distribution::Outcome::Failed) {
-      std::string why = d.failure;
-      if (why.rfind("error: ", 0) == 0) why = why.substr(7);
-      std::cerr << fmt::format("error: rank {} of {} failed on {}: {}\nthe other ranks stopped at their next iteration "
-                               "boundary; all finished work is in {}; fix the cause and continue with --resume\n",
-                               d.failed_rank, mpi.size(), run.failed_unit, why, folder.string());
-      return d.failure_exit;
-    }
+    DistributedRuns run = run_distributed(mpi, {{&config, options, &checkpoint, ""}}, &StopSignalGuard::stop_requested);
+    if (const auto status = unfinished_exit_status(mpi, run, folder, StopSignalGuard::exit_status())) return *status;
     if (!mpi.is_root()) return kExitSuccess;
-    print_unit_times(run, mpi.size());
-    results = std::move(run.results);
+    print_unit_times(run.distribution, mpi.size());
+    results = std::move(run.results.front());
   }
   write_run_results(out, results);
   checkpoint.remove();

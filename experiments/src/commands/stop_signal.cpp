@@ -1,5 +1,7 @@
 #include "stop_signal.hpp"
 
+#include "gpilqg/experiments/cli_errors.hpp"
+
 #include <csignal>
 #include <cstring>
 
@@ -43,5 +45,7 @@ StopSignalGuard::~StopSignalGuard() {
 bool StopSignalGuard::stop_requested() { return g_signal != 0; }
 
 int StopSignalGuard::signal_number() { return static_cast<int>(g_signal); }
+
+int StopSignalGuard::exit_status() { return kExitSignalBase + (g_signal != 0 ? static_cast<int>(g_signal) : SIGTERM); }
 
 }  // namespace gpilqg::cli

@@ -18,6 +18,9 @@ class StopSignalGuard {
   static bool stop_requested();
   /// The signal that asked to stop (0: none).
   static int signal_number();
+  /// The exit status of a command that stopped early: 128 + the signal (SIGTERM when the stop came
+  /// from elsewhere, e.g. another rank of an MPI job).
+  static int exit_status();
 };
 
 }  // namespace gpilqg::cli

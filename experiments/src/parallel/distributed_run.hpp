@@ -19,15 +19,23 @@
 
 namespace gpilqg::cli {
 
-struct DistributedRun {
-  Distribution distribution;  ///< how it ended; on rank 0 also which rank ran each unit, and how long
-  RunResults results;         ///< rank 0, when every unit finished: the run's results
-  std::string failed_unit;    ///< rank 0, when a unit failed: which one ("seed 3, task swingup, gp_ilqg")
+/// One run of the work: `gpilqg run` has one, `gpilqg sweep` one per grid point.
+struct RunPart {
+  const RunConfig* config = nullptr;
+  RunOptions options;                 ///< options.journal must be `checkpoint`
+  RunCheckpoint* checkpoint = nullptr;  ///< this rank's handle on the part's checkpoint folder
+  std::string label;                  ///< names the part in messages ("grid point 3"; empty for a run)
 };
 
-/// Every rank calls this with the same config and options; `checkpoint` is this rank's handle on the
-/// shared checkpoint folder (options.journal must point to it).
-DistributedRun run_distributed(const MpiSession& session, const RunConfig& config, const RunOptions& options,
-                               RunCheckpoint& checkpoint, const std::function<bool()>& stop_signal);
+struct DistributedRuns {
+  Distribution distribution;        ///< how it ended; on rank 0 also which rank ran each unit, and how long
+  std::vector<RunResults> results;  ///< rank 0, when every unit finished: each part's results
+  std::string failed_unit;          ///< when a unit failed: which one ("seed 3, task swingup, gp_ilqg")
+};
+
+/// Every rank calls this with the same parts. The units of all parts form one list, so the ranks
+/// share the work of every part.
+DistributedRuns run_distributed(const MpiSession& session, const std::vector<RunPart>& parts,
+                                const std::function<bool()>& stop_signal);
 
 }  // namespace gpilqg::cli

@@ -30,11 +30,16 @@
 
 #include <filesystem>
 
+#include "gpilqg/core/hdf5_writer.hpp"
 #include "gpilqg/experiments/run_experiment.hpp"
 
 namespace gpilqg {
 
 /// Writes `results` atomically. Throws std::runtime_error naming the file when writing fails.
 void write_run_results(const std::filesystem::path& file, const RunResults& results);
+
+/// The same layout below the group `root` ("" for the file's root; "/point_3" for a grid point of
+/// `gpilqg sweep`), the root attributes on that group.
+void write_run_results_to(Hdf5Writer& h5, const std::string& root, const RunResults& results);
 
 }  // namespace gpilqg

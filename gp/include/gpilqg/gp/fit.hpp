@@ -4,7 +4,9 @@
 /// minimise the negative log marginal likelihood of a MarginalLikelihoodObjective over its parameter
 /// vector with NLopt's L-BFGS (LD_LBFGS) inside the objective's box bounds.
 ///
-/// Start points, in order: FitOptions::warm_start (if given, clipped to the bounds), the objective's
+/// Start points, in order: FitOptions::warm_start (if given, clipped to the bounds; a warm start of
+/// another length, from a fit with a different number of backend-specific parameters such as FITC's
+/// pseudo-inputs, contributes its D + 2 shared hyperparameters with this objective's extras), the objective's
 /// data-driven initial values, then FitOptions::restarts random restarts (restart_parameters). The
 /// start with the lowest NLML wins.
 ///
@@ -24,7 +26,8 @@ struct ParameterFit {
   FitSummary summary;  ///< everything but backend, training_points and conditioning
 };
 
-/// Runs the fit. Throws std::invalid_argument for invalid options or a warm start of the wrong size.
+/// Runs the fit. Throws std::invalid_argument for invalid options or a warm start shorter than the
+/// shared hyperparameters.
 ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOptions& options);
 
 }  // namespace gpilqg::gp

@@ -1,0 +1,97 @@
+#include "run_session.hpp"
+
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "commands/output_options.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+
+namespace gpilqg::cli {
+namespace {
+
+std::vector<RunCheckpoint> open_all(const std::vector<CheckpointRequest>& requests, bool create) {
+  std::vector<RunCheckpoint> out;
+  for (const auto& r : requests) {
+    out.push_back(create ? RunCheckpoint::create(r.folder, *r.config, *r.options)
+                         : RunCheckpoint::resume(r.folder, *r.config, *r.options));
+    remove_stale_temporaries_in(r.folder);  // of writes that a kill interrupted
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<RunCheckpoint> open_checkpoints(const MpiSession& mpi, const std::vector<CheckpointRequest>& requests,
+                                            bool resume) {
+  if (!mpi.distributed()) return open_all(requests, !resume);
+  std::vector<RunCheckpoint> checkpoints;
+  std::exception_ptr root_error;
+  if (mpi.is_root()) {
+    try {
+      checkpoints = open_all(requests, !resume);
+    } catch (...) {
+      root_error = std::current_exception();
+    }
+  }
+  if (mpi.first_error(root_error ? "rank 0 could not open the checkpoint" : "")) {
+    if (root_error) std::rethrow_exception(root_error);
+    throw ReportedElsewhere(kExitBadInput);
+  }
+  std::string error;
+  if (!mpi.is_root()) {
+    try {
+      checkpoints = open_all(requests, false);
+    } catch (const std::exception& e) {
+      error = fmt::format("rank {} on {} cannot open the checkpoint rank 0 prepared ({}); the result's folder must be on a "
+                          "file system that every rank sees",
+                          mpi.rank(), mpi.host(), e.what());
+    }
+  }
+  if (const auto failed = mpi.first_error(error)) {
+    if (mpi.is_root()) throw InputError(failed->second);
+    throw ReportedElsewhere(kExitBadInput);
+  }
+  return checkpoints;
+}
+
+void print_unit_times(const Distribution& distribution, int ranks) {
+  std::vector<double> busy(static_cast<std::size_t>(ranks), 0.0);
+  std::vector<int> count(static_cast<std::size_t>(ranks), 0);
+  for (std::size_t i = 0; i < distribution.ranks.size(); ++i) {
+    const int r = distribution.ranks[i];
+    if (r < 0) continue;
+    busy[static_cast<std::size_t>(r)] += distribution.seconds[i];
+    ++count[static_cast<std::size_t>(r)];
+  }
+  for (int r = 0; r < ranks; ++r)
+    std::cerr << fmt::format("rank {}: {} units, {:.1f} s of work\n", r, count[static_cast<std::size_t>(r)],
+                             busy[static_cast<std::size_t>(r)]);
+}
+
+std::optional<int> unfinished_exit_status(const MpiSession& mpi, const DistributedRuns& runs,
+                                          const std::filesystem::path& checkpoint, int interrupted_status) {
+  const Distribution& d = runs.distribution;
+  switch (d.outcome) {
+    case Distribution::Outcome::Finished:
+      return std::nullopt;
+    case Distribution::Outcome::Interrupted:
+      if (mpi.is_root())
+        std::cerr << fmt::format("interrupted: every rank stopped at its next iteration boundary; progress is in {}\n"
+                                 "continue with the same command and --resume\n",
+                                 checkpoint.string());
+      return interrupted_status;
+    case Distribution::Outcome::Failed: {
+      if (!mpi.is_root()) return d.failure_exit;
+      std::string why = d.failure;
+      if (why.rfind("error: ", 0) == 0) why = why.substr(7);
+      std::cerr << fmt::format("error: rank {} of {} failed on {}: {}\nthe other ranks stopped at their next iteration "
+                               "boundary; all finished work is in {}; fix the cause and continue with --resume\n",
+                               d.failed_rank, mpi.size(), runs.failed_unit, why, checkpoint.string());
+      return d.failure_exit;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace gpilqg::cli

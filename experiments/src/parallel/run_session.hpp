@@ -1,0 +1,37 @@
+#pragma once
+/// @file run_session.hpp
+/// What `gpilqg run` and `gpilqg sweep` share around their work under MPI: opening the checkpoints
+/// on every rank, and turning how the work ended into messages and an exit status, printed once.
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "distributed_run.hpp"
+
+namespace gpilqg::cli {
+
+struct CheckpointRequest {
+  std::filesystem::path folder;
+  const RunConfig* config = nullptr;
+  const RunOptions* options = nullptr;
+};
+
+/// Every requested checkpoint, created (or opened with `resume`) on every rank. Rank 0 creates or
+/// checks them first; the other ranks then open them, which fails when the folders are not on a file
+/// system they see. An error on any rank stops every rank before the work starts, reported once by
+/// rank 0 (the others throw ReportedElsewhere).
+std::vector<RunCheckpoint> open_checkpoints(const MpiSession& mpi, const std::vector<CheckpointRequest>& requests,
+                                            bool resume);
+
+/// Which rank ran how many units for how long, on stderr: the numbers behind a cluster's time
+/// estimate (docs/cluster.md).
+void print_unit_times(const Distribution& distribution, int ranks);
+
+/// The exit status when the work did not finish, after printing once (rank 0) why: a failed unit
+/// (naming the rank and the unit, and where the finished work is) or an interruption. Nothing when
+/// every unit finished.
+std::optional<int> unfinished_exit_status(const MpiSession& mpi, const DistributedRuns& runs,
+                                          const std::filesystem::path& checkpoint, int interrupted_status);
+
+}  // namespace gpilqg::cli
