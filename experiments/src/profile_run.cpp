@@ -81,8 +81,35 @@ void ProfileOptions::validate(const ProfileData& data) const {
   }
 }
 
-ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options,
-                          const std::function<void(const ProfileRow&)>& progress) {
+namespace {
+
+/// The test set the rows are scored on: all of it, or the first max_test_points of a fixed permutation.
+void test_set(const ProfileData& data, const ProfileOptions& options, Matrix& inputs, Vector& targets) {
+  inputs = data.test_inputs;
+  targets = data.test_targets;
+  if (!options.max_test_points || *options.max_test_points >= data.test_inputs.rows()) return;
+  const auto rows = nested_subset(static_cast<int>(data.test_inputs.rows()), *options.max_test_points, options.fit.seed + 1);
+  inputs.resize(static_cast<Eigen::Index>(rows.size()), data.test_inputs.cols());
+  targets.resize(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    inputs.row(static_cast<Eigen::Index>(r)) = data.test_inputs.row(rows[r]);
+    targets(static_cast<Eigen::Index>(r)) = data.test_targets(rows[r]);
+  }
+}
+
+}  // namespace
+
+std::vector<ProfileCase> profile_cases(const ProfileData& data, const ProfileOptions& options) {
+  std::vector<ProfileCase> cases;
+  for (int requested : options.sizes) {
+    const int size = requested == 0 ? data.train.size() : requested;
+    if (data.reference) cases.push_back({"exact_reference", size});
+    for (const std::string& name : options.backends) cases.push_back({name, size});
+  }
+  return cases;
+}
+
+ProfileReport profile_report_header(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options) {
   options.validate(data);
   ProfileReport report;
   report.file = file.string();
@@ -91,23 +118,21 @@ ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& 
   report.data.target = data.target;
   report.data.train.inputs.resize(0, data.train.input_dim());
   report.options = options;
-  Matrix test_inputs = data.test_inputs;
-  Vector test_targets = data.test_targets;
-  if (options.max_test_points && *options.max_test_points < data.test_inputs.rows()) {
-    const auto rows = nested_subset(static_cast<int>(data.test_inputs.rows()), *options.max_test_points, options.fit.seed + 1);
-    test_inputs.resize(static_cast<Eigen::Index>(rows.size()), data.test_inputs.cols());
-    test_targets.resize(static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t r = 0; r < rows.size(); ++r) {
-      test_inputs.row(static_cast<Eigen::Index>(r)) = data.test_inputs.row(rows[r]);
-      test_targets(static_cast<Eigen::Index>(r)) = data.test_targets(rows[r]);
-    }
-  }
+  Matrix test_inputs;
+  Vector test_targets;
+  test_set(data, options, test_inputs, test_targets);
   report.test_points = static_cast<int>(test_inputs.rows());
+  return report;
+}
+
+ProfileRow run_profile_case(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options,
+                            const ProfileCase& c) {
+  Matrix test_inputs;
+  Vector test_targets;
+  test_set(data, options, test_inputs, test_targets);
   const auto order = nested_subset(data.train.size(), data.train.size(), options.fit.seed);
-  auto emit = [&](ProfileRow row) {
-    if (progress) progress(row);
-    report.rows.push_back(std::move(row));
-  };
+  const std::vector<int> rows(order.begin(), order.begin() + c.size);
+  const gp::TrainingSet subset = data.train.subset(rows);
   auto over_budget = [&](ProfileRow& row, bool fitted) {
     const double need = exact_memory_bytes(row.size, fitted);
     if (need <= options.memory_budget_bytes) return false;
@@ -116,61 +141,57 @@ ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& 
                              need / (1ull << 30), row.size, fitted ? 2 : 1, options.memory_budget_bytes / (1ull << 30));
     return true;
   };
-  for (int requested : options.sizes) {
-    const int size = requested == 0 ? data.train.size() : requested;
-    const std::vector<int> rows(order.begin(), order.begin() + size);
-    const gp::TrainingSet subset = data.train.subset(rows);
-    if (data.reference) {
-      ProfileRow row;
-      row.backend = "exact_reference";
-      row.size = size;
-      row.termination = "not optimised";
-      if (!over_budget(row, false)) {
-        const gp::ExactGpBackend exact(gp::ExactGpOptions{gp::ExactGpOptions::kAllPoints, options.settings.threads});
-        const auto start = Clock::now();
-        try {
-          const auto model = exact.condition(subset, data.reference->pack(), options.fit.jitter);
-          row.fit_seconds = seconds_since(start);
-          score(*model, test_inputs, test_targets, subset.targets, row);
-        } catch (const std::runtime_error& e) {
-          row.status = "failed";
-          row.reason = e.what();
-        } catch (const std::invalid_argument& e) {
-          throw data_error(file, row, e);
-        }
-      }
-      emit(row);
+  ProfileRow row;
+  row.backend = c.backend;
+  row.size = c.size;
+  if (c.backend == "exact_reference") {
+    row.termination = "not optimised";
+    if (over_budget(row, false)) return row;
+    const gp::ExactGpBackend exact(gp::ExactGpOptions{gp::ExactGpOptions::kAllPoints, options.settings.threads});
+    const auto start = Clock::now();
+    try {
+      const auto model = exact.condition(subset, data.reference->pack(), options.fit.jitter);
+      row.fit_seconds = seconds_since(start);
+      score(*model, test_inputs, test_targets, subset.targets, row);
+    } catch (const std::runtime_error& e) {
+      row.status = "failed";
+      row.reason = e.what();
+    } catch (const std::invalid_argument& e) {
+      throw data_error(file, row, e);
     }
-    for (const std::string& name : options.backends) {
-      ProfileRow row;
-      row.backend = name;
-      row.size = size;
-      if (name == "exact" && over_budget(row, true)) {
-        emit(row);
-        continue;
-      }
-      gp::BackendSettings settings = options.settings;
-      settings.exact_points = size;
-      const auto backend = gp::make_backend(name, settings);
-      try {
-        gp::FitOptions fit_options = options.fit;
-        if (options.start_from_reference) {  // the full vector: reference hyperparameters + the backend's extras
-          fit_options.warm_start = backend->objective(subset, fit_options)->initial_parameters();
-          fit_options.warm_start.head(gp::Hyperparameters::count(subset.input_dim())) = data.reference->pack();
-        }
-        const gp::FitResult fit = backend->fit(subset, fit_options);
-        row.fit_seconds = fit.summary.seconds;
-        row.evaluations = fit.summary.evaluations;
-        row.termination = std::string(gp::to_string(fit.summary.termination));
-        score(*fit.model, test_inputs, test_targets, subset.targets, row);
-      } catch (const std::runtime_error& e) {  // e.g. conditioning failed even with jitter
-        row.status = "failed";
-        row.reason = e.what();
-      } catch (const std::invalid_argument& e) {  // e.g. constant targets
-        throw data_error(file, row, e);
-      }
-      emit(row);
+    return row;
+  }
+  if (c.backend == "exact" && over_budget(row, true)) return row;
+  gp::BackendSettings settings = options.settings;
+  settings.exact_points = c.size;
+  const auto backend = gp::make_backend(c.backend, settings);
+  try {
+    gp::FitOptions fit_options = options.fit;
+    if (options.start_from_reference) {  // the full vector: reference hyperparameters + the backend's extras
+      fit_options.warm_start = backend->objective(subset, fit_options)->initial_parameters();
+      fit_options.warm_start.head(gp::Hyperparameters::count(subset.input_dim())) = data.reference->pack();
     }
+    const gp::FitResult fit = backend->fit(subset, fit_options);
+    row.fit_seconds = fit.summary.seconds;
+    row.evaluations = fit.summary.evaluations;
+    row.termination = std::string(gp::to_string(fit.summary.termination));
+    score(*fit.model, test_inputs, test_targets, subset.targets, row);
+  } catch (const std::runtime_error& e) {  // e.g. conditioning failed even with jitter
+    row.status = "failed";
+    row.reason = e.what();
+  } catch (const std::invalid_argument& e) {  // e.g. constant targets
+    throw data_error(file, row, e);
+  }
+  return row;
+}
+
+ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options,
+                          const std::function<void(const ProfileRow&)>& progress) {
+  ProfileReport report = profile_report_header(file, data, options);
+  for (const ProfileCase& c : profile_cases(data, options)) {
+    ProfileRow row = run_profile_case(file, data, options, c);
+    if (progress) progress(row);
+    report.rows.push_back(std::move(row));
   }
   return report;
 }

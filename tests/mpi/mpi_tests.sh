@@ -12,6 +12,7 @@
 #   sweep    a 2 x 2 sweep (gp.backend x loop.rollouts, 2 seeds) over 2 ranks equals the single-process
 #            sweep; a grid point equals `gpilqg run` with that point's config; the summary figure is
 #            written; a grid field the run config does not have is refused naming it
+#   profile  `gpilqg profile` over 2 ranks reports the single process's rows (every number but the times)
 # Each case works in its own temporary folder.
 set -euo pipefail
 gpilqg="$1"; mpiexec="$2"; case_name="$3"
@@ -106,6 +107,21 @@ sweep)
   status=$?
   set -e
   [ "$status" -eq 2 ] && grep -q "^error: .*typo.toml.*gp.bakend" typo.log || { cat typo.log; fail "an unknown grid field was not refused by name"; }
+  ;;
+profile)
+  data="$here/../../data/cartpole_hidden_friction.csv"
+  args=(profile "$data" --system cartpole --backends exact,fitc,ssgp --sizes 100,300 --json)
+  "$gpilqg" "${args[@]}" > single.json 2> single.log || { cat single.log; fail "the single-process profile failed"; }
+  mpi 2 "$gpilqg" "${args[@]}" > mpi.json 2> mpi.log || { cat mpi.log; fail "mpirun profile exited $?"; }
+  grep -q '^\[rank 1\] profile: ' mpi.log || { cat mpi.log; fail "rank 1 profiled nothing"; }
+  $python - single.json mpi.json <<'PY' || fail "the profile over 2 ranks differs from the single process's"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+untimed = lambda rows: [{k: v for k, v in r.items() if not k.endswith("_s")} for r in rows]
+assert len(a["rows"]) == 6, len(a["rows"])
+assert untimed(a["rows"]) == untimed(b["rows"]), "rows differ"
+assert {k: v for k, v in a.items() if k != "rows"} == {k: v for k, v in b.items() if k != "rows"}, "header differs"
+PY
   ;;
 *)
   fail "unknown case '$case_name'"

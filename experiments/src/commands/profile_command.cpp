@@ -11,6 +11,8 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "output_options.hpp"
+#include "parallel/mpi_session.hpp"
+#include "parallel/unit_distribution.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/profile.hpp"
@@ -35,7 +37,45 @@ struct ProfileCommandOptions {
   int max_test = 0;
   double memory_budget_gb = 4.0;
   gp::BackendSettings settings;
+  bool threads_given = false;  ///< --threads on the command line (else under MPI: each rank's share)
 };
+
+/// Rough relative cost of a row, for the order in which ranks take them (unit_scheduler.hpp): the
+/// dense exact GP grows as N^3, the approximations about linearly.
+double expected_cost(const ProfileCase& c) {
+  const double n = c.size / 1000.0;
+  return 1e-3 + (c.backend.rfind("exact", 0) == 0 ? n * n * n : n);
+}
+
+/// The rows on every rank of `mpirun` (or in order in one process); rank 0 gets them all, in report
+/// order; the other ranks get nothing.
+std::vector<ProfileRow> profile_rows(const MpiSession& mpi, const std::filesystem::path& file, const ProfileData& data,
+                                     const ProfileOptions& options, const std::function<void(const ProfileRow&)>& progress) {
+  const std::vector<ProfileCase> cases = profile_cases(data, options);
+  std::vector<double> weights;
+  for (const auto& c : cases) weights.push_back(expected_cost(c));
+  UnitScheduler scheduler(std::vector<std::vector<int>>(cases.size()), weights);
+  const UnitWork work = [&](int index, const std::function<bool()>&) {
+    ProfileRow row = run_profile_case(file, data, options, cases[static_cast<std::size_t>(index)]);
+    progress(row);
+    return profile_row_bytes(row);
+  };
+  const Distribution d = distribute_units(mpi, scheduler, work, [] { return false; });
+  if (d.outcome == Distribution::Outcome::Failed) {
+    if (!mpi.is_root()) throw ReportedElsewhere(d.failure_exit);
+    const ProfileCase& c = cases.at(static_cast<std::size_t>(d.failed_unit));
+    std::string why = d.failure;
+    if (why.rfind("error: ", 0) == 0) why = why.substr(7);
+    const std::string message = fmt::format("rank {} of {} failed on backend '{}', N = {}: {}", d.failed_rank, mpi.size(),
+                                            c.backend, c.size, why);
+    if (d.failure_exit == kExitBadInput) throw InputError(message);
+    throw std::runtime_error(message);
+  }
+  std::vector<ProfileRow> rows;
+  if (mpi.is_root())
+    for (const auto& bytes : d.payloads) rows.push_back(profile_row_from_bytes(bytes));
+  return rows;
+}
 
 /// "1000, 5000,all" -> {1000, 5000, 0}; InputError naming the entry.
 std::vector<int> parse_sizes(const std::string& list) {
@@ -69,6 +109,7 @@ std::vector<int> parse_sizes(const std::string& list) {
 }
 
 int run_profile_command(ProfileCommandOptions& o) {
+  const MpiSession mpi;
   check_output_file_option("--out", o.out);
   check_output_folder_option("--plots", o.plots);
   if (o.target == "residual")
@@ -95,10 +136,14 @@ int run_profile_command(ProfileCommandOptions& o) {
   options.start_from_reference = o.start == "reference";
   const ProfileData data = read_profile_data(o.file, o.data);
   options.validate(data);
-  const ProfileReport report = run_profile(o.file, data, options, [&](const ProfileRow& row) {
-    std::cerr << fmt::format("profile: {} N={} {} fit {:.3f} s, predict {:.3f} s{}\n", row.backend, row.size, row.status,
-                             row.fit_seconds, row.predict_seconds, row.reason.empty() ? "" : " (" + row.reason + ")");
+  if (mpi.distributed() && !o.threads_given) options.settings.threads = mpi.threads_per_rank();
+  const std::string rank_prefix = mpi.distributed() ? fmt::format("[rank {}] ", mpi.rank()) : "";
+  ProfileReport report = profile_report_header(o.file, data, options);
+  report.rows = profile_rows(mpi, o.file, data, options, [&](const ProfileRow& row) {
+    std::cerr << fmt::format("{}profile: {} N={} {} fit {:.3f} s, predict {:.3f} s{}\n", rank_prefix, row.backend, row.size,
+                             row.status, row.fit_seconds, row.predict_seconds, row.reason.empty() ? "" : " (" + row.reason + ")");
   });
+  if (!mpi.is_root()) return kExitSuccess;
   std::filesystem::path h5 = o.out;
   if (!o.out.empty()) write_profile_hdf5(o.out, report);
   if (!o.plots.empty()) {
@@ -169,7 +214,7 @@ void add_profile_command(CLI::App& app, CommandAction& action) {
                   "compact: each support radius may grow by this / --compact-neighbours during the fit")
       ->capture_default_str()
       ->check(integer_in(1, limits::kMaxNeighbours));
-  cmd->add_option("--threads", o->settings.threads, "Threads inside one fit")
+  cmd->add_option("--threads", o->settings.threads, "Threads inside one fit (under MPI default: each rank's share of its machine)")
       ->capture_default_str()
       ->check(integer_in(1, limits::kMaxThreads));
   cmd->add_option("--system", o->data.system, std::string("Measurement sets: the system. ") + kSystemHelp);
@@ -180,7 +225,10 @@ void add_profile_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--test-every", o->data.test_every, "Measurement sets: every k-th sample is held out for testing")
       ->capture_default_str()
       ->check(integer_in(2, limits::kMaxSamples));
-  cmd->callback([o, &action] { action = [o] { return run_profile_command(*o); }; });
+  cmd->callback([o, cmd, &action] {
+    o->threads_given = cmd->count("--threads") > 0;
+    action = [o] { return run_profile_command(*o); };
+  });
 }
 
 }  // namespace gpilqg::cli

@@ -100,6 +100,29 @@ struct ProfileReport {
   std::vector<ProfileRow> rows;
 };
 
+/// One row of the report: a backend (or "exact_reference") at one training-set size.
+struct ProfileCase {
+  std::string backend;
+  int size = 0;
+};
+
+/// The rows run_profile computes, in report order: per size the reference row (when the data has
+/// reference hyperparameters), then every backend. Each is independent of the others, so
+/// `mpirun -np K gpilqg profile` runs them on K ranks.
+std::vector<ProfileCase> profile_cases(const ProfileData& data, const ProfileOptions& options);
+
+/// The report without rows (file, data summary, options, test points); validates the options.
+ProfileReport profile_report_header(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options);
+
+/// One row: the fit (or, for "exact_reference", the conditioning) on the nested subset of that size,
+/// then the scores; a skipped or failed row says why. Throws like run_profile.
+ProfileRow run_profile_case(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options,
+                            const ProfileCase& c);
+
+/// A row as bytes and back, every number bit for bit (rows travel from the ranks to rank 0).
+std::string profile_row_bytes(const ProfileRow& row);
+ProfileRow profile_row_from_bytes(const std::string& bytes);
+
 /// Runs everything; `progress` (may be empty) gets one line per finished row. A backend that refuses
 /// the data (std::invalid_argument, e.g. constant targets) is an InputError starting with `file`.
 ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options,
