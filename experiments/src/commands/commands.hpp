@@ -31,6 +31,9 @@ void add_diagnose_command(CLI::App& app, CommandAction& action);
 /// `gpilqg run SYSTEM [--config F] [--seeds N] [--iterations K] [--backends LIST] [--out F.h5] [--plots DIR]`
 void add_run_command(CLI::App& app, CommandAction& action);
 
+/// `gpilqg merge PART.h5... --out F.h5 [--plots DIR] [--no-plots]`
+void add_merge_command(CLI::App& app, CommandAction& action);
+
 /// `gpilqg profile DATA --backends LIST [--sizes LIST] [--json] [--out F.h5] [--plots DIR]`
 void add_profile_command(CLI::App& app, CommandAction& action);
 

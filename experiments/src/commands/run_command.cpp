@@ -104,7 +104,7 @@ int run_command(const RunArguments& a) {
   print_summary(results);
   std::cout << fmt::format("\nresults: {}\n", out.string());
   if (a.no_plots) return kExitSuccess;
-  const std::filesystem::path plots = a.plots.empty() ? (out.has_parent_path() ? out.parent_path() : std::filesystem::path(".")) : std::filesystem::path(a.plots);
+  const std::filesystem::path plots = figures_folder(out, a.plots);
   run_plot_script("plot_run.py", out, plots);
   std::cout << fmt::format("figures: {}\n", plots.string());
   return kExitSuccess;
