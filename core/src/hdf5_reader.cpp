@@ -105,6 +105,25 @@ std::vector<std::string> Hdf5Reader::datasets(const std::string& group) const {
   return out;
 }
 
+std::optional<std::string> Hdf5Reader::soft_link_target(const std::string& path) const {
+  const std::size_t slash = path.find_last_of('/');
+  const std::string parent = slash == std::string::npos || slash == 0 ? "/" : path.substr(0, slash);
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  if (name.empty() || !exists(parent)) return std::nullopt;
+  return guarded(file_, path, "reading link", [&]() -> std::optional<std::string> {
+    if (parent != "/" && impl_->file.childObjType(parent) != H5O_TYPE_GROUP) return std::nullopt;
+    const H5::Group g = impl_->file.openGroup(parent);
+    if (!g.nameExists(name)) return std::nullopt;
+    H5L_info_t info;
+    if (H5Lget_info(g.getId(), name.c_str(), &info, H5P_DEFAULT) < 0 || info.type != H5L_TYPE_SOFT) return std::nullopt;
+    std::string target(info.u.val_size, '\0');
+    if (H5Lget_val(g.getId(), name.c_str(), target.data(), target.size(), H5P_DEFAULT) < 0)
+      throw std::runtime_error(file_.string() + ": the soft link '" + path + "' cannot be read");
+    target.resize(target.find('\0') == std::string::npos ? target.size() : target.find('\0'));
+    return target;
+  });
+}
+
 std::vector<std::uint64_t> Hdf5Reader::shape(const std::string& path) const {
   return guarded(file_, path, "reading the shape of dataset", [&] {
     const H5::DataSpace space = impl_->file.openDataSet(path).getSpace();
@@ -160,6 +179,18 @@ bool Hdf5Reader::has_attribute(const std::string& object, const std::string& nam
     H5::Group g;
     H5::DataSet d;
     return impl_->object(object, g, d).attrExists(name);
+  });
+}
+
+std::vector<std::string> Hdf5Reader::attributes(const std::string& object) const {
+  return guarded(file_, object, "listing the attributes of", [&] {
+    H5::Group g;
+    H5::DataSet d;
+    const H5::H5Object& holder = impl_->object(object, g, d);
+    std::vector<std::string> names;
+    for (int i = 0; i < holder.getNumAttrs(); ++i) names.push_back(holder.openAttribute(static_cast<unsigned>(i)).getName());
+    std::sort(names.begin(), names.end());
+    return names;
   });
 }
 

@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
   gpilqg::cli::add_diagnose_command(app, action);
   gpilqg::cli::add_run_command(app, action);
   gpilqg::cli::add_sweep_command(app, action);
+  gpilqg::cli::add_merge_command(app, action);
   gpilqg::cli::add_profile_command(app, action);
   gpilqg::cli::add_plan_command(app, action);
   gpilqg::cli::add_rollout_command(app, action);

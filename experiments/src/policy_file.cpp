@@ -40,19 +40,6 @@ void check_shapes(const PolicyFile& p) {
   if (!std::isfinite(p.predicted_cost) || !std::isfinite(p.expected_cost)) fail("the costs must be finite");
 }
 
-/// The reader's failures as bad input, naming the file (Hdf5Reader's messages already do).
-template <typename F>
-auto as_input_error(const std::filesystem::path& file, F&& read) {
-  try {
-    return read();
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    const std::string what = e.what();
-    throw InputError(what.rfind(file.string(), 0) == 0 ? what : file.string() + ": " + what);
-  }
-}
-
 }  // namespace
 
 AffinePolicy file_policy(const AffinePolicy& policy) {

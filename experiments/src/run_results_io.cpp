@@ -1,5 +1,7 @@
 #include "gpilqg/experiments/run_results_io.hpp"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <ctime>
 
@@ -176,7 +178,7 @@ void write_run_results_to(Hdf5Writer& h5, const std::string& root, const RunResu
   std::vector<std::string> state_names;
   for (const auto& q : signature.states) state_names.push_back(q.name);
 
-  h5.attribute(here, "schema_version", std::int64_t{1});
+  h5.attribute(here, "schema_version", kRunResultsSchemaVersion);
   h5.attribute(here, "gpilqg_version", std::string(kVersionString));
   h5.attribute(here, "config", c.text);
   h5.attribute(here, "seed", static_cast<std::int64_t>(results.options.seeds.front()));
@@ -203,6 +205,53 @@ void write_run_results_to(Hdf5Writer& h5, const std::string& root, const RunResu
   }
 }
 
+namespace {
+
+/// The per-iteration matrices (K+1 x S) of an algorithm's group.
+constexpr std::array<std::string_view, 10> kIterationBySeed = {
+    "cost", "normalised_cost", "time_fit", "time_solve", "time_rollouts", "time_evaluation",
+    "data_rows", "repeated", "diverged", "policy_change"};
+/// The datasets of an algorithm's iter_<k>/ group (S x ...).
+constexpr std::array<std::string_view, 8> kPlanBySeed = {"x", "u", "K", "k", "eval_x", "eval_u", "predicted_cost", "solve_time"};
+
+bool is_one_of(std::string_view name, const auto& names) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+/// "iter_<k>/<leaf>" -> "<leaf>"; empty when `dataset` is not in an iter_<k> group.
+std::string_view iteration_leaf(std::string_view dataset) {
+  constexpr std::string_view prefix = "iter_";
+  if (dataset.substr(0, prefix.size()) != prefix) return {};
+  const std::size_t slash = dataset.find('/');
+  const std::string_view k = dataset.substr(prefix.size(), slash == std::string_view::npos ? 0 : slash - prefix.size());
+  if (k.empty() || !std::all_of(k.begin(), k.end(), [](char c) { return c >= '0' && c <= '9'; })) return {};
+  return dataset.substr(slash + 1);
+}
+
+/// "gp/<state>/<leaf>" -> "<leaf>"; empty when `dataset` is not in a gp/<state> group.
+std::string_view gp_leaf(std::string_view dataset) {
+  constexpr std::string_view prefix = "gp/";
+  if (dataset.substr(0, prefix.size()) != prefix) return {};
+  const std::size_t slash = dataset.find('/', prefix.size());
+  if (slash == std::string_view::npos || slash == prefix.size()) return {};
+  return dataset.substr(slash + 1);
+}
+
+}  // namespace
+
+std::optional<std::size_t> seed_axis(std::string_view dataset) {
+  if (is_one_of(dataset, kIterationBySeed) || dataset == "evaluation_costs") return 1;
+  if (dataset == "converged_at") return 0;
+  if (is_one_of(iteration_leaf(dataset), kPlanBySeed)) return 0;
+  const std::string_view gp = gp_leaf(dataset);
+  if (gp == "hyper" || gp == "fitted") return 1;
+  return std::nullopt;
+}
+
+bool is_wall_clock_time(std::string_view dataset) {
+  return dataset == "time_fit" || dataset == "time_solve" || dataset == "time_rollouts" || dataset == "time_evaluation" ||
+         iteration_leaf(dataset) == "solve_time";
+}
 
 void write_run_results(const std::filesystem::path& file, const RunResults& results) {
   write_atomically(file, [&](const std::filesystem::path& temporary) {

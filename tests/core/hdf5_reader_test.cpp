@@ -1,5 +1,6 @@
 /// Hdf5Reader reads back exactly what Hdf5Writer wrote (bit for bit, shapes kept), lists datasets
-/// without following soft links, and names the file and object in every error.
+/// without following soft links (whose targets it reads) and attributes, and names the file and
+/// object in every error.
 
 #include "gpilqg/core/hdf5_reader.hpp"
 
@@ -56,6 +57,14 @@ TEST(Hdf5Reader, ReadsBackWhatTheWriterWroteBitForBit) {
   EXPECT_FALSE(h5.exists("/s/under_a_dataset"));
   EXPECT_EQ(h5.datasets(), (std::vector<std::string>{"/g/a", "/g/empty", "/g/h/cube", "/g/v", "/s"}));
   EXPECT_EQ(h5.datasets("/g/h"), (std::vector<std::string>{"/g/h/cube"}));
+  EXPECT_EQ(h5.soft_link_target("/alias"), std::optional<std::string>("/g/a"));
+  EXPECT_EQ(h5.soft_link_target("/g/a"), std::nullopt);
+  EXPECT_EQ(h5.soft_link_target("/g"), std::nullopt);
+  EXPECT_EQ(h5.soft_link_target("/g/nothing/deeper"), std::nullopt);
+  EXPECT_EQ(h5.soft_link_target("/s/under_a_dataset"), std::nullopt);
+  EXPECT_EQ(h5.attributes("/"), (std::vector<std::string>{"list", "name"}));
+  EXPECT_EQ(h5.attributes("/g/v"), (std::vector<std::string>{"count"}));
+  EXPECT_TRUE(h5.attributes("/g/h").empty());
   std::filesystem::remove_all(dir);
 }
 

@@ -50,16 +50,23 @@ std::vector<std::string> listing(const fs::path& folder) {
   return names;
 }
 
-/// The inputs every writer below reads: a measurement file, a run and a plan config, a policy file.
+/// The inputs every writer below reads: a measurement file, a run and a plan config, a policy file,
+/// two run results of one seed each.
 struct Inputs {
-  fs::path data, run_config, plan_config, policy;
+  fs::path data, run_config, plan_config, policy, seed_1, seed_2, sweep;
 };
 
 Inputs make_inputs(const fs::path& dir) {
   Inputs in{dir / "data.csv", write(dir / "run.toml", test::kTinyRun), write(dir / "plan.toml", test::kTinyPlan),
-            dir / "policy.h5"};
+            dir / "policy.h5", dir / "seed_1.h5", dir / "seed_2.h5",
+            write(dir / "sweep.toml", "system = \"cartpole\"\nconfig = \"run.toml\"\n[grid]\n\"loop.rollouts\" = [1, 2]\n")};
   EXPECT_EQ(test::run_cli("simulate --system cartpole --episodes 4 --steps 60 --out " + quote(in.data)).status, 0);
   EXPECT_EQ(test::run_cli("plan " + quote(in.plan_config) + " --out " + quote(in.policy)).status, 0);
+  for (const auto& [seed, part] : {std::pair{"1", in.seed_1}, std::pair{"2", in.seed_2}})
+    EXPECT_EQ(test::run_cli("run cartpole --config " + quote(in.run_config) + " --first-seed " + seed + " --no-plots --out " +
+                            quote(part))
+                  .status,
+              0);
   return in;
 }
 
@@ -79,6 +86,8 @@ std::vector<Writer> writers(const Inputs& in) {
        "model.toml"},
       {"profile --out", "profile " + quote(in.data) + " --system cartpole --backends exact --sizes 60 --out {out}", "profile.h5"},
       {"run --out", "run cartpole --config " + quote(in.run_config) + " --no-plots --out {out}", "run.h5"},
+      {"sweep --out", "sweep " + quote(in.sweep) + " --no-plots --out {out}", "sweep.h5"},
+      {"merge --out", "merge " + quote(in.seed_1) + " " + quote(in.seed_2) + " --no-plots --out {out}", "merged.h5"},
       {"plan --out", "plan " + quote(in.plan_config) + " --out {out}", "policy.h5"},
       {"rollout --out", "rollout --system cartpole --policy " + quote(in.policy) + " --out {out}", "log.csv"},
   };
@@ -238,7 +247,7 @@ transfer = false
       {"simulate --system cartpole --observation-noise -1" + out, "--observation-noise: is -1; expected a finite number >= 0"},
       {"simulate --system cartpole --param pole_length=inf" + out, "--param 'pole_length=inf': the value is not a finite number"},
       {"rollout --system cartpole --policy p.h5 --x0 1e300,0,0,0" + out, "--x0: is 1e300; expected a finite number >= -1000000000000 and <= 1000000000000"},
-      {"frobnicate", "error: unknown command 'frobnicate'; expected one of: data, solve, simulate, diagnose, run, profile, plan, rollout"},
+      {"frobnicate", "error: unknown command 'frobnicate'; expected one of: data, solve, simulate, diagnose, run, sweep, merge, profile, plan, rollout"},
   };
   for (const Case& c : cases) {
     const auto r = test::run_cli(c.arguments);

@@ -19,8 +19,8 @@
 #include <gtest/gtest.h>
 
 #include "gpilqg/core/atomic_file.hpp"
-#include "gpilqg/core/hdf5_reader.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
+#include "result_files.hpp"
 #include "same_run_results.hpp"
 #include "test_support.hpp"
 #include "tiny_run_config.hpp"
@@ -153,25 +153,6 @@ bool wait_for_checkpoint_files(const std::filesystem::path& folder, int files, p
   return false;
 }
 
-/// Every dataset of two result files except the wall-clock timings.
-void expect_same_result_files(const std::filesystem::path& resumed, const std::filesystem::path& reference) {
-  const Hdf5Reader a(resumed), b(reference);
-  const auto names = b.datasets();
-  ASSERT_EQ(a.datasets(), names);
-  int compared = 0;
-  for (const auto& name : names) {
-    const std::string leaf = name.substr(name.find_last_of('/') + 1);
-    if (leaf.rfind("time_", 0) == 0 || leaf == "solve_time") continue;
-    EXPECT_EQ(a.shape(name), b.shape(name)) << name;
-    const auto x = a.read_array(name), y = b.read_array(name);
-    bool same = x.size() == y.size();
-    for (std::size_t i = 0; same && i < x.size(); ++i) same = x[i] == y[i] || (std::isnan(x[i]) && std::isnan(y[i]));
-    EXPECT_TRUE(same) << name;
-    ++compared;
-  }
-  EXPECT_GT(compared, 100);
-}
-
 class RunSignals : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -196,7 +177,7 @@ class RunSignals : public ::testing::Test {
     ASSERT_EQ(resumed.status, 0) << resumed.err;
     EXPECT_NE(resumed.err.find("resumed after iteration"), std::string::npos) << resumed.err;
     EXPECT_FALSE(std::filesystem::exists(RunCheckpoint::folder_for(out))) << "the checkpoint outlived the finished run";
-    expect_same_result_files(out, reference_);
+    test::expect_same_result_files(out, reference_);
   }
 
   std::filesystem::path dir_, config_, reference_;

@@ -34,6 +34,9 @@ void add_run_command(CLI::App& app, CommandAction& action);
 /// `gpilqg sweep SWEEP.toml [--out F.h5] [--plots DIR] [--resume]`
 void add_sweep_command(CLI::App& app, CommandAction& action);
 
+/// `gpilqg merge PART.h5... --out F.h5 [--plots DIR] [--no-plots]`
+void add_merge_command(CLI::App& app, CommandAction& action);
+
 /// `gpilqg profile DATA --backends LIST [--sizes LIST] [--json] [--out F.h5] [--plots DIR]`
 void add_profile_command(CLI::App& app, CommandAction& action);
 

@@ -35,6 +35,11 @@ void check_output_file_option(const std::string& option, const std::filesystem::
   remove_and_name(stale_temporaries(file));
 }
 
+std::filesystem::path figures_folder(const std::filesystem::path& result, const std::string& plots) {
+  if (!plots.empty()) return plots;
+  return result.has_parent_path() ? result.parent_path() : std::filesystem::path(".");
+}
+
 void check_output_folder_option(const std::string& option, const std::filesystem::path& folder) {
   if (folder.empty()) return;
   if (const auto problem = output_folder_problem(folder))
@@ -42,10 +47,5 @@ void check_output_folder_option(const std::string& option, const std::filesystem
 }
 
 void remove_stale_temporaries_in(const std::filesystem::path& folder) { remove_and_name(stale_temporaries_in(folder)); }
-
-std::filesystem::path figures_folder(const std::filesystem::path& result, const std::string& plots_option) {
-  if (!plots_option.empty()) return plots_option;
-  return result.has_parent_path() ? result.parent_path() : std::filesystem::path(".");
-}
 
 }  // namespace gpilqg::cli

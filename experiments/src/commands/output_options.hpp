@@ -16,8 +16,9 @@ void check_output_file_option(const std::string& option, const std::filesystem::
 /// Checks `folder` with output_folder_problem; an empty path passes.
 void check_output_folder_option(const std::string& option, const std::filesystem::path& folder);
 
-/// Where a command's figures go: the --plots folder when given, else the result file's folder.
-std::filesystem::path figures_folder(const std::filesystem::path& result, const std::string& plots_option);
+/// Where the figures of the result file `result` go: the --plots folder `plots` when given, else the
+/// result's own folder.
+std::filesystem::path figures_folder(const std::filesystem::path& result, const std::string& plots);
 
 /// Removes the temporaries of interrupted writes in `folder` (stale_temporaries_in), naming them on stderr.
 void remove_stale_temporaries_in(const std::filesystem::path& folder);

@@ -83,7 +83,15 @@ int sweep_command(const SweepArguments& a) {
     throw InputError(fmt::format("{}: a checkpoint of an interrupted sweep is in the way; continue that sweep with --resume, "
                                  "or delete the folder to start over",
                                  folder.string()));
-  std::vector<RunCheckpoint> checkpoints = open_checkpoints(mpi, requests, a.resume);
+  const bool folder_existed = std::filesystem::exists(folder);
+  std::vector<RunCheckpoint> checkpoints;
+  try {
+    checkpoints = open_checkpoints(mpi, requests, a.resume);
+  } catch (...) {
+    std::error_code ignored;
+    if (mpi.is_root() && !folder_existed) std::filesystem::remove(folder, ignored);  // only when empty
+    throw;
+  }
   const StopSignalGuard stop_signal;
   std::vector<RunPart> parts;
   for (std::size_t p = 0; p < sweep.points.size(); ++p) {

@@ -10,12 +10,25 @@
 namespace gpilqg::cli {
 namespace {
 
+/// Creates (or opens) every checkpoint; when creating one fails, the ones created before it go too,
+/// so a failed start leaves nothing that a later start would take for an interrupted run.
 std::vector<RunCheckpoint> open_all(const std::vector<CheckpointRequest>& requests, bool create) {
   std::vector<RunCheckpoint> out;
-  for (const auto& r : requests) {
-    out.push_back(create ? RunCheckpoint::create(r.folder, *r.config, *r.options)
-                         : RunCheckpoint::resume(r.folder, *r.config, *r.options));
-    remove_stale_temporaries_in(r.folder);  // of writes that a kill interrupted
+  try {
+    for (const auto& r : requests) {
+      out.push_back(create ? RunCheckpoint::create(r.folder, *r.config, *r.options)
+                           : RunCheckpoint::resume(r.folder, *r.config, *r.options));
+      remove_stale_temporaries_in(r.folder);  // of writes that a kill interrupted
+    }
+  } catch (...) {
+    if (create)
+      for (auto& checkpoint : out) {
+        try {
+          checkpoint.remove();
+        } catch (const std::exception&) {  // the original error is the one to report
+        }
+      }
+    throw;
   }
   return out;
 }

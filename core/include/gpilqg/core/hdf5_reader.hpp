@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,9 @@ class Hdf5Reader {
   bool exists(const std::string& path) const;
   /// The full paths of every dataset below `group` ("/": the whole file), depth first, sorted by name.
   std::vector<std::string> datasets(const std::string& group = "/") const;
+  /// The target path of the soft link at `path` (what Hdf5Writer::link stored, e.g. "/task/gp_ilqg_exact");
+  /// std::nullopt when nothing is at `path` or it is a group or dataset itself.
+  std::optional<std::string> soft_link_target(const std::string& path) const;
   /// The shape of the dataset at `path` (empty for a scalar).
   std::vector<std::uint64_t> shape(const std::string& path) const;
 
@@ -53,6 +57,8 @@ class Hdf5Reader {
   std::vector<double> number_list_attribute(const std::string& object, const std::string& name) const;
   std::vector<std::string> string_list_attribute(const std::string& object, const std::string& name) const;
   bool has_attribute(const std::string& object, const std::string& name) const;
+  /// The names of every attribute of a group or dataset, sorted.
+  std::vector<std::string> attributes(const std::string& object) const;
 
  private:
   struct Impl;

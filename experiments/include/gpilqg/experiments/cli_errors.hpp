@@ -5,6 +5,7 @@
 /// and the line, field or dataset; exit 1 on an internal failure; exit 128 + signal when a command
 /// stopped early on SIGINT or SIGTERM (`gpilqg run`, after saving its progress).
 
+#include <filesystem>
 #include <functional>
 #include <iosfwd>
 #include <stdexcept>
@@ -37,6 +38,21 @@ class ReportedElsewhere : public std::exception {
  private:
   int exit_status_;
 };
+
+/// Runs `read`, which reads the input file `file`, and returns what it returns; any failure becomes an
+/// InputError naming the file (the message kept as it is when it starts with the file's name, as
+/// Hdf5Reader's do): a file that cannot be read as expected is bad input, not an internal failure.
+template <typename Read>
+auto as_input_error(const std::filesystem::path& file, Read&& read) {
+  try {
+    return read();
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    throw InputError(what.rfind(file.string(), 0) == 0 ? what : file.string() + ": " + what);
+  }
+}
 
 /// Runs `command` and turns exceptions into the exit-status contract, writing to `err`:
 /// DataError, InputError and std::invalid_argument -> "error: <message>", exit 2;

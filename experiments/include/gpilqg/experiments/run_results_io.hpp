@@ -14,7 +14,7 @@
 ///   /<task>/<algorithm>/normalised_cost  (K+1 x S) cost / ilqg_real's cost of the same seed
 ///   /<task>/<algorithm>/evaluation_costs (K+1 x S x E) the single rollouts behind `cost`
 ///   /<task>/<algorithm>/{time_fit, time_solve, time_rollouts, time_evaluation} (K+1 x S) [s]
-///   /<task>/<algorithm>/{data_rows, repeated, diverged} (K+1 x S); converged_at (S), -1: never
+///   /<task>/<algorithm>/{data_rows, repeated, diverged, policy_change} (K+1 x S); converged_at (S), -1: never
 ///   /<task>/<algorithm>/iter_<k>/x (S x n x T+1), u (S x m x T): the plan's nominal trajectory
 ///   /<task>/<algorithm>/iter_<k>/K (S x T x m x n), k (S x m x T): its feedback and feed-forward
 ///   /<task>/<algorithm>/iter_<k>/{predicted_cost, solve_time} (S)
@@ -27,13 +27,39 @@
 ///
 /// The file is written to a temporary name in the same folder and renamed into place, so a reader
 /// never sees a half-written result and an interrupted write leaves any previous file intact.
+///
+/// Where the seeds are: every dataset of an algorithm's group holds one slice per seed along the axis
+/// seed_axis() names; /<task>/data holds each row's seed in data/seed; /<task>/figure1 is the first
+/// seed's. Files of disjoint seeds join along these axes (`gpilqg merge`, run_merge.hpp).
 
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
+#include <optional>
+#include <string_view>
 
 #include "gpilqg/core/hdf5_writer.hpp"
 #include "gpilqg/experiments/run_experiment.hpp"
 
 namespace gpilqg {
+
+/// The root's schema_version: the version of the layout above.
+inline constexpr std::int64_t kRunResultsSchemaVersion = 1;
+
+/// The axis along which a dataset of /<task>/<algorithm>/ holds one slice per seed, the one table
+/// of it that the writer's layout and `gpilqg merge` share. `dataset` is relative to the algorithm's
+/// group ("cost", "iter_3/K", "gp/theta/hyper"):
+///   axis 1: the (K+1 x S) matrices (cost, normalised_cost, time_*, data_rows, repeated, diverged,
+///           policy_change), evaluation_costs (K+1 x S x E), gp/<state>/hyper (K+1 x S x D+2) and
+///           gp/<state>/fitted (K+1 x S);
+///   axis 0: converged_at (S) and every iter_<k>/ dataset (S x ...).
+/// std::nullopt: not a dataset of this layout (a file of another gpilqg version).
+std::optional<std::size_t> seed_axis(std::string_view dataset);
+
+/// Whether the dataset of an algorithm's group (named as for seed_axis) measures wall-clock time
+/// (time_fit, time_solve, time_rollouts, time_evaluation, iter_<k>/solve_time): the only numbers
+/// in which two runs of the same seed and config may differ.
+bool is_wall_clock_time(std::string_view dataset);
 
 /// Writes `results` atomically. Throws std::runtime_error naming the file when writing fails.
 void write_run_results(const std::filesystem::path& file, const RunResults& results);
