@@ -50,6 +50,14 @@ equal)
     $python "$here/same_results.py" single.h5 "mpi$np.h5" || fail "-np $np differs from the single-process result"
     [ ! -e "mpi$np.h5.checkpoint" ] || fail "the checkpoint of a finished run was left behind"
   done
+  # Bad input stops every rank before any work, reported once, exit 2 (no rank waits for another).
+  set +e
+  mpi 2 "$gpilqg" run cartpole --config missing.toml --out bad.h5 --no-plots > bad.log 2>&1
+  status=$?
+  set -e
+  [ "$status" -ne 0 ] || fail "a missing config exited 0"
+  [ "$(grep -c '^error: .*missing.toml' bad.log)" -eq 1 ] || { cat bad.log; fail "the error was not reported exactly once"; }
+  [ ! -e bad.h5.checkpoint ] || fail "bad input left a checkpoint"
   ;;
 resume)
   cat tiny.toml > slow.toml

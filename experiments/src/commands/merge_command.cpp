@@ -9,7 +9,6 @@
 #include "commands.hpp"
 #include "output_options.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
-#include "gpilqg/experiments/plot_script.hpp"
 #include "gpilqg/experiments/run_merge.hpp"
 
 namespace gpilqg::cli {
@@ -32,11 +31,7 @@ int merge_command(const MergeArguments& a) {
   std::cout << fmt::format("merged {} files: {} seed(s) ({})\n", summary.parts, summary.seeds.size(), fmt::join(summary.seeds, ", "));
   for (const MergedTask& task : summary.tasks)
     std::cout << fmt::format("  {}: {} ({} data rows)\n", task.name, fmt::join(task.algorithms, ", "), task.data_rows);
-  std::cout << fmt::format("\nresults: {}\n", out.string());
-  if (a.no_plots) return kExitSuccess;
-  const std::filesystem::path plots = figures_folder(out, a.plots);
-  run_plot_script("plot_run.py", out, plots);
-  std::cout << fmt::format("figures: {}\n", plots.string());
+  print_result_and_draw_figures("plot_run.py", out, a.plots, a.no_plots);
   return kExitSuccess;
 }
 

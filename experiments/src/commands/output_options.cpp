@@ -10,6 +10,7 @@
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/output_path.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/plot_script.hpp"
 
 namespace gpilqg::cli {
 
@@ -47,5 +48,14 @@ void check_output_folder_option(const std::string& option, const std::filesystem
 }
 
 void remove_stale_temporaries_in(const std::filesystem::path& folder) { remove_and_name(stale_temporaries_in(folder)); }
+
+void print_result_and_draw_figures(const std::string& script, const std::filesystem::path& result,
+                                   const std::string& plots, bool no_plots) {
+  std::cout << fmt::format("\nresults: {}\n", result.string());
+  if (no_plots) return;
+  const std::filesystem::path folder = figures_folder(result, plots);
+  run_plot_script(script, result, folder);
+  std::cout << fmt::format("figures: {}\n", folder.string());
+}
 
 }  // namespace gpilqg::cli

@@ -20,6 +20,12 @@ void check_output_folder_option(const std::string& option, const std::filesystem
 /// result's own folder.
 std::filesystem::path figures_folder(const std::filesystem::path& result, const std::string& plots);
 
+/// The end of a command that wrote a result file: prints "results: FILE", then (unless `no_plots`)
+/// draws its figures with `script` (plot_script.hpp) into figures_folder(result, plots) and prints
+/// "figures: DIR".
+void print_result_and_draw_figures(const std::string& script, const std::filesystem::path& result,
+                                   const std::string& plots, bool no_plots);
+
 /// Removes the temporaries of interrupted writes in `folder` (stale_temporaries_in), naming them on stderr.
 void remove_stale_temporaries_in(const std::filesystem::path& folder);
 

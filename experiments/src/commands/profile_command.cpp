@@ -12,6 +12,7 @@
 #include "option_checks.hpp"
 #include "output_options.hpp"
 #include "parallel/mpi_session.hpp"
+#include "parallel/run_session.hpp"
 #include "parallel/unit_distribution.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -110,32 +111,35 @@ std::vector<int> parse_sizes(const std::string& list) {
 
 int run_profile_command(ProfileCommandOptions& o) {
   const MpiSession mpi;
-  check_output_file_option("--out", o.out);
-  check_output_folder_option("--plots", o.plots);
-  if (o.target == "residual")
-    o.data.target = ProfileTarget::Residual;
-  else if (o.target == "increment")
-    o.data.target = ProfileTarget::Increment;
-  else
-    throw InputError("--target '" + o.target + "': expected 'residual' or 'increment'");
   ProfileOptions options;
-  try {
-    options.backends = gp::parse_backend_list(o.backends);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(std::string("--backends: ") + e.what());
-  }
-  options.sizes = parse_sizes(o.sizes);
-  options.settings = o.settings;
-  options.fit.restarts = o.restarts;
-  options.fit.max_evaluations = o.max_evaluations;
-  options.fit.seed = o.seed;
-  options.memory_budget_bytes = o.memory_budget_gb * static_cast<double>(1ull << 30);
-  if (o.max_test > 0) options.max_test_points = o.max_test;
-  if (o.start != "data" && o.start != "reference")
-    throw InputError("--start '" + o.start + "': expected 'data' or 'reference'");
-  options.start_from_reference = o.start == "reference";
-  const ProfileData data = read_profile_data(o.file, o.data);
-  options.validate(data);
+  ProfileData data;
+  every_rank_then_agree(mpi, [&] {
+    check_output_file_option("--out", o.out);
+    check_output_folder_option("--plots", o.plots);
+    if (o.target == "residual")
+      o.data.target = ProfileTarget::Residual;
+    else if (o.target == "increment")
+      o.data.target = ProfileTarget::Increment;
+    else
+      throw InputError("--target '" + o.target + "': expected 'residual' or 'increment'");
+    try {
+      options.backends = gp::parse_backend_list(o.backends);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(std::string("--backends: ") + e.what());
+    }
+    options.sizes = parse_sizes(o.sizes);
+    options.settings = o.settings;
+    options.fit.restarts = o.restarts;
+    options.fit.max_evaluations = o.max_evaluations;
+    options.fit.seed = o.seed;
+    options.memory_budget_bytes = o.memory_budget_gb * static_cast<double>(1ull << 30);
+    if (o.max_test > 0) options.max_test_points = o.max_test;
+    if (o.start != "data" && o.start != "reference")
+      throw InputError("--start '" + o.start + "': expected 'data' or 'reference'");
+    options.start_from_reference = o.start == "reference";
+    data = read_profile_data(o.file, o.data);
+    options.validate(data);
+  });
   if (mpi.distributed() && !o.threads_given) options.settings.threads = mpi.threads_per_rank();
   const std::string rank_prefix = mpi.distributed() ? fmt::format("[rank {}] ", mpi.rank()) : "";
   ProfileReport report = profile_report_header(o.file, data, options);

@@ -72,27 +72,33 @@ void print_summary(const RunResults& results) {
 int run_command(const RunArguments& a) {
   const MpiSession mpi;
   const std::filesystem::path out = a.out.empty() ? std::filesystem::path("out") / ("run_" + a.system + ".h5") : std::filesystem::path(a.out);
-  check_output_file_option("--out", out);
-  if (!a.no_plots) check_output_folder_option("--plots", a.plots);
-  if (a.first_seed + static_cast<std::uint64_t>(a.seeds) - 1 > limits::kMaxSeed)
-    throw InputError(fmt::format("--first-seed {} --seeds {}: the last seed exceeds {} (the largest seed)", a.first_seed, a.seeds,
-                                 limits::kMaxSeed));
-  RunConfig config = load_run_config(a.system, a.config.empty() ? std::nullopt : std::optional<std::filesystem::path>(a.config));
-  if (a.iterations > 0) config.iterations = a.iterations;  // validated by its option check
+  RunConfig config;
   RunOptions options;
-  options.seeds.clear();
-  for (int s = 0; s < a.seeds; ++s) options.seeds.push_back(a.first_seed + static_cast<std::uint64_t>(s));
-  if (!a.backends.empty()) {
-    try {
-      options.backends = gp::parse_backend_list(a.backends);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(fmt::format("--backends: {}", e.what()));
+  every_rank_then_agree(mpi, [&] {
+    check_output_file_option("--out", out);
+    if (!a.no_plots) check_output_folder_option("--plots", a.plots);
+    if (a.first_seed + static_cast<std::uint64_t>(a.seeds) - 1 > limits::kMaxSeed)
+      throw InputError(fmt::format("--first-seed {} --seeds {}: the last seed exceeds {} (the largest seed)", a.first_seed,
+                                   a.seeds, limits::kMaxSeed));
+    config = load_run_config(a.system, a.config.empty() ? std::nullopt : std::optional<std::filesystem::path>(a.config));
+    if (a.iterations > 0) config.iterations = a.iterations;  // validated by its option check
+    options.seeds.clear();
+    for (int s = 0; s < a.seeds; ++s) options.seeds.push_back(a.first_seed + static_cast<std::uint64_t>(s));
+    if (!a.backends.empty()) {
+      try {
+        options.backends = gp::parse_backend_list(a.backends);
+      } catch (const std::invalid_argument& e) {
+        throw InputError(fmt::format("--backends: {}", e.what()));
+      }
     }
-  }
+  });
   options.threads = a.threads > 0 ? a.threads : mpi.distributed() ? mpi.threads_per_rank() : kDefaultThreads;
   const std::string rank_prefix = mpi.distributed() ? fmt::format("[rank {}] ", mpi.rank()) : "";
   options.progress = [rank_prefix](const std::string& line) { std::cerr << rank_prefix + line + "\n" << std::flush; };
-  if (mpi.is_root() && out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
+  on_root_then_agree(mpi, [&] {
+    if (!a.no_plots) require_plotting("plot_run.py");  // before the work, not after
+    if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
+  });
 
   // Every completed iteration goes to the checkpoint folder beside the result (run_checkpoint.hpp);
   // Ctrl-C stops at the next iteration boundary, leaving any previous result file as it was.
@@ -123,11 +129,7 @@ int run_command(const RunArguments& a) {
   write_run_results(out, results);
   checkpoint.remove();
   print_summary(results);
-  std::cout << fmt::format("\nresults: {}\n", out.string());
-  if (a.no_plots) return kExitSuccess;
-  const std::filesystem::path plots = figures_folder(out, a.plots);
-  run_plot_script("plot_run.py", out, plots);
-  std::cout << fmt::format("figures: {}\n", plots.string());
+  print_result_and_draw_figures("plot_run.py", out, a.plots, a.no_plots);
   return kExitSuccess;
 }
 

@@ -60,10 +60,14 @@ void print_summary(const SweepConfig& sweep, const std::vector<RunResults>& resu
 
 int sweep_command(const SweepArguments& a) {
   const MpiSession mpi;
-  const SweepConfig sweep = load_sweep_config(a.file);
-  const std::filesystem::path out = a.out.empty() ? sweep.out : std::filesystem::path(a.out);
-  check_output_file_option(a.out.empty() ? "out (in the sweep file)" : "--out", out);
-  if (!a.no_plots) check_output_folder_option("--plots", a.plots);
+  SweepConfig sweep;
+  std::filesystem::path out;
+  every_rank_then_agree(mpi, [&] {
+    sweep = load_sweep_config(a.file);
+    out = a.out.empty() ? sweep.out : std::filesystem::path(a.out);
+    check_output_file_option(a.out.empty() ? "out (in the sweep file)" : "--out", out);
+    if (!a.no_plots) check_output_folder_option("--plots", a.plots);
+  });
   const std::string rank_prefix = mpi.distributed() ? fmt::format("[rank {}] ", mpi.rank()) : "";
   const int threads = a.threads > 0 ? a.threads : mpi.distributed() ? mpi.threads_per_rank() : kDefaultThreads;
 
@@ -78,12 +82,16 @@ int sweep_command(const SweepArguments& a) {
     options[p].progress = [prefix](const std::string& line) { std::cerr << prefix + line + "\n" << std::flush; };
     requests.push_back({folder / fmt::format("point-{}", p), &sweep.points[p].config, &options[p]});
   }
-  if (mpi.is_root() && out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
-  if (!a.resume && mpi.is_root() && std::filesystem::exists(folder) && !std::filesystem::is_empty(folder))
-    throw InputError(fmt::format("{}: a checkpoint of an interrupted sweep is in the way; continue that sweep with --resume, "
-                                 "or delete the folder to start over",
-                                 folder.string()));
-  const bool folder_existed = std::filesystem::exists(folder);
+  bool folder_existed = false;
+  on_root_then_agree(mpi, [&] {
+    if (!a.no_plots) require_plotting("plot_sweep.py");  // before the work, not after
+    if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
+    folder_existed = std::filesystem::exists(folder);
+    if (!a.resume && folder_existed && !std::filesystem::is_empty(folder))
+      throw InputError(fmt::format("{}: a checkpoint of an interrupted sweep is in the way; continue that sweep with --resume, "
+                                   "or delete the folder to start over",
+                                   folder.string()));
+  });
   std::vector<RunCheckpoint> checkpoints;
   try {
     checkpoints = open_checkpoints(mpi, requests, a.resume);
@@ -113,11 +121,7 @@ int sweep_command(const SweepArguments& a) {
   std::error_code ignored;
   std::filesystem::remove(folder, ignored);  // empty now
   print_summary(sweep, runs.results);
-  std::cout << fmt::format("\nresults: {}\n", out.string());
-  if (a.no_plots) return kExitSuccess;
-  const std::filesystem::path plots = figures_folder(out, a.plots);
-  run_plot_script("plot_sweep.py", out, plots);
-  std::cout << fmt::format("figures: {}\n", plots.string());
+  print_result_and_draw_figures("plot_sweep.py", out, a.plots, a.no_plots);
   return kExitSuccess;
 }
 

@@ -1,6 +1,7 @@
 #include "run_session.hpp"
 
 #include <iostream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -35,22 +36,53 @@ std::vector<RunCheckpoint> open_all(const std::vector<CheckpointRequest>& reques
 
 }  // namespace
 
+namespace {
+
+/// Runs `step`; on an error, returns "<exit status>\n<message as the command line prints it>".
+std::string failure_of(const std::function<void()>& step, std::exception_ptr& error) {
+  try {
+    step();
+    return "";
+  } catch (...) {
+    error = std::current_exception();
+  }
+  std::ostringstream message;
+  const int status = run_reporting_errors([&]() -> int { std::rethrow_exception(error); }, message);
+  return std::to_string(status) + "\n" + message.str();
+}
+
+}  // namespace
+
+void every_rank_then_agree(const MpiSession& mpi, const std::function<void()>& step) {
+  if (!mpi.distributed()) return step();
+  std::exception_ptr error;
+  const auto failed = mpi.first_error(failure_of(step, error));
+  if (!failed) return;
+  if (mpi.is_root() && error) std::rethrow_exception(error);
+  const std::string& text = failed->second;
+  const int status = std::stoi(text.substr(0, text.find('\n')));
+  if (mpi.is_root()) {
+    std::string message = text.substr(text.find('\n') + 1);
+    if (message.rfind("error: ", 0) == 0) message = message.substr(7);
+    std::cerr << fmt::format("error: rank {} of {}: {}", failed->first, mpi.size(), message);
+  }
+  throw ReportedElsewhere(status);
+}
+
+void on_root_then_agree(const MpiSession& mpi, const std::function<void()>& step) {
+  if (!mpi.distributed()) return step();
+  std::exception_ptr error;
+  const auto failed = mpi.first_error(mpi.is_root() ? failure_of(step, error) : "");
+  if (!failed) return;
+  if (error) std::rethrow_exception(error);
+  throw ReportedElsewhere(std::stoi(failed->second.substr(0, failed->second.find('\n'))));
+}
+
 std::vector<RunCheckpoint> open_checkpoints(const MpiSession& mpi, const std::vector<CheckpointRequest>& requests,
                                             bool resume) {
   if (!mpi.distributed()) return open_all(requests, !resume);
   std::vector<RunCheckpoint> checkpoints;
-  std::exception_ptr root_error;
-  if (mpi.is_root()) {
-    try {
-      checkpoints = open_all(requests, !resume);
-    } catch (...) {
-      root_error = std::current_exception();
-    }
-  }
-  if (mpi.first_error(root_error ? "rank 0 could not open the checkpoint" : "")) {
-    if (root_error) std::rethrow_exception(root_error);
-    throw ReportedElsewhere(kExitBadInput);
-  }
+  on_root_then_agree(mpi, [&] { checkpoints = open_all(requests, !resume); });
   std::string error;
   if (!mpi.is_root()) {
     try {

@@ -4,6 +4,7 @@
 /// on every rank, and turning how the work ended into messages and an exit status, printed once.
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -16,6 +17,17 @@ struct CheckpointRequest {
   const RunConfig* config = nullptr;
   const RunOptions* options = nullptr;
 };
+
+/// Runs `step` (reading options and configs) on every rank and then tells every rank whether all
+/// succeeded: an error on any rank stops every rank. Rank 0 reports it once (its own error as
+/// thrown; another rank's as "error: rank R on HOST: ..."), the other ranks throw ReportedElsewhere,
+/// so no rank is left waiting in a collective for one that stopped. With one rank it just runs `step`.
+void every_rank_then_agree(const MpiSession& mpi, const std::function<void()>& step);
+
+/// Runs `step` on rank 0 only and then tells every rank whether it succeeded: rank 0 rethrows its
+/// error, the other ranks throw ReportedElsewhere with the exit status it maps to, so no rank is left
+/// waiting for one that stopped. With one rank it just runs `step`.
+void on_root_then_agree(const MpiSession& mpi, const std::function<void()>& step);
 
 /// Every requested checkpoint, created (or opened with `resume`) on every rank. Rank 0 creates or
 /// checks them first; the other ranks then open them, which fails when the folders are not on a file
