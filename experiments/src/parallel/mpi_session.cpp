@@ -53,16 +53,23 @@ MpiSession::MpiSession() : host_(host_name()) {
 #ifdef GPILQG_WITH_MPI
   int provided = 0;
   check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided), "MPI_Init_thread");
-  started_ = true;
-  if (provided < MPI_THREAD_SERIALIZED)
+  if (provided < MPI_THREAD_SERIALIZED) {
+    MPI_Finalize();  // the destructor of a constructor that throws does not run
     throw std::runtime_error("the MPI library does not support MPI_THREAD_SERIALIZED, which gpilqg needs");
-  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
-  check(MPI_Comm_rank(MPI_COMM_WORLD, &rank_), "MPI_Comm_rank");
-  check(MPI_Comm_size(MPI_COMM_WORLD, &size_), "MPI_Comm_size");
-  MPI_Comm local;
-  check(MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &local), "MPI_Comm_split_type");
-  MPI_Comm_size(local, &local_size_);
-  MPI_Comm_free(&local);
+  }
+  try {
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+    check(MPI_Comm_rank(MPI_COMM_WORLD, &rank_), "MPI_Comm_rank");
+    check(MPI_Comm_size(MPI_COMM_WORLD, &size_), "MPI_Comm_size");
+    MPI_Comm local;
+    check(MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &local), "MPI_Comm_split_type");
+    MPI_Comm_size(local, &local_size_);
+    MPI_Comm_free(&local);
+  } catch (...) {
+    MPI_Finalize();
+    throw;
+  }
+  started_ = true;
 #else
   throw std::runtime_error(
       "an MPI launcher started several gpilqg processes, but this gpilqg was built without MPI (install "
