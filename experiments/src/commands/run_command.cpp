@@ -1,6 +1,7 @@
 /// `gpilqg run cartpole|quadrotor [--config F] [--seeds N] [--iterations K] [--backends LIST] [--out F.h5]
-/// [--plots DIR] [--resume]`: the paper's experiments (run_experiment.hpp), results in HDF5 (run_results_io.hpp),
-/// figures by experiments/plots/plot_run.py.
+/// [--plots DIR] [--resume] [--threads N]`: the paper's experiments (run_experiment.hpp), results in HDF5
+/// (run_results_io.hpp), figures by experiments/plots/plot_run.py. Under `mpirun -np K` the run's units
+/// are spread over the ranks (parallel/distributed_run.hpp) and the result file is the same.
 
 #include <cmath>
 #include <csignal>
