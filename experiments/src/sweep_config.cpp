@@ -30,14 +30,17 @@ std::vector<PathStep> split_path(const std::string& path) {
     } else if (!quoted && c == '.') {
       steps.emplace_back();
     } else if (!quoted && c == '[') {
+      // One index per step, digits only, then '.' or the end: "tasks[1].horizon".
       const std::size_t close = path.find(']', i);
-      if (close == std::string::npos) return {};
-      try {
-        steps.back().index = std::stoi(path.substr(i + 1, close - i - 1));
-      } catch (const std::exception&) {
+      if (close == std::string::npos || close == i + 1 || steps.back().index >= 0) return {};
+      const std::string digits = path.substr(i + 1, close - i - 1);
+      if (digits.size() > 6 || !std::all_of(digits.begin(), digits.end(), [](char d) { return d >= '0' && d <= '9'; }))
         return {};
-      }
+      if (close + 1 < path.size() && path[close + 1] != '.') return {};
+      steps.back().index = std::stoi(digits);
       i = close;
+    } else if (!quoted && (c == ']' || steps.back().index >= 0)) {
+      return {};  // text after an index within one step
     } else {
       steps.back().key += c;
     }
@@ -133,6 +136,11 @@ SweepConfig load_sweep_config(const std::filesystem::path& file) {
                                 "\"tasks[1].horizon\")", field, s.system));
     const toml::array* values = node.as_array();
     if (values == nullptr || values->empty()) f.fail(where, "expected a non-empty array of the values to try");
+    for (const auto& value : *values)
+      if (value.is_table())
+        f.fail(where, "a value is a table; vary the table's fields one by one (e.g. \"world.parameters.pole_mass\")");
+    if (f.has("iterations") && field == "loop.iterations")
+      f.fail(where, "the sweep file's `iterations` would override every value of this field; remove one of them");
     order.emplace_back(key.source().begin, entries.size());
     entries.emplace_back(field, values);
   }

@@ -93,6 +93,16 @@ TEST(SweepConfig, ErrorsNameTheFileTheFieldAndThePoint) {
   const std::string wrong = error_of(sweep_file("wrong.toml", "system = \"cartpole\"\n[grid]\n\"loop.rollouts\" = [1, \"x\"]\n"));
   EXPECT_NE(wrong.find("wrong.toml: grid point 1 (loop.rollouts = 'x')"), std::string::npos) << wrong;
   EXPECT_NE(wrong.find("loop.rollouts"), std::string::npos) << wrong;
+  for (const char* path : {"tasks[1][0].horizon", "tasks[-1].horizon", "tasks[1x].horizon", "tasks[1]horizon", "tasks[].x0"})
+    EXPECT_NE(error_of(sweep_file("index.toml", std::string("system = \"cartpole\"\n[grid]\n\"") + path + "\" = [3]\n"))
+                  .find("is not a field of the run config"),
+              std::string::npos)
+        << path;
+  EXPECT_NE(error_of(sweep_file("both.toml", "system = \"cartpole\"\niterations = 2\n[grid]\n\"loop.iterations\" = [1, 3]\n"))
+                .find("would override every value"),
+            std::string::npos);
+  EXPECT_NE(error_of(sweep_file("table.toml", "system = \"cartpole\"\n[grid]\n\"gp\" = [{backend = \"fitc\"}]\n")).find("is a table"),
+            std::string::npos);
   EXPECT_NE(error_of(sweep_file("nosys.toml", "system = \"nosuch\"\n[grid]\n\"loop.rollouts\" = [1]\n")).find("nosuch"),
             std::string::npos);
 }

@@ -2,6 +2,7 @@
 
 #include "gpilqg/experiments/cli_errors.hpp"
 
+#include <atomic>
 #include <csignal>
 #include <cstring>
 
@@ -10,7 +11,10 @@
 namespace gpilqg::cli {
 namespace {
 
-volatile std::sig_atomic_t g_signal = 0;
+/// Written by the handler, read by any thread (rank 0's coordinator too): a lock-free atomic is both
+/// async-signal-safe and free of data races, which a volatile sig_atomic_t is not across threads.
+std::atomic<int> g_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free);
 struct sigaction g_previous_int, g_previous_term;
 
 void on_stop_signal(int signal) {
@@ -44,8 +48,11 @@ StopSignalGuard::~StopSignalGuard() {
 
 bool StopSignalGuard::stop_requested() { return g_signal != 0; }
 
-int StopSignalGuard::signal_number() { return static_cast<int>(g_signal); }
+int StopSignalGuard::signal_number() { return g_signal.load(); }
 
-int StopSignalGuard::exit_status() { return kExitSignalBase + (g_signal != 0 ? static_cast<int>(g_signal) : SIGTERM); }
+int StopSignalGuard::exit_status() {
+  const int signal = g_signal.load();
+  return kExitSignalBase + (signal != 0 ? signal : SIGTERM);
+}
 
 }  // namespace gpilqg::cli

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "gpilqg/experiments/run_units.hpp"
+#include "run_session.hpp"
 
 namespace gpilqg::cli {
 
@@ -26,19 +27,22 @@ DistributedRuns run_distributed(const MpiSession& session, const std::vector<Run
   std::vector<std::pair<std::size_t, int>> where;  // whole-list index -> (part, unit)
   std::vector<std::vector<int>> depends_on;
   std::vector<double> weights;
-  for (std::size_t p = 0; p < parts.size(); ++p) {
-    const RunPart& part = parts[p];
-    if (part.options.journal != part.checkpoint) throw std::logic_error("run_distributed: each part's journal must be its checkpoint");
-    PartUnits plan{make_run_models(*part.config), plan_run_units(*part.config, part.options), static_cast<int>(where.size())};
-    for (int i = 0; i < static_cast<int>(plan.units.size()); ++i) {
-      std::vector<int> deps = plan.units[static_cast<std::size_t>(i)].depends_on;
-      for (int& d : deps) d += plan.first;
-      depends_on.push_back(std::move(deps));
-      weights.push_back(plan.units[static_cast<std::size_t>(i)].weight);
-      where.emplace_back(p, i);
+  // The same on every rank; a rank that fails here (a model file missing on its machine) stops all.
+  every_rank_then_agree(session, [&] {
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      const RunPart& part = parts[p];
+      if (part.options.journal != part.checkpoint) throw std::logic_error("run_distributed: each part's journal must be its checkpoint");
+      PartUnits plan{make_run_models(*part.config), plan_run_units(*part.config, part.options), static_cast<int>(where.size())};
+      for (int i = 0; i < static_cast<int>(plan.units.size()); ++i) {
+        std::vector<int> deps = plan.units[static_cast<std::size_t>(i)].depends_on;
+        for (int& d : deps) d += plan.first;
+        depends_on.push_back(std::move(deps));
+        weights.push_back(plan.units[static_cast<std::size_t>(i)].weight);
+        where.emplace_back(p, i);
+      }
+      plans.push_back(std::move(plan));
     }
-    plans.push_back(std::move(plan));
-  }
+  });
   UnitScheduler scheduler(depends_on, weights);
 
   const auto completed_of = [&](std::size_t p) -> CompletedRun {
@@ -65,6 +69,7 @@ DistributedRuns run_distributed(const MpiSession& session, const std::vector<Run
 
   DistributedRuns out;
   out.distribution = distribute_units(session, scheduler, work, stop_signal);
+  for (const RunPart& part : parts) part.checkpoint->set_stop_requested(stop_signal);  // not the distribution's
   if (out.distribution.failed_unit >= 0) out.failed_unit = name_of(out.distribution.failed_unit);
   if (session.is_root() && out.distribution.outcome == Distribution::Outcome::Finished)
     for (std::size_t p = 0; p < parts.size(); ++p) {

@@ -89,8 +89,9 @@ int MpiSession::threads_per_rank() const {
   cpu_set_t set;
   CPU_ZERO(&set);
   if (sched_getaffinity(0, sizeof set, &set) == 0) allowed = std::max(1, CPU_COUNT(&set));
-  // Bound to its own cores by the launcher: those are this rank's. Unbound: a share of the machine.
-  return allowed < machine ? allowed : std::max(1, machine / local_size_);
+  // The cores it may use, but no more than its share of the machine: ranks bound to a shared set (a
+  // socket, a SLURM cpuset) must not each take the whole set.
+  return std::max(1, std::min(allowed, machine / local_size_));
 }
 
 #ifdef GPILQG_WITH_MPI

@@ -43,7 +43,7 @@ class MpiSession {
   /// The name of this rank's machine.
   const std::string& host() const { return host_; }
   /// Threads each rank may use without oversubscribing its machine: the cores this process may run
-  /// on (its CPU affinity) divided by the ranks on the machine when they share them, at least 1.
+  /// on (its CPU affinity), at most the machine's cores divided by the ranks on it, at least 1.
   int threads_per_rank() const;
 
   void send(int destination, int tag, const std::string& bytes) const;

@@ -11,6 +11,16 @@
 namespace gpilqg::cli {
 namespace {
 
+/// Deletes the checkpoints of a start that failed; the start's own error is the one to report.
+void remove_checkpoints(std::vector<RunCheckpoint>& checkpoints) {
+  for (auto& checkpoint : checkpoints) {
+    try {
+      checkpoint.remove();
+    } catch (const std::exception&) {
+    }
+  }
+}
+
 /// Creates (or opens) every checkpoint; when creating one fails, the ones created before it go too,
 /// so a failed start leaves nothing that a later start would take for an interrupted run.
 std::vector<RunCheckpoint> open_all(const std::vector<CheckpointRequest>& requests, bool create) {
@@ -22,13 +32,7 @@ std::vector<RunCheckpoint> open_all(const std::vector<CheckpointRequest>& reques
       remove_stale_temporaries_in(r.folder);  // of writes that a kill interrupted
     }
   } catch (...) {
-    if (create)
-      for (auto& checkpoint : out) {
-        try {
-          checkpoint.remove();
-        } catch (const std::exception&) {  // the original error is the one to report
-        }
-      }
+    if (create) remove_checkpoints(out);
     throw;
   }
   return out;
@@ -94,6 +98,7 @@ std::vector<RunCheckpoint> open_checkpoints(const MpiSession& mpi, const std::ve
     }
   }
   if (const auto failed = mpi.first_error(error)) {
+    if (mpi.is_root() && !resume) remove_checkpoints(checkpoints);  // a start that failed leaves nothing in the way
     if (mpi.is_root()) throw InputError(failed->second);
     throw ReportedElsewhere(kExitBadInput);
   }

@@ -178,13 +178,15 @@ class Coordinator {
 
   /// The first reason to stop wins. (Called from either thread: the messages go out in dispatch.)
   void begin_stop(Distribution::Outcome why) {
-    if (stopping_) return;
+    if (stopping_ || scheduler_.all_finished()) return;  // a stop after the last unit changes nothing
     stopping_ = true;
     result_.outcome = why;
   }
 
   /// Gives each waiting rank a ready unit, or tells it to finish when nothing is left to start; when
-  /// the run stops, asks each busy rank to stop at its next safe point. Coordinator thread only.
+  /// the run stops, asks each busy rank to stop at its next safe point. Coordinator thread only. The
+  /// blocking sends under the mutex cannot wait on a worker: orders are a few bytes (sent eagerly),
+  /// and a busy worker is only ever sent Abort.
   void dispatch() {
     for (std::size_t r = 1; r < busy_.size(); ++r)
       if (stopping_ && busy_[r] >= 0 && !aborted_[r]) {
