@@ -65,10 +65,8 @@ std::vector<ProfileRow> profile_rows(const MpiSession& mpi, const std::filesyste
   if (d.outcome == Distribution::Outcome::Failed) {
     if (!mpi.is_root()) throw ReportedElsewhere(d.failure_exit);
     const ProfileCase& c = cases.at(static_cast<std::size_t>(d.failed_unit));
-    std::string why = d.failure;
-    if (why.rfind("error: ", 0) == 0) why = why.substr(7);
     const std::string message = fmt::format("rank {} of {} failed on backend '{}', N = {}: {}", d.failed_rank, mpi.size(),
-                                            c.backend, c.size, why);
+                                            c.backend, c.size, d.failure);
     if (d.failure_exit == kExitBadInput) throw InputError(message);
     throw std::runtime_error(message);
   }

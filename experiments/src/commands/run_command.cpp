@@ -40,9 +40,6 @@ struct RunArguments {
   int threads = 0;  ///< 0: 2 in one process, each rank's share of its machine under MPI
 };
 
-/// Threads inside one unit of work for a single process (the GP's outputs fitted concurrently).
-constexpr int kDefaultThreads = 2;
-
 /// Mean and standard deviation over seeds of each iteration's normalised cost, one line per algorithm.
 void print_summary(const RunResults& results) {
   for (std::size_t t = 0; t < results.tasks.size(); ++t) {
@@ -93,7 +90,7 @@ int run_command(const RunArguments& a) {
       }
     }
   });
-  options.threads = a.threads > 0 ? a.threads : mpi.distributed() ? mpi.threads_per_rank() : kDefaultThreads;
+  options.threads = unit_threads(mpi, a.threads);
   const std::string rank_prefix = mpi.distributed() ? fmt::format("[rank {}] ", mpi.rank()) : "";
   options.progress = [rank_prefix](const std::string& line) { std::cerr << rank_prefix + line + "\n" << std::flush; };
   on_root_then_agree(mpi, [&] {

@@ -31,8 +31,6 @@ struct SweepArguments {
   int threads = 0;
 };
 
-constexpr int kDefaultThreads = 2;
-
 /// Per grid point and task: gp_ilqg's normalised cost at the last iteration, mean and spread over seeds.
 void print_summary(const SweepConfig& sweep, const std::vector<RunResults>& results) {
   std::cout << fmt::format("\n{} grid points x {} seed(s); gp_ilqg's normalised cost at the last iteration "
@@ -69,7 +67,7 @@ int sweep_command(const SweepArguments& a) {
     if (!a.no_plots) check_output_folder_option("--plots", a.plots);
   });
   const std::string rank_prefix = mpi.distributed() ? fmt::format("[rank {}] ", mpi.rank()) : "";
-  const int threads = a.threads > 0 ? a.threads : mpi.distributed() ? mpi.threads_per_rank() : kDefaultThreads;
+  const int threads = unit_threads(mpi, a.threads);
 
   // One checkpoint per grid point in "<out>.checkpoint/point-<p>/" (run_checkpoint.hpp).
   const std::filesystem::path folder = RunCheckpoint::folder_for(out);

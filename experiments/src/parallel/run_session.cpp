@@ -42,7 +42,7 @@ std::vector<RunCheckpoint> open_all(const std::vector<CheckpointRequest>& reques
 
 namespace {
 
-/// Runs `step`; on an error, returns "<exit status>\n<message as the command line prints it>".
+/// Runs `step`; on an error, returns "<exit status>\n<message without \"error: \">".
 std::string failure_of(const std::function<void()>& step, std::exception_ptr& error) {
   try {
     step();
@@ -50,9 +50,8 @@ std::string failure_of(const std::function<void()>& step, std::exception_ptr& er
   } catch (...) {
     error = std::current_exception();
   }
-  std::ostringstream message;
-  const int status = run_reporting_errors([&]() -> int { std::rethrow_exception(error); }, message);
-  return std::to_string(status) + "\n" + message.str();
+  const DescribedError d = describe_error(error);
+  return std::to_string(d.exit_status) + "\n" + d.detail;
 }
 
 }  // namespace
@@ -66,9 +65,7 @@ void every_rank_then_agree(const MpiSession& mpi, const std::function<void()>& s
   const std::string& text = failed->second;
   const int status = std::stoi(text.substr(0, text.find('\n')));
   if (mpi.is_root()) {
-    std::string message = text.substr(text.find('\n') + 1);
-    if (message.rfind("error: ", 0) == 0) message = message.substr(7);
-    std::cerr << fmt::format("error: rank {} of {}: {}", failed->first, mpi.size(), message);
+    std::cerr << fmt::format("error: rank {} of {}: {}\n", failed->first, mpi.size(), text.substr(text.find('\n') + 1));
   }
   throw ReportedElsewhere(status);
 }
@@ -105,6 +102,11 @@ std::vector<RunCheckpoint> open_checkpoints(const MpiSession& mpi, const std::ve
   return checkpoints;
 }
 
+int unit_threads(const MpiSession& mpi, int option) {
+  if (option > 0) return option;
+  return mpi.distributed() ? mpi.threads_per_rank() : RunOptions{}.threads;
+}
+
 void print_unit_times(const Distribution& distribution, int ranks) {
   std::vector<double> busy(static_cast<std::size_t>(ranks), 0.0);
   std::vector<int> count(static_cast<std::size_t>(ranks), 0);
@@ -133,11 +135,9 @@ std::optional<int> unfinished_exit_status(const MpiSession& mpi, const Distribut
       return interrupted_status;
     case Distribution::Outcome::Failed: {
       if (!mpi.is_root()) return d.failure_exit;
-      std::string why = d.failure;
-      if (why.rfind("error: ", 0) == 0) why = why.substr(7);
       std::cerr << fmt::format("error: rank {} of {} failed on {}: {}\nthe other ranks stopped at their next iteration "
                                "boundary; all finished work is in {}; fix the cause and continue with --resume\n",
-                               d.failed_rank, mpi.size(), runs.failed_unit, why, checkpoint.string());
+                               d.failed_rank, mpi.size(), runs.failed_unit, d.failure, checkpoint.string());
       return d.failure_exit;
     }
   }

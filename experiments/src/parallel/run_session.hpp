@@ -36,6 +36,10 @@ void on_root_then_agree(const MpiSession& mpi, const std::function<void()>& step
 std::vector<RunCheckpoint> open_checkpoints(const MpiSession& mpi, const std::vector<CheckpointRequest>& requests,
                                             bool resume);
 
+/// Threads inside one unit of work: `--threads` when given (> 0), else each rank's share of its
+/// machine under MPI, else RunOptions' default.
+int unit_threads(const MpiSession& mpi, int option);
+
 /// Which rank ran how many units for how long, on stderr: the numbers behind a cluster's time
 /// estimate (docs/cluster.md).
 void print_unit_times(const Distribution& distribution, int ranks);

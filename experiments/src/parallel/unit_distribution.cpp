@@ -71,12 +71,10 @@ Message run_one(const UnitWork& work, int unit, const std::function<bool()>& sto
     report.kind = Kind::Interrupted;
     report.bytes = e.what();
   } catch (...) {
-    std::ostringstream text;
-    const std::exception_ptr error = std::current_exception();
-    report.code = run_reporting_errors([&]() -> int { std::rethrow_exception(error); }, text);
+    const DescribedError error = describe_error(std::current_exception());
     report.kind = Kind::Failed;
-    report.bytes = text.str();
-    while (!report.bytes.empty() && report.bytes.back() == '\n') report.bytes.pop_back();
+    report.code = error.exit_status;
+    report.bytes = error.detail;
   }
   report.seconds = seconds_since(start);
   return report;

@@ -41,7 +41,7 @@ struct Distribution {
   /// Failed: the exit status the failing unit's error maps to (cli_errors.hpp).
   int failure_exit = 0;
   int failed_rank = -1, failed_unit = -1;
-  std::string failure;  ///< Failed: the error message, as the command line would print it
+  std::string failure;  ///< Failed: the error message, without the command line's "error: "
   /// Rank 0 only, per unit: the bytes its work returned, the rank that ran it and its wall time [s]
   /// (-1 for a unit that did not finish).
   std::vector<std::string> payloads;

@@ -6,6 +6,7 @@
 /// stopped early on SIGINT or SIGTERM (`gpilqg run`, after saving its progress).
 
 #include <filesystem>
+#include <exception>
 #include <functional>
 #include <iosfwd>
 #include <stdexcept>
@@ -61,5 +62,15 @@ auto as_input_error(const std::filesystem::path& file, Read&& read) {
 /// ReportedElsewhere -> nothing, its exit status;
 /// any other exception -> "internal error: <message>", exit 1.
 int run_reporting_errors(const std::function<int()>& command, std::ostream& err);
+
+/// An error as run_reporting_errors reports it, for passing it on (e.g. from one rank of an MPI job
+/// to the rank that prints): its exit status, the message as printed ("error: ..." or "internal
+/// error: ...", no trailing newline), and the message without a leading "error: ".
+struct DescribedError {
+  int exit_status = 0;
+  std::string message;
+  std::string detail;
+};
+DescribedError describe_error(const std::exception_ptr& error);
 
 }  // namespace gpilqg
