@@ -19,6 +19,7 @@ packages=(
   libmujoco-dev
   pybind11-dev python3-pybind11 python3-pytest python3-sklearn python3-pandas libmatio-dev
   openmpi-bin libopenmpi-dev
+  libopenblas-pthread-dev
 )
 sudo_cmd=""
 if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi

@@ -2,13 +2,13 @@
 /// @file dense_cholesky.hpp
 /// Internal dense linear algebra of the GP backends: Cholesky with escalating jitter, and the inverse
 /// of a symmetric positive definite matrix from its Cholesky factor in N^3/3 + N^3/3 flops (LAPACK's
-/// dtrtri + dlauum algorithms, recursive so that the bulk of the work is Eigen's blocked matrix
-/// products), instead of the 2 N^3 of solving against the identity.
+/// dtrtri + dlauum), instead of the 2 N^3 of solving against the identity. The work runs in the
+/// system's LAPACK/BLAS (blas_lapack.hpp: OpenBLAS's AVX2/AVX-512 kernels where installed).
 ///
 /// All routines work on the lower triangle only and never read or write the strictly upper part.
-/// `threads` > 1 splits the large blocks of the recursion over that many threads (2 is what the
-/// machine has; the results are the same up to rounding order, which does not change: every entry is
-/// computed by the same sequence of operations whichever thread computes it).
+/// `threads` > 1 splits matrices of order >= 384 into 2 x 2 blocks whose BLAS-3 updates run on two
+/// threads. The split changes the rounding order against `threads` = 1, but not from run to run:
+/// every entry is computed by the same sequence of operations whichever thread computes it.
 
 #include <functional>
 
@@ -35,11 +35,11 @@ FactorOutcome cholesky_with_jitter(Eigen::Index n, const std::function<void(Matr
                                    double mean_kernel_diagonal, double noise_variance,
                                    const JitterSchedule& schedule, Matrix& factor, int threads = 1);
 
-/// In place: lower triangle A -> chol(A) (right-looking, recursive). False when A is not
+/// In place: lower triangle A -> chol(A) (dpotrf; right-looking 2 x 2 blocks over threads). False when A is not
 /// numerically positive definite (then the lower triangle holds garbage).
 bool cholesky_in_place(Eigen::Ref<Matrix> lower, int threads = 1);
 
-/// In place: lower triangle L -> L^-1 (dtrtri).
+/// In place: lower triangle L -> L^-1 (dtrtri; 2 x 2 blocks over threads).
 void invert_lower_triangular(Eigen::Ref<Matrix> lower, int threads = 1);
 
 /// In place: lower triangle M -> lower triangle of M' M (dlauum). With M = L^-1 this is K^-1.

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "blas_lapack.hpp"
 #include "dense_cholesky.hpp"
 #include "exact_gp_internal.hpp"
 #include "exact_prediction.hpp"
@@ -114,11 +115,14 @@ class ExactFittedGp final : public FittedGp {
       k = predictor_.signal_variance() * (-0.5 * k).exp();
     }
     mean.noalias() = cross.transpose() * predictor_.alpha();
+    // k*' K^-1 k* = |L^-1 k*|^2 for every point at once: one BLAS-3 triangular product (cached
+    // L^-1) or solve (L) with `count` right-hand sides.
     if (predictor_.inverse_factor().size() != 0) {
-      solved.noalias() = predictor_.inverse_factor().triangularView<Eigen::Lower>() * cross;
+      solved = cross;
+      blas::multiply_lower(blas::Side::Left, blas::Transpose::No, predictor_.inverse_factor(), solved);
       variance = solved.colwise().squaredNorm().transpose();
     } else {
-      predictor_.factor().triangularView<Eigen::Lower>().solveInPlace(cross);
+      blas::solve_lower(blas::Side::Left, blas::Transpose::No, predictor_.factor(), cross);
       variance = cross.colwise().squaredNorm().transpose();
     }
     variance = (predictor_.signal_variance() - variance.array()).max(0.0).matrix();

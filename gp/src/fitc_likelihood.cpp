@@ -47,12 +47,14 @@
 #include <vector>
 
 #include "gpilqg/gp/fitc.hpp"
+#include "blas_lapack.hpp"
 #include "parallel.hpp"
 #include "sparse_linalg.hpp"
 
 namespace gpilqg::gp {
 
 using sparse_detail::cholesky_with_jitter;
+namespace blas = detail::blas;
 
 struct FitcLikelihood::Workspace {
   Vector inv_ell;  // 1 / l (D)
@@ -183,7 +185,7 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
     auto Y = w.Y.middleCols(begin, n);
     sparse_detail::se_cross_covariance(w.Xus, w.Xs.middleRows(begin, n), w.sf2, U);
     V = U;
-    w.Luu.triangularView<Eigen::Lower>().solveInPlace(V);
+    blas::solve_lower(blas::Side::Left, blas::Transpose::No, w.Luu, V);
     for (Eigen::Index i = begin; i < end; ++i) {
       const double d = w.sf2 - w.V.col(i).squaredNorm();
       w.mask(i) = d > 0.0 ? 1.0 : 0.0;
@@ -192,7 +194,7 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
     Y = V * w.g.segment(begin, n).cwiseSqrt().cwiseInverse().asDiagonal();
     Matrix& A = w.partial_mm[static_cast<std::size_t>(worker)];
     A.setZero(M, M);
-    A.selfadjointView<Eigen::Lower>().rankUpdate(Y);
+    blas::rank_update_lower(1.0, Y, blas::Transpose::No, 0.0, A);
     Matrix& md = w.partial_md[static_cast<std::size_t>(worker)];
     md.resize(M, D + 2);
     md.col(D + 1).noalias() = V * r_.segment(begin, n).cwiseQuotient(w.g.segment(begin, n));
@@ -257,18 +259,18 @@ NlmlEvaluation FitcLikelihood::evaluate(const VectorCRef& theta, Vector* gradien
     auto V = w.V.middleCols(begin, n);
     auto Y = w.Y.middleCols(begin, n);
     auto Z = w.Z.middleCols(begin, n);
-    Y.noalias() = R1 * V;
+    blas::multiply(1.0, R1, blas::Transpose::No, V, blas::Transpose::No, 0.0, Y);
     for (Eigen::Index i = begin; i < end; ++i) {
       const double s = w.U.col(i).dot(w.Y.col(i));
       const double gi = w.g(i);
       w.Gdiag(i) = 1.0 / gi - s / (gi * gi) - w.alpha(i) * w.alpha(i);
       w.h(i) = w.mask(i) * w.Gdiag(i);
     }
-    w.Luu.transpose().triangularView<Eigen::Upper>().solveInPlace(V);
+    blas::solve_lower(blas::Side::Left, blas::Transpose::Yes, w.Luu, V);
     Z = V * w.h.segment(begin, n).asDiagonal();
     Matrix& H = w.partial_mm[static_cast<std::size_t>(worker)];
-    H.setZero(M, M);
-    H.triangularView<Eigen::Lower>() += Z * V.transpose();
+    H.resize(M, M);
+    blas::multiply(1.0, Z, blas::Transpose::No, V, blas::Transpose::Yes, 0.0, H);  // symmetric; lower used
     // P = dnlZ/dKuf = X1 Lambda^-1 - B diag(h) - beta alpha'; E = P .* Kuf, then its contractions.
     for (Eigen::Index i = begin; i < end; ++i) {
       auto col = w.Y.col(i);

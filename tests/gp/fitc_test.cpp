@@ -10,6 +10,10 @@
 
 #include <cmath>
 #include <limits>
+#include <atomic>
+#include <random>
+#include <thread>
+#include <tuple>
 #include <set>
 
 #include "gp_test_support.hpp"
@@ -519,5 +523,64 @@ TEST(FitcFailure, DuplicatePseudoInputsAreConditionedWithReportedJitter) {
   EXPECT_TRUE(p.mean_gradient.allFinite() && p.variance_gradient.allFinite());
 }
 
+}  // namespace
+}  // namespace gpilqg::gp::test
+
+namespace gpilqg::gp::test {
+namespace {
+
+/// Data of n points in 3 inputs, y = sin(3 x1) + 0.5 x2 + noise.
+TrainingSet wave_data(int n, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  TrainingSet data{Matrix(n, 3), Vector(n)};
+  for (int i = 0; i < n; ++i) {
+    for (int d = 0; d < 3; ++d) data.inputs(i, d) = uniform(gen);
+    data.targets(i) = std::sin(3.0 * data.inputs(i, 0)) + 0.5 * data.inputs(i, 1) + 0.05 * uniform(gen);
+  }
+  return data;
+}
+
+/// The NLML and its gradient are a function of the data and theta alone: the same bits on every
+/// evaluation, whatever the BLAS's buffers or other threads evaluating other objectives at the same
+/// time are doing (run, merge and MPI results are compared file against file, bit for bit).
+TEST(FitcBackendTest, RepeatedAndConcurrentEvaluationsGiveTheSameBits) {
+  struct Setting {
+    int points, inducing, threads;
+  };
+  const std::vector<Setting> settings{{20, 50, 1}, {37, 10, 1}, {150, 30, 2}, {1500, 60, 1}, {1500, 60, 2}};
+  auto make = [](const Setting& s) {
+    FitcOptions fitc;
+    fitc.inducing = s.inducing;
+    fitc.threads = s.threads;
+    return FitcBackend(fitc).objective(wave_data(s.points, static_cast<unsigned>(s.points)), FitOptions{});
+  };
+  std::vector<double> values;
+  std::vector<Vector> gradients;
+  for (const Setting& s : settings) {
+    Vector gradient;
+    auto objective = make(s);
+    values.push_back(objective->evaluate(objective->initial_parameters(), &gradient).value);
+    gradients.push_back(gradient);
+  }
+  // Two threads, each with objectives of its own, evaluate all settings repeatedly in opposite orders.
+  std::atomic<int> differing{0};
+  auto evaluate_all = [&](bool reverse) {
+    std::vector<std::unique_ptr<MarginalLikelihoodObjective>> objectives;
+    for (const Setting& s : settings) objectives.push_back(make(s));
+    for (int repeat = 0; repeat < 10; ++repeat)
+      for (std::size_t k = 0; k < settings.size(); ++k) {
+        const std::size_t index = reverse ? settings.size() - 1 - k : k;
+        Vector gradient;
+        auto& objective = *objectives[index];
+        const double value = objective.evaluate(objective.initial_parameters(), &gradient).value;
+        if (value != values[index] || gradient != gradients[index]) ++differing;
+      }
+  };
+  std::thread other(evaluate_all, true);
+  evaluate_all(false);
+  other.join();
+  EXPECT_EQ(differing.load(), 0) << "of " << 2 * 10 * settings.size() << " evaluations";
+}
 }  // namespace
 }  // namespace gpilqg::gp::test
