@@ -37,6 +37,7 @@ struct DdpWorkspace {
   AffinePolicy policy;         ///< x_bar, u_bar (the current nominal), k, K, limits
   Matrix x_new, u_new;         ///< the line-search candidate
   std::vector<StepJacobians> jac;
+  std::vector<StepJacobians> jac_new;  ///< the candidate's, when the model's are nearly free
   std::vector<CostDerivatives> cost;       ///< T stages + the terminal at index T
   std::vector<DiffusionColumns> noise;     ///< sqrt(dt) F at each step (iLQG, Robust-iLQG)
   std::vector<DiffusionColumns> uncertainty;  ///< sqrt(dt) G at each step (Robust-iLQG)
@@ -65,6 +66,8 @@ struct DdpWorkspace {
     u_new.setZero(m, T);
     jac.resize(static_cast<std::size_t>(T));
     for (auto& j : jac) j.resize(n, m);
+    jac_new.resize(static_cast<std::size_t>(T));
+    for (auto& j : jac_new) j.resize(n, m);
     cost.resize(static_cast<std::size_t>(T + 1));
     for (auto& c : cost) c.resize(n, m);
     noise.resize(static_cast<std::size_t>(T));
@@ -111,8 +114,12 @@ class Engine {
   /// Rolls out `policy` with feed-forward scale alpha into (x_out, u_out); returns the merit with the
   /// stored S (trace terms included for iLQG variants), or +inf when the rollout diverges.
   double forward(double alpha, Matrix& x_out, Matrix& u_out);
-  /// Derivatives of model, cost and diffusion columns along the nominal trajectory.
+  /// Derivatives of model, cost and diffusion columns along the nominal trajectory; nothing when
+  /// they are already those of the nominal (derivatives_current_).
   void differentiate();
+  /// The candidate (x_new, u_new) becomes the nominal, with its model Jacobians when forward()
+  /// computed them.
+  void accept_candidate();
   /// One backward pass with regularisation lambda. False when a Q_uu block is not positive definite.
   bool backward(double lambda);
   void increase_lambda();
@@ -134,6 +141,12 @@ class Engine {
   double merit_at_nominal_ = 0.0;   ///< nominal cost + trace terms with the new S
   double nominal_cost_ = 0.0;
   double gradient_norm_ = 0.0;
+  /// forward() asks the model for Jacobians (StepModel::jacobians_nearly_free).
+  bool jacobians_in_forward_ = false;
+  /// ws_.jac hold the nominal's model Jacobians (from the candidate that became the nominal).
+  bool model_jacobians_current_ = false;
+  /// Everything differentiate() computes is that of the nominal (it did not change since).
+  bool derivatives_current_ = false;
 };
 
 double Engine::trace_term(const DiffusionColumns& d, const Matrix& S, Vector& Sc) {
@@ -165,7 +178,8 @@ double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
       }
     }
     const bool control_finite = u_out.col(t).allFinite();
-    if (control_finite) model_.step(x_out.col(t), u_out.col(t), x_out.col(t + 1), nullptr, *model_ws_);
+    StepJacobians* jacobians = jacobians_in_forward_ ? &ws_.jac_new[static_cast<std::size_t>(t)] : nullptr;
+    if (control_finite) model_.step(x_out.col(t), u_out.col(t), x_out.col(t + 1), jacobians, *model_ws_);
     if (!control_finite || check_divergence(x_out.col(t + 1)) != RolloutStatus::Completed) {
       // Diverged (rollout.hpp's test, shared with every rollout): keep the candidate free of NaN and
       // inf (the last state within the bound repeated, the nominal controls after it) and reject it.
@@ -179,13 +193,14 @@ double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
 }
 
 void Engine::differentiate() {
+  if (derivatives_current_) return;
   const int T = ws_.T;
   const double sqrt_dt = std::sqrt(model_.dt());
   const auto& x = ws_.policy.x_bar;
   const auto& u = ws_.policy.u_bar;
   for (int t = 0; t < T; ++t) {
     const auto ts = static_cast<std::size_t>(t);
-    model_.step(x.col(t), u.col(t), ws_.x_new.col(t + 1), &ws_.jac[ts], *model_ws_);
+    if (!model_jacobians_current_) model_.step(x.col(t), u.col(t), ws_.x_new.col(t + 1), &ws_.jac[ts], *model_ws_);
     cost_.stage(t, x.col(t), u.col(t), &ws_.cost[ts]);
     if (uses_noise()) {
       model_.noise(x.col(t), u.col(t), ws_.noise[ts], true, *model_ws_);
@@ -197,6 +212,16 @@ void Engine::differentiate() {
     }
   }
   cost_.terminal(x.col(T), &ws_.cost[static_cast<std::size_t>(T)]);
+  model_jacobians_current_ = true;
+  derivatives_current_ = true;
+}
+
+void Engine::accept_candidate() {
+  ws_.policy.x_bar.swap(ws_.x_new);
+  ws_.policy.u_bar.swap(ws_.u_new);
+  if (jacobians_in_forward_) ws_.jac.swap(ws_.jac_new);
+  model_jacobians_current_ = jacobians_in_forward_;
+  derivatives_current_ = false;
 }
 
 bool Engine::backward(double lambda) {
@@ -365,6 +390,8 @@ DdpResult Engine::run(const Matrix& initial_controls) {
 
   DdpResult result;
   DdpSummary& summary = result.summary;
+  jacobians_in_forward_ = model_.jacobians_nearly_free();
+  model_jacobians_current_ = derivatives_current_ = false;
   lambda_ = opt_.lambda_initial;
   dlambda_ = 1.0;
 
@@ -387,7 +414,7 @@ DdpResult Engine::run(const Matrix& initial_controls) {
     result.gradient = Matrix::Zero(m, T);
     return result;
   }
-  w.policy.x_bar = w.x_new;
+  accept_candidate();  // u_bar: the initial controls, as the rollout applied them
   summary.initial_cost = merit;
 
   const double log_first = 0.0, log_last = -3.0;
@@ -454,8 +481,7 @@ DdpResult Engine::run(const Matrix& initial_controls) {
     summary.timings.forward_s += seconds_since(t0);
 
     if (accepted) {
-      w.policy.x_bar.swap(w.x_new);
-      w.policy.u_bar.swap(w.u_new);
+      accept_candidate();
       decrease_lambda();
       record.accepted = true;
       record.cost = new_merit;

@@ -30,6 +30,8 @@ class BeliefSpaceModel final : public StepModel {
             StepJacobians* jacobians = nullptr) const override;
   void step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next, StepJacobians* jacobians,
             StepWorkspace& workspace) const override;
+  /// The moment match dominates a belief step; its derivatives add little (docs/results/pddp.md).
+  bool jacobians_nearly_free() const override { return true; }
 
  private:
   const BeliefStepModel& belief_;

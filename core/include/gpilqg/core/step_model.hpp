@@ -59,6 +59,11 @@ class StepModel {
                     StepWorkspace&) const {
     step(x, u, x_next, jacobians);
   }
+  /// True when step() with Jacobians costs little more than without, because the work both share
+  /// dominates (a belief step by moment matching: the N x N kernel expectations). DDP then asks for
+  /// the Jacobians during its line search and its derivative pass reuses those of the accepted
+  /// candidate instead of stepping the whole trajectory again (ddp_solver.cpp).
+  virtual bool jacobians_nearly_free() const { return false; }
 
   /// Number of process-noise columns p (0: deterministic).
   virtual int noise_dim() const { return 0; }
