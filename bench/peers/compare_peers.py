@@ -7,7 +7,8 @@ N, D and hyperparameters (issue #17):
   c. FITC NLML + gradient, N = 5,000, M = 100                                vs GPML under Octave
   d. batched exact prediction with variance, 1,750 points at N = 4,000       vs scikit-learn
 
-Usage (Debian's /usr/bin/python3, which has NumPy, h5py and scikit-learn; build the program first):
+Usage, from the repository root (Debian's /usr/bin/python3, which has NumPy, h5py and scikit-learn; build
+the program first):
 
   cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DGPILQG_BUILD_BENCH=ON
   cmake --build build-bench -j2 --target gpilqg_peer_cases

@@ -25,11 +25,13 @@ def ratio(peer, ours):
 def markdown(report):
     s, m = report["settings"], report["machine"]
     lines = ["## gpilqg against its peers" + (" (--quick)" if s["quick"] else ""), ""]
-    lines.append("Commit %s, %s; %s, %d cores; load average %.2f at the start, %.2f at the end%s." % (
-        report["commit"], report["date"], m["cpu"], m["cores"], m["load_start"], m["load_end"],
-        " (other work was running)" if max(m["load_start"], m["load_end"]) > 0.5 else ""))
+    # The 1-minute load average before the run is other work; at the end it includes this run.
+    lines.append("Commit %s, %s; %s, %d cores; load average %.2f before the run%s, %.2f at its end." % (
+        report["commit"], report["date"], m["cpu"], m["cores"], m["load_start"],
+        " (other work was running)" if m["load_start"] > 0.5 else "", m["load_end"]))
     lines.append("gpilqg: `%s`, timed in C++ (steady_clock). Peers timed in this process (perf_counter). "
-                 "Every time is best of %d (median) after one untimed run; the fit %d run(s), no untimed run." % (
+                 "Every time is best of %d (median) after one untimed run; the fit %d run(s), no untimed run. "
+                 "Ratios: peer best / gpilqg best." % (
                      s["program"], s["repeats"], s["fit_repeats"]))
     lines.append("Peer threads: %s; %s." % (
         ", ".join("%s=%s" % kv for kv in s["thread_variables"].items()), s["peer_libraries"]))
