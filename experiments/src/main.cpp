@@ -16,6 +16,7 @@
 #include "commands/commands.hpp"
 #include "gpilqg/core/plugin.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/gp/blas_library.hpp"
 
 namespace {
 
@@ -59,6 +60,9 @@ int main(int argc, char** argv) {
                  "repeatable, allowed after the command's name")
       ->type_name("LIB.so")
       ->allow_extra_args(false);
+  app.set_version_flag("--version", [] {
+    return "gpilqg " GPILQG_VERSION_STRING "\nBLAS: " + gpilqg::gp::blas_library();
+  });
   app.fallthrough();  // inherited by the subcommands added below
   gpilqg::cli::CommandAction action;
   gpilqg::cli::add_data_command(app, action);
@@ -77,6 +81,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     const std::string word = first_word(argc, argv);

@@ -1,10 +1,12 @@
 #include "blas_lapack.hpp"
+#include "gpilqg/gp/blas_library.hpp"
 
 #include <dlfcn.h>
 
 #include <algorithm>
 #include <climits>
 #include <cstddef>
+#include <filesystem>
 #include <stdexcept>
 
 // The Fortran interface of BLAS and LAPACK (LP64: 32-bit integers, Debian's libblas3/liblapack3 and
@@ -143,9 +145,12 @@ void multiply(double alpha, const Eigen::Ref<const Matrix>& a, Transpose transpo
 
 std::string library_description() {
   Dl_info info{};
-  std::string text = dladdr(reinterpret_cast<void*>(&dgemm_), &info) != 0 && info.dli_fname != nullptr
-                         ? info.dli_fname
-                         : "unknown BLAS";
+  std::string text = "unknown BLAS";
+  if (dladdr(reinterpret_cast<void*>(&dgemm_), &info) != 0 && info.dli_fname != nullptr) {
+    std::error_code error;  // the alternatives' symlinks resolved: which implementation it is
+    const std::filesystem::path file = std::filesystem::canonical(info.dli_fname, error);
+    text = error ? std::string(info.dli_fname) : file.string();
+  }
   using Config = const char* (*)();
   using CoreName = const char* (*)();
   if (auto config = reinterpret_cast<Config>(dlsym(RTLD_DEFAULT, "openblas_get_config"))) {
@@ -157,3 +162,9 @@ std::string library_description() {
 }
 
 }  // namespace gpilqg::gp::detail::blas
+
+namespace gpilqg::gp {
+
+std::string blas_library() { return detail::blas::library_description(); }
+
+}  // namespace gpilqg::gp
