@@ -100,7 +100,8 @@ nlohmann::json profile_json(const ProfileReport& report) {
             {"compact_neighbours", o.settings.compact_neighbours},
             {"compact_max_neighbours", o.settings.compact_max_neighbours},
             {"threads", o.settings.threads},
-            {"memory_budget_gib", o.memory_budget_bytes / (1ull << 30)}}},
+            {"memory_budget_gib", o.memory_budget_bytes / (1ull << 30)},
+            {"time_budget_s", o.time_budget_seconds}}},
           {"rows", rows}};
 }
 
@@ -117,7 +118,8 @@ std::string format_profile(const ProfileReport& report) {
     }
     os << fmt::format("{:<16} {:>7} {:>10.3f} {:>10.3f} {:>9.5f} {:>9.5f} {:>9.5f} {:>6}  {}{}\n", row.backend, row.size,
                       row.fit_seconds, row.predict_seconds, row.smse, row.mnlp, row.msll, row.evaluations,
-                      row.termination, row.conditioning == "ok" ? "" : ", " + row.conditioning);
+                      row.reason.empty() ? row.termination : row.reason,
+                      row.conditioning == "ok" ? "" : ", " + row.conditioning);
   }
   return os.str();
 }

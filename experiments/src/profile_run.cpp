@@ -1,11 +1,13 @@
 /// Running `gpilqg profile`: every backend at every size, the exact GP under the reference
-/// hyperparameters as the baseline, memory budget for the dense exact GP (profile.hpp).
+/// hyperparameters as the baseline; a row over its memory or time budget skipped before any numeric
+/// work (profile_budget.cpp), a fit past the time budget stopped with its best point (profile.hpp).
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <random>
 
@@ -58,10 +60,6 @@ void score(const gp::FittedGp& model, const Matrix& test_inputs, const Vector& t
 
 }  // namespace
 
-double exact_memory_bytes(std::int64_t n, bool fitted) {
-  return (fitted ? 16.0 : 8.0) * static_cast<double>(n) * static_cast<double>(n);
-}
-
 void ProfileOptions::validate(const ProfileData& data) const {
   if (backends.empty()) throw InputError("--backends: expected at least one backend");
   if (sizes.empty()) throw InputError("--sizes: expected at least one size");
@@ -70,6 +68,11 @@ void ProfileOptions::validate(const ProfileData& data) const {
       throw InputError(fmt::format("--sizes: {} is outside [1, {}] (the training set of {}; 'all' for all)", size,
                                    data.train.size(), data.name));
   if (!(memory_budget_bytes > 0.0)) throw InputError("--memory-budget-gb: expected a positive number");
+  if (!(time_budget_seconds >= 0.0) || !std::isfinite(time_budget_seconds))
+    throw InputError(fmt::format("--time-budget: is {}; expected a finite number of seconds >= 0 (0: no time budget)",
+                                 time_budget_seconds));
+  if (!(flops_per_second >= 0.0) || !std::isfinite(flops_per_second))
+    throw InputError(fmt::format("flops_per_second: is {}; expected a finite number >= 0 (0: measured)", flops_per_second));
   if (max_test_points && *max_test_points < 1) throw InputError("--max-test: expected >= 1");
   if (start_from_reference && !data.reference)
     throw InputError("--start reference: " + data.name + " has no /reference_hyperparameters");
@@ -125,6 +128,48 @@ ProfileReport profile_report_header(const std::filesystem::path& file, const Pro
   return report;
 }
 
+namespace {
+
+/// The FitOptions of a fitted row: the profile's, with the time budget as the fit's limit and, with
+/// --start reference, the full warm start (the reference hyperparameters and the backend's extras).
+/// For exact_reference: the reference hyperparameters, not optimised.
+gp::FitOptions row_fit_options(const ProfileCase& c, const gp::GpBackend* backend, const gp::TrainingSet& subset,
+                               const ProfileData& data, const ProfileOptions& options) {
+  gp::FitOptions fit = options.fit;
+  fit.max_seconds = options.time_budget_seconds;
+  if (c.backend == "exact_reference") {
+    fit.optimise = false;
+    fit.warm_start = data.reference->pack();
+  } else if (options.start_from_reference) {
+    fit.warm_start = backend->objective(subset, fit)->initial_parameters();
+    fit.warm_start.head(gp::Hyperparameters::count(subset.input_dim())) = data.reference->pack();
+  }
+  return fit;
+}
+
+/// Fits (or, for exact_reference, conditions) and scores into `row`.
+void fit_and_score(const ProfileCase& c, const gp::GpBackend* backend, const gp::TrainingSet& subset,
+                   const gp::FitOptions& fit_options, const ProfileOptions& options, const Matrix& test_inputs,
+                   const Vector& test_targets, ProfileRow& row) {
+  if (c.backend == "exact_reference") {
+    const gp::ExactGpBackend exact(gp::ExactGpOptions{gp::ExactGpOptions::kAllPoints, options.settings.threads});
+    const auto start = Clock::now();
+    const auto model = exact.condition(subset, fit_options.warm_start, options.fit.jitter);
+    row.fit_seconds = seconds_since(start);
+    score(*model, test_inputs, test_targets, subset.targets, row);
+    return;
+  }
+  const gp::FitResult fit = backend->fit(subset, fit_options);
+  row.fit_seconds = fit.summary.seconds;
+  row.evaluations = fit.summary.evaluations;
+  row.termination = std::string(gp::to_string(fit.summary.termination));
+  score(*fit.model, test_inputs, test_targets, subset.targets, row);
+  if (fit.summary.termination == gp::FitTermination::TimeLimit)
+    row.reason = fmt::format("stopped at time budget after {} evaluations", fit.summary.evaluations);
+}
+
+}  // namespace
+
 ProfileRow run_profile_case(const std::filesystem::path& file, const ProfileData& data, const ProfileOptions& options,
                             const ProfileCase& c) {
   Matrix test_inputs;
@@ -133,49 +178,24 @@ ProfileRow run_profile_case(const std::filesystem::path& file, const ProfileData
   const auto order = nested_subset(data.train.size(), data.train.size(), options.fit.seed);
   const std::vector<int> rows(order.begin(), order.begin() + c.size);
   const gp::TrainingSet subset = data.train.subset(rows);
-  auto over_budget = [&](ProfileRow& row, bool fitted) {
-    const double need = exact_memory_bytes(row.size, fitted);
-    if (need <= options.memory_budget_bytes) return false;
-    row.status = "skipped";
-    row.reason = fmt::format("the dense exact GP needs {:.2f} GiB at N = {} ({} N x N matrices), over the budget of {:.2f} GiB",
-                             need / (1ull << 30), row.size, fitted ? 2 : 1, options.memory_budget_bytes / (1ull << 30));
-    return true;
-  };
   ProfileRow row;
   row.backend = c.backend;
   row.size = c.size;
-  if (c.backend == "exact_reference") {
-    row.termination = "not optimised";
-    if (over_budget(row, false)) return row;
-    const gp::ExactGpBackend exact(gp::ExactGpOptions{gp::ExactGpOptions::kAllPoints, options.settings.threads});
-    const auto start = Clock::now();
-    try {
-      const auto model = exact.condition(subset, data.reference->pack(), options.fit.jitter);
-      row.fit_seconds = seconds_since(start);
-      score(*model, test_inputs, test_targets, subset.targets, row);
-    } catch (const std::runtime_error& e) {
-      row.status = "failed";
-      row.reason = e.what();
-    } catch (const std::invalid_argument& e) {
-      throw data_error(file, row, e);
-    }
-    return row;
-  }
-  if (c.backend == "exact" && over_budget(row, true)) return row;
-  gp::BackendSettings settings = options.settings;
-  settings.exact_points = c.size;
-  const auto backend = gp::make_backend(c.backend, settings);
+  if (c.backend == "exact_reference") row.termination = "not optimised";
   try {
-    gp::FitOptions fit_options = options.fit;
-    if (options.start_from_reference) {  // the full vector: reference hyperparameters + the backend's extras
-      fit_options.warm_start = backend->objective(subset, fit_options)->initial_parameters();
-      fit_options.warm_start.head(gp::Hyperparameters::count(subset.input_dim())) = data.reference->pack();
+    std::unique_ptr<gp::GpBackend> backend;
+    if (c.backend != "exact_reference") {
+      gp::BackendSettings settings = options.settings;
+      settings.exact_points = c.size;
+      backend = gp::make_backend(c.backend, settings);
     }
-    const gp::FitResult fit = backend->fit(subset, fit_options);
-    row.fit_seconds = fit.summary.seconds;
-    row.evaluations = fit.summary.evaluations;
-    row.termination = std::string(gp::to_string(fit.summary.termination));
-    score(*fit.model, test_inputs, test_targets, subset.targets, row);
+    const gp::FitOptions fit_options = row_fit_options(c, backend.get(), subset, data, options);
+    row.reason = profile_skip_reason(c, subset, static_cast<int>(test_inputs.rows()), options, fit_options);
+    if (!row.reason.empty()) {
+      row.status = "skipped";
+      return row;
+    }
+    fit_and_score(c, backend.get(), subset, fit_options, options, test_inputs, test_targets, row);
   } catch (const std::runtime_error& e) {  // e.g. conditioning failed even with jitter
     row.status = "failed";
     row.reason = e.what();

@@ -25,6 +25,7 @@ std::string_view to_string(FitTermination termination) {
     case FitTermination::MaxEvaluations: return "evaluation limit reached";
     case FitTermination::NotOptimised: return "not optimised";
     case FitTermination::OptimiserError: return "optimiser error";
+    case FitTermination::TimeLimit: return "time limit reached";
   }
   return "unknown";
 }
@@ -53,6 +54,8 @@ void FitOptions::validate() const {
   if (!(min_noise_ratio >= 0.0) || !std::isfinite(min_noise_ratio))
     fail("min_noise_ratio", std::to_string(min_noise_ratio), "finite and >= 0");
   if (!warm_start.allFinite()) fail("warm_start", "a vector with non-finite entries", "finite entries");
+  if (!(max_seconds >= 0.0) || !std::isfinite(max_seconds))
+    fail("max_seconds", std::to_string(max_seconds), "finite and >= 0 (0: no limit)");
   jitter.validate();
 }
 

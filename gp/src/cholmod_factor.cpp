@@ -39,18 +39,19 @@ struct CholmodFactorizer::Impl {
 
 namespace {
 
-/// A cholmod_sparse header over the caller's arrays (no copy; CHOLMOD only reads them).
-cholmod_sparse lower_view(const LowerPattern& pattern, const std::vector<double>& values) {
+/// A cholmod_sparse header over the caller's arrays (no copy; CHOLMOD only reads them); without
+/// `values`, the pattern alone.
+cholmod_sparse lower_view(const LowerPattern& pattern, const std::vector<double>* values) {
   cholmod_sparse a{};
   a.nrow = static_cast<std::size_t>(pattern.size);
   a.ncol = static_cast<std::size_t>(pattern.size);
   a.nzmax = pattern.row.size();
   a.p = const_cast<int*>(pattern.column_start.data());
   a.i = const_cast<int*>(pattern.row.data());
-  a.x = const_cast<double*>(values.data());
+  a.x = values != nullptr ? const_cast<double*>(values->data()) : nullptr;
   a.stype = -1;  // lower triangle stored
   a.itype = CHOLMOD_INT;
-  a.xtype = CHOLMOD_REAL;
+  a.xtype = values != nullptr ? CHOLMOD_REAL : CHOLMOD_PATTERN;
   a.dtype = CHOLMOD_DOUBLE;
   a.sorted = 1;
   a.packed = 1;
@@ -87,11 +88,29 @@ void copy_supernodal(const cholmod_factor& l, SupernodalFactor& out) {
 CholmodFactorizer::CholmodFactorizer() : impl_(std::make_unique<Impl>()) {}
 CholmodFactorizer::~CholmodFactorizer() = default;
 
+SymbolicFactor CholmodFactorizer::analyze(const LowerPattern& pattern) {
+  cholmod_common* c = &impl_->common;
+  cholmod_sparse a = lower_view(pattern, nullptr);
+  Impl::FactorPtr l(cholmod_analyze(&a, c), Impl::FactorDeleter{c});
+  if (!l) impl_->fail("analysis");
+  SymbolicFactor symbolic{c->lnz, c->fl, 0.0};
+  if (l->is_super) {
+    const auto* super = static_cast<const int*>(l->super);
+    const auto* pi = static_cast<const int*>(l->pi);
+    for (std::size_t s = 0; s < l->nsuper; ++s) {
+      const double columns = super[s + 1] - super[s], below = pi[s + 1] - pi[s] - columns;
+      symbolic.inverse_subset_flops +=
+          3.0 * columns * columns * columns + 4.0 * below * columns * columns + 2.0 * below * below * columns;
+    }
+  }
+  return symbolic;
+}
+
 SparseFactorOutcome CholmodFactorizer::factorize(const LowerPattern& pattern, const std::vector<double>& values,
                                                  double noise_variance, double scale, const JitterSchedule& schedule,
                                                  std::int64_t max_factor_nonzeros, SupernodalFactor& factor) {
   cholmod_common* c = &impl_->common;
-  cholmod_sparse a = lower_view(pattern, values);
+  cholmod_sparse a = lower_view(pattern, &values);
   Impl::FactorPtr l(cholmod_analyze(&a, c), Impl::FactorDeleter{c});
   if (!l) impl_->fail("analysis");
   SparseFactorOutcome outcome;

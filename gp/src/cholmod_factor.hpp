@@ -22,6 +22,16 @@ struct SparseFactorOutcome {
   double factor_nonzeros = 0.0;  ///< nnz(L) of the symbolic analysis
 };
 
+/// CHOLMOD's symbolic analysis of a pattern (ordering, elimination tree, column counts c_j of L, the
+/// diagonal included, supernodes): known before any numerical work.
+struct SymbolicFactor {
+  double nonzeros = 0.0;  ///< nnz(L) = sum_j c_j (CHOLMOD's Common->lnz)
+  double flops = 0.0;     ///< sum_j c_j^2 (Common->fl), the flops of one LL' factorisation: N(N+1)(2N+1)/6 ~ N^3/3 dense
+  /// Flops of SupernodalFactor::inverse_subset on these supernodes: sum_s 3 c^3 + 4 b c^2 + 2 b^2 c
+  /// for supernode s of c columns with b rows below them (supernodal_factor.cpp).
+  double inverse_subset_flops = 0.0;
+};
+
 /// Owns one cholmod_common (started and finished with it) and factorises symmetric matrices given by
 /// their lower triangle in compressed-column form. Not copyable; one per thread.
 class CholmodFactorizer {
@@ -44,6 +54,10 @@ class CholmodFactorizer {
   SparseFactorOutcome factorize(const LowerPattern& pattern, const std::vector<double>& values, double noise_variance,
                                 double scale, const JitterSchedule& schedule, std::int64_t max_factor_nonzeros,
                                 SupernodalFactor& factor);
+
+  /// The same ordering and symbolic analysis as factorize() on `pattern` alone (no values, no
+  /// numerical work). Throws std::runtime_error when CHOLMOD reports an error.
+  SymbolicFactor analyze(const LowerPattern& pattern);
 
  private:
   struct Impl;

@@ -53,6 +53,10 @@ struct ObjectiveBridge {
   }
 };
 
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 std::vector<double> to_std(const Vector& v) { return {v.data(), v.data() + v.size()}; }
 
 Vector clip(const Vector& theta, const ParameterBounds& b) {
@@ -107,6 +111,8 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
   } else {
     double best_of_starts = std::numeric_limits<double>::infinity();
     bool any_start_worked = false;
+    bool out_of_time = false;
+    std::size_t begun = 0;
     for (std::size_t k = 0; k < starts.size(); ++k) {
       nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(p));
       opt.set_lower_bounds(to_std(bounds.lower));
@@ -115,6 +121,15 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
       opt.set_maxeval(options.max_evaluations);
       opt.set_ftol_rel(options.relative_tolerance);
       opt.set_xtol_rel(options.parameter_tolerance);
+      if (options.max_seconds > 0.0) {
+        const double left = options.max_seconds - seconds_since(start_time);
+        if (left <= 0.0) {  // no start begins once the time is used up
+          out_of_time = true;
+          break;
+        }
+        opt.set_maxtime(left);
+      }
+      ++begun;
       std::vector<double> x = to_std(starts[k]);
       double value = 0.0;
       FitTermination termination = FitTermination::Converged;
@@ -122,6 +137,10 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
       try {
         const nlopt::result r = opt.optimize(x, value);
         if (r == nlopt::MAXEVAL_REACHED) termination = FitTermination::MaxEvaluations;
+        if (r == nlopt::MAXTIME_REACHED) {
+          termination = FitTermination::TimeLimit;
+          out_of_time = true;
+        }
       } catch (const nlopt::roundoff_limited&) {
         // L-BFGS stops this way when it cannot improve further at the working precision, typically
         // at the optimum; the best point seen is kept.
@@ -136,8 +155,9 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
         s.termination = worked ? termination : FitTermination::OptimiserError;
       }
     }
-    s.starts = static_cast<int>(starts.size());
+    s.starts = static_cast<int>(begun);
     if (!any_start_worked) s.termination = FitTermination::OptimiserError;
+    if (out_of_time) s.termination = FitTermination::TimeLimit;
     out.parameters = bridge.best_theta.size() == p ? bridge.best_theta : starts.front();
   }
   s.nlml = std::isfinite(bridge.best_value) ? bridge.best_value : s.initial_nlml;
@@ -145,7 +165,7 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
   s.jittered_evaluations = bridge.jittered;
   s.failed_evaluations = bridge.failed;
   s.max_jitter = bridge.max_jitter;
-  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  s.seconds = seconds_since(start_time);
   return out;
 }
 

@@ -37,6 +37,7 @@ struct ProfileCommandOptions {
   std::uint64_t seed = 1;
   int max_test = 0;
   double memory_budget_gb = 4.0;
+  double time_budget = ProfileOptions{}.time_budget_seconds;
   gp::BackendSettings settings;
   bool threads_given = false;  ///< --threads on the command line (else under MPI: each rank's share)
 };
@@ -131,6 +132,7 @@ int run_profile_command(ProfileCommandOptions& o) {
     options.fit.max_evaluations = o.max_evaluations;
     options.fit.seed = o.seed;
     options.memory_budget_bytes = o.memory_budget_gb * static_cast<double>(1ull << 30);
+    options.time_budget_seconds = o.time_budget;
     if (o.max_test > 0) options.max_test_points = o.max_test;
     if (o.start != "data" && o.start != "reference")
       throw InputError("--start '" + o.start + "': expected 'data' or 'reference'");
@@ -202,6 +204,11 @@ void add_profile_command(CLI::App& app, CommandAction& action) {
                   "Skip exact-GP sizes whose dense N x N matrices (16 N^2 bytes fitted, 8 N^2 conditioned) exceed this")
       ->capture_default_str()
       ->check(number_in(0.0, 1e6, true));
+  cmd->add_option("--time-budget", o->time_budget,
+                  "Seconds per row (backend x size): skip rows whose predicted fit + prediction time (flop count at "
+                  "this machine's measured rate) exceeds this, stop fits that pass it at their best point; 0: none")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e9));
   cmd->add_option("--inducing", o->settings.inducing, "fitc: pseudo-inputs M")
       ->capture_default_str()
       ->check(integer_in(1, limits::kMaxInducing));

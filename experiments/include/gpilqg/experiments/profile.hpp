@@ -18,9 +18,16 @@
 /// Subsets: the first n points of one fixed random permutation of the training set (seeded), so each
 /// size contains the smaller ones. Rows: every backend at every size, plus, when the data set has
 /// reference hyperparameters, "exact_reference": the exact GP conditioned (no fit) on the same subset
-/// with those hyperparameters, the baseline. The exact GP (fitted or reference) needs two dense N x N
-/// matrices while fitting (16 N^2 bytes; one when only conditioning); a size whose need exceeds the
-/// memory budget is skipped, and the row says so (status "skipped", reason).
+/// with those hyperparameters, the baseline.
+///
+/// Budgets (profile_budget.cpp), checked per row before any numeric work; a row over one is skipped
+/// and says why (status "skipped", reason):
+///  - memory: the exact GP (fitted or reference) needs two dense N x N matrices while fitting
+///    (16 N^2 bytes; one when only conditioning);
+///  - time: the row's predicted seconds, its flop count (ProfileRowWork) over a measured machine rate
+///    (gp::dense_flop_rate), above the time budget. A fit that runs anyway and passes the budget stops
+///    at its next NLML evaluation with its best point (FitOptions::max_seconds); its row is scored and
+///    says so in `reason`.
 
 #include <cstdint>
 #include <filesystem>
@@ -69,6 +76,14 @@ struct ProfileOptions {
   gp::BackendSettings settings;          ///< exact_points is set to the size for "exact"
   gp::FitOptions fit;                    ///< restarts, max_evaluations, seed
   double memory_budget_bytes = 4.0 * (1ull << 30);  ///< for the exact GP's dense matrices
+  /// Seconds per row (fit + prediction), 0 for none: a row predicted to take longer is skipped, a fit
+  /// that passes it stops at its next NLML evaluation. The default keeps a profile of a few backends
+  /// at a few sizes within minutes: with 100 evaluations it admits the exact GP up to N ~ 2,600 at
+  /// 15 GFLOP/s (N^3 flops per evaluation), while the cheap rows take seconds.
+  double time_budget_seconds = 120.0;
+  /// The machine rate for the time budget in flops per second; 0: measured (gp::dense_flop_rate with
+  /// settings.threads) the first time a row could exceed the budget on a core of 1 GFLOP/s.
+  double flops_per_second = 0.0;
   std::optional<int> max_test_points;    ///< score on the first n of a fixed permutation of the test set
   /// Start every fit from the reference hyperparameters (the backend's extras at its data-driven
   /// values) besides its own data-driven start; needs reference hyperparameters in the data.
@@ -81,7 +96,7 @@ struct ProfileRow {
   std::string backend;    ///< registry name, or "exact_reference"
   int size = 0;           ///< training points
   std::string status;     ///< "ok", "skipped" or "failed"
-  std::string reason;     ///< why skipped / failed
+  std::string reason;     ///< why skipped / failed, or "stopped at time budget after K evaluations"
   double fit_seconds = 0.0;      ///< fit (or conditioning for exact_reference)
   double predict_seconds = 0.0;  ///< mean and variance at all test points
   double smse = 0.0, mnlp = 0.0, msll = 0.0;
@@ -131,6 +146,46 @@ ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& 
 /// The peak memory the exact GP needs at n points: 16 n^2 bytes when fitted, 8 n^2 when conditioned.
 double exact_memory_bytes(std::int64_t n, bool fitted);
 
+/// The predicted work of one row in flops (counted as the dense linear algebra's: one multiply or add
+/// each), with N the size, D the input dimension, T the test points, E = 1 + max_evaluations x starts
+/// the most evaluations the fit may make (starts: the data-driven one, the restarts, and the
+/// reference when --start reference):
+///   exact             per evaluation N^3 (Cholesky N^3/3, inverse from it 2 N^3/3) + N^2 (3 D + 20)
+///                     (kernel with its exp, gradient); final 2 N^3/3 (conditioning, L^-1) + T N^2
+///                     (variances) + T N (3 D + 20) (cross-covariances); exact_reference: final only;
+///   compact           at the fit's first start, from CHOLMOD's symbolic analysis
+///                     (gp::CompactBackend::analyze, no numerical work): fl, the flops of one
+///                     factorisation, and Z, those of the gradient's sparse inverse subset; per
+///                     evaluation fl + Z + nnz(K) (6 D + 40) (kernel values, gradient sums); final
+///                     fl + 2 T nnz(L) (a solve through L per test point, the worst case);
+///   fitc, ssgp        M = min(inducing, N) for fitc (six N x M by M x M products), M = 2 frequencies
+///                     for ssgp (Phi'Phi and Phi A^-1): per evaluation 12 N M^2 (fitc) or 3 N M^2
+///                     (ssgp) + 2 N M (3 D + 20) (kernel or features, gradient); final
+///                     4 N M^2 + T (M^2 + M (3 D + 20)).
+struct ProfileRowWork {
+  double per_evaluation = 0.0;  ///< flops of one NLML evaluation with its gradient
+  int evaluations = 0;          ///< E (0 for exact_reference)
+  double final = 0.0;           ///< flops of conditioning the returned model and predicting the test set
+  std::string what;             ///< the per-evaluation count in words, for the reason
+  double total() const { return per_evaluation * evaluations + final; }
+};
+
+/// The work of row `c` on `subset` (its nested training set) with `test_points` test points; `fit`
+/// is the row's FitOptions (its warm start is the compact backend's first start). Runs the compact
+/// backend's symbolic analysis; throws std::invalid_argument for degenerate data like a fit would.
+ProfileRowWork profile_row_work(const ProfileCase& c, const gp::TrainingSet& subset, int test_points,
+                                const ProfileOptions& options, const gp::FitOptions& fit);
+
+/// Why row `c` is skipped before any numeric work, or empty: over the memory budget (the exact GP's
+/// dense matrices, exact_memory_bytes), or, with a time budget, predicted seconds
+/// profile_row_work(...).total() / rate above it, e.g.
+///   "predicted 267 s > 120 s time budget (CHOLMOD: 3.8e9 flops per factorisation + 3.6e10 for the
+///    gradient's inverse subset, x 101 evaluations + 1.3e10 to condition and predict, at 14.9 GFLOP/s)".
+/// The rate is options.flops_per_second, else measured (gp::dense_flop_rate) only when the row needs
+/// more than budget x 1e9 flops.
+std::string profile_skip_reason(const ProfileCase& c, const gp::TrainingSet& subset, int test_points,
+                                const ProfileOptions& options, const gp::FitOptions& fit);
+
 /// {"file", "data": {name, format, target, train_points, test_points, input_dim}, "settings": {...},
 ///  "rows": [{backend, size, status, reason, fit_s, predict_s, smse, mnlp, msll, nlml, evaluations,
 ///  termination, conditioning}]} (numbers null for skipped rows).
@@ -142,7 +197,8 @@ std::string format_profile(const ProfileReport& report);
 ///   / attrs: schema_version (1), gpilqg_version, created, data_file, data_name, target, test_points,
 ///            train_points, input_dim
 ///   /rows/{backend (strings), size, status (strings), reason (strings), fit_s, predict_s, smse, mnlp,
-///          msll, nlml, evaluations}   one entry per row (NaN where skipped)
+///          msll, nlml, evaluations}   one entry per row (0 where skipped); `reason` also says when a
+///          fit was stopped at the time budget
 /// Throws std::runtime_error naming the file.
 void write_profile_hdf5(const std::filesystem::path& file, const ProfileReport& report);
 

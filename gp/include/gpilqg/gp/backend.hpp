@@ -163,6 +163,11 @@ struct FitOptions {
   double min_noise_std = 1e-9;     ///< absolute floor on sn (target units), see hyperparameter_bounds
   double min_noise_ratio = 1e-4;   ///< floor on sn relative to the target std, see hyperparameter_bounds
   JitterSchedule jitter;
+  /// Wall-clock limit of the whole fit in seconds, 0 for none. Checked after every NLML evaluation
+  /// (NLopt's maxtime, each start given the time that is left; no start begins once it is used up):
+  /// the fit stops at its first evaluation past the limit with the best point so far
+  /// (FitTermination::TimeLimit). Conditioning the returned model comes on top.
+  double max_seconds = 0.0;
   /// Throws std::invalid_argument naming the field.
   void validate() const;
 };
@@ -172,6 +177,7 @@ enum class FitTermination {
   MaxEvaluations,  ///< the best start ran out of evaluations
   NotOptimised,    ///< FitOptions::optimise was false
   OptimiserError,  ///< NLopt failed at every start; the best point evaluated is used
+  TimeLimit,       ///< FitOptions::max_seconds stopped a start or left starts unrun; the best point so far is used
 };
 std::string_view to_string(FitTermination termination);
 
@@ -181,7 +187,7 @@ struct FitSummary {
   int parameters = 0;
   double initial_nlml = 0.0;     ///< at the first start point
   double nlml = 0.0;             ///< at the returned parameters
-  int starts = 0;
+  int starts = 0;                ///< starts begun (fewer than planned when the time limit stopped the fit)
   int best_start = 0;            ///< index of the start that won (0: warm start if given, else initial)
   int evaluations = 0;           ///< over all starts
   int jittered_evaluations = 0;  ///< evaluations whose Cholesky needed jitter

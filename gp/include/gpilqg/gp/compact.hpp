@@ -75,6 +75,26 @@ struct CompactOptions {
   void validate() const;
 };
 
+/// What one evaluation at given hyperparameters will cost, from CHOLMOD's symbolic analysis of the
+/// pattern K will have there (the same ordering and supernodes as the fit's; no kernel values, no
+/// numerical work). With c_j the entries of column j of L (diagonal included):
+///   factor_nonzeros = sum_j c_j,   factorisation_flops = sum_j c_j^2
+/// (CHOLMOD's Common->lnz and Common->fl): N(N+1)(2N+1)/6 ~ N^3/3 when L is dense, N when K is
+/// diagonal, 4N - 3 for a path (tridiagonal K, no fill). The gradient's sparse inverse subset works
+/// per supernode (c columns, b rows below them): the diagonal block inverted by a triangular solve
+/// and multiplied out as full c x c products, then the products with the rows below,
+///   inverse_subset_flops = sum_s 3 c^3 + 4 b c^2 + 2 b^2 c
+/// (3 N^3 when L is dense, one supernode): in 17 dimensions about 9 times the factorisation.
+struct CompactFactorAnalysis {
+  std::int64_t kernel_nonzeros = 0;  ///< entries of K's lower triangle, diagonal included
+  double factor_nonzeros = 0.0;
+  double factorisation_flops = 0.0;
+  double inverse_subset_flops = 0.0;
+  /// K's pattern or L exceeds CompactOptions::max_factor_nonzeros: an evaluation there fails at once
+  /// (no numerical work). When K's pattern is over, nothing was analysed and the counts are 0.
+  bool over_budget = false;
+};
+
 class CompactBackend final : public GpBackend {
  public:
   explicit CompactBackend(CompactOptions options = {});
@@ -87,6 +107,11 @@ class CompactBackend final : public GpBackend {
   /// the factor would exceed max_factor_nonzeros (naming both numbers).
   std::unique_ptr<FittedGp> condition(TrainingSet data, const VectorCRef& parameters,
                                       const JitterSchedule& jitter = {}) const override;
+
+  /// The symbolic analysis at `parameters` ([log l; log sf; log sn], D + 2 entries, e.g. the head of
+  /// objective(data)->initial_parameters()). Costs the neighbour search and the ordering, O(nnz(K))
+  /// memory. Throws std::invalid_argument for degenerate data or a wrongly sized / non-finite vector.
+  CompactFactorAnalysis analyze(const TrainingSet& data, const VectorCRef& parameters) const;
 
  private:
   CompactOptions options_;

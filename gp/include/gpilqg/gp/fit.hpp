@@ -10,6 +10,11 @@
 /// data-driven initial values, then FitOptions::restarts random restarts (restart_parameters). The
 /// start with the lowest NLML wins.
 ///
+/// Time limit (FitOptions::max_seconds > 0): measured from the call; each start gets NLopt's maxtime
+/// set to the time left, which NLopt checks after every evaluation, and no start begins once none is
+/// left. A fit stopped so keeps its best point so far and reports FitTermination::TimeLimit and the
+/// starts begun (FitSummary::starts).
+///
 /// Numerical safeguards: an evaluation whose Cholesky needs jitter is counted and its largest jitter
 /// reported. An evaluation that fails even with jitter returns +infinity from the objective; the
 /// fitter never hands that (or a NaN) to NLopt. It returns a large finite value (1e10 (1 + |best
