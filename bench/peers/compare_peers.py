@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """gpilqg's GP against the peer a user would pick instead, side by side in one run, on the same data,
-N, D and hyperparameters (issue #17):
+N, D and hyperparameters:
 
   a. exact GP NLML + gradient, SE-ARD + noise, D = 5, N = 1,000 and 4,000   vs scikit-learn
   b. a whole exact-GP fit at N = 1,000, one start from the same point        vs scikit-learn

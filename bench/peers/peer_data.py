@@ -16,7 +16,7 @@ import numpy as np
 INPUTS = 5
 THETA = np.array([0.3, 0.5, 1.0, 0.8, 0.8, 0.0, math.log(0.05)])
 
-# Sizes of the cases (issue #17) and of the smoke test (--quick).
+# Sizes of the cases and of the smoke test (--quick).
 FULL = {"nlml_sizes": [1000, 4000], "fit_size": 1000, "predict_size": 4000, "test_points": 1750,
         "fitc_size": 5000, "fitc_inducing": 100}
 QUICK = {"nlml_sizes": [300, 600], "fit_size": 300, "predict_size": 600, "test_points": 350,
