@@ -10,6 +10,7 @@
 #include "gpilqg/control/ddp_solver.hpp"
 #include "gpilqg/core/cartpole.hpp"
 #include "gpilqg/core/integrator.hpp"
+#include "cartpole_swingup.hpp"
 #include "test_support.hpp"
 
 namespace gpilqg {
@@ -26,10 +27,7 @@ class CartPoleOracle : public ::testing::TestWithParam<OracleCase> {};
 TEST_P(CartPoleOracle, ReachesTheReferenceOptimumAndFinalState) {
   const OracleCase c = GetParam();
   IntegratedStepModel model(std::make_shared<CartPole>(), Integrator::Euler, 0.05);
-  Vector goal(4);
-  goal << 0, 0, std::numbers::pi, 0;
-  const QuadraticCost cost(0.05, Matrix::Zero(4, 4), Matrix::Constant(1, 1, 0.1),
-                           Vector(Eigen::Vector4d(100, 100, 1000, 100)).asDiagonal(), goal);
+  const QuadraticCost cost = test::cartpole_swingup_cost(0.05, Matrix::Zero(4, 4));
   DdpProblem problem;
   problem.model = &model;
   problem.cost = &cost;

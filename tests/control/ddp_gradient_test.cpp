@@ -9,6 +9,7 @@
 
 #include "gpilqg/control/ddp_solver.hpp"
 #include "gpilqg/core/integrator.hpp"
+#include "cartpole_swingup.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "linear_models.hpp"
 #include "test_support.hpp"
@@ -52,10 +53,7 @@ TEST_P(MeritGradient, MatchesCentralDifferencesOnANonlinearSystem) {
   noise.additive_std = Vector::Constant(1, 0.3);
   noise.multiplicative_std = Vector::Constant(1, 0.4);
   IntegratedStepModel model(make_system("cartpole", Preset::Simulator, {}, noise), Integrator::RK4, 0.05);
-  Vector goal(4);
-  goal << 0, 0, std::numbers::pi, 0;
-  const QuadraticCost cost(0.05, Matrix::Identity(4, 4), Matrix::Constant(1, 1, 0.1),
-                           Vector(Eigen::Vector4d(100, 100, 1000, 100)).asDiagonal(), goal);
+  const QuadraticCost cost = test::cartpole_swingup_cost(0.05, Matrix::Identity(4, 4));
   DdpProblem problem;
   problem.model = &model;
   problem.cost = &cost;

@@ -9,6 +9,7 @@
 #include "gpilqg/control/ddp_solver.hpp"
 #include "gpilqg/core/cartpole.hpp"
 #include "gpilqg/core/integrator.hpp"
+#include "cartpole_swingup.hpp"
 
 namespace gpilqg {
 namespace {
@@ -35,10 +36,7 @@ class CountingModel final : public StepModel {
 };
 
 DdpResult swing_up(const StepModel& model) {
-  Vector goal(4);
-  goal << 0, 0, std::numbers::pi, 0;
-  const QuadraticCost cost(0.05, Matrix::Zero(4, 4), Matrix::Constant(1, 1, 0.1),
-                           Vector(Eigen::Vector4d(100, 100, 1000, 100)).asDiagonal(), goal);
+  const QuadraticCost cost = test::cartpole_swingup_cost(0.05, Matrix::Zero(4, 4));
   DdpProblem problem;
   problem.model = &model;
   problem.cost = &cost;
