@@ -42,6 +42,16 @@ TEST(Cli, HelpListsTheDataCommand) {
   EXPECT_NE(info_help.out.find("--json"), std::string::npos) << info_help.out;
 }
 
+TEST(Cli, VersionNamesTheBlasLibraryItLoaded) {
+  const auto result = test::run_cli("--version");
+  EXPECT_EQ(result.status, 0) << result.err;
+  EXPECT_EQ(result.out.rfind("gpilqg ", 0), 0u) << result.out;
+  // The file the loader resolved for BLAS's dgemm: a libblas or an OpenBLAS library, never unknown.
+  const auto blas = result.out.find("BLAS: /");
+  ASSERT_NE(blas, std::string::npos) << result.out;
+  EXPECT_TRUE(result.out.find("blas", blas + 7) != std::string::npos) << result.out;
+}
+
 TEST(Cli, DataInfoPrintsASummaryTable) {
   const auto file = write_text(test::temporary_dir("cli_data") / "cart.csv", kValidCsv);
   const auto result = test::run_cli("data info " + quote(file) + " --system cartpole");
