@@ -84,11 +84,12 @@ ParameterBounds hyperparameter_bounds(const TrainingSet& data, double min_noise_
   b.lower.resize(Hyperparameters::count(d));
   b.upper.resize(Hyperparameters::count(d));
   b.lower.head(d) = (spread.array() * 1e-3).log().matrix();
-  b.upper.head(d) = (spread.array() * 1e3).log().matrix();
+  b.upper.head(d) = (spread.array() * kMaxLengthscaleOverSpread).log().matrix();
   b.lower(d) = std::log(1e-3 * sy);
   b.upper(d) = std::log(1e3 * sy);
   b.lower(d + 1) = std::log(std::max(min_noise_ratio * sy, min_noise_std));
-  b.upper(d + 1) = std::log(10.0 * sy);
+  // A floor above 10 s_y (sensors noisier than the targets vary) fixes sn at the floor.
+  b.upper(d + 1) = std::max(std::log(10.0 * sy), b.lower(d + 1));
   return b;
 }
 

@@ -1,5 +1,6 @@
 #include "gpilqg/gp/residual_model.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -29,6 +30,8 @@ void ResidualModelOptions::validate() const {
   resample.validate();
   if (threads < 1)
     throw std::invalid_argument("ResidualModelOptions::threads = " + std::to_string(threads) + "; expected >= 1");
+  if (!((noise_floor.array() >= 0.0).all() && noise_floor.allFinite()))
+    throw std::invalid_argument("ResidualModelOptions::noise_floor must be finite and >= 0");
 }
 
 ResidualModel::ResidualModel(SimulatorPtr simulator, std::vector<std::unique_ptr<FittedGp>> outputs,
@@ -64,6 +67,9 @@ ResidualModel ResidualModel::fit(SimulatorPtr simulator, const ResidualData& dat
                                 "; expected N x " + std::to_string(n + m) + " and N x " + std::to_string(n));
   if (previous != nullptr && (previous->state_dim() != n || previous->control_dim() != m))
     throw std::invalid_argument("ResidualModel::fit: the previous model has different dimensions");
+  if (options.noise_floor.size() != 0 && options.noise_floor.size() != n)
+    throw std::invalid_argument("ResidualModel::fit: noise_floor has " + std::to_string(options.noise_floor.size()) +
+                                " entries; expected " + std::to_string(n) + " (one per state) or none");
 
   std::vector<std::unique_ptr<FittedGp>> outputs(static_cast<std::size_t>(n));
   ResidualFitReport local;
@@ -75,6 +81,8 @@ ResidualModel ResidualModel::fit(SimulatorPtr simulator, const ResidualData& dat
   const auto fit_output = [&](int i) {
     const auto index = static_cast<std::size_t>(i);
     FitOptions fit_options = options.fit;
+    if (options.noise_floor.size() != 0)
+      fit_options.min_noise_std = std::max(fit_options.min_noise_std, options.noise_floor(i));
     // Warm start from the previous learner of the same backend (the GP-ILQG loop refits every iteration).
     if (previous != nullptr && previous->output(i).backend_name() == backend.name())
       fit_options.warm_start = previous->output(i).parameters();

@@ -57,10 +57,17 @@ struct ParameterBounds {
 ///   sf  = std of the targets,  sn = 0.1 sf.
 Hyperparameters initial_hyperparameters(const TrainingSet& data);
 
+/// The largest length-scale the box allows, in units of the input's spread. An input the targets do
+/// not depend on drives its length-scale up without bound (ARD switches it off), and the optimiser
+/// runs it to the top of the box. The box must let it get far enough to be off: at 1e6 spreads the
+/// kernel's factor for that input is exp(-(dz / l)^2 / 2) >= 1 - 1e-11 over the data, so it no longer
+/// changes a prediction (a box of 1e3 spreads left a factor down to 1 - 1e-5 per such input).
+inline constexpr double kMaxLengthscaleOverSpread = 1e6;
+
 /// Data-driven box for the shared part, wide enough never to bind on sensible data:
-///   log l_d in [log(1e-3 s_d), log(1e3 s_d)] (s_d the input spread),
+///   log l_d in [log(1e-3 s_d), log(kMaxLengthscaleOverSpread s_d)] (s_d the input spread),
 ///   log sf  in [log(1e-3 s_y), log(1e3 s_y)]  (s_y the target std),
-///   log sn  in [log(max(min_noise_ratio s_y, min_noise_std)), log(10 s_y)].
+///   log sn  in [log(max(min_noise_ratio s_y, min_noise_std)), max(that, log(10 s_y))].
 /// The lower end of sn is the floor on the noise variance: it bounds the condition number of
 /// K = Kff + sn^2 I by about 1 + N sf^2 / sn^2, so that predictions and their gradients keep their
 /// digits even on noise-free (simulated) data. `min_noise_std` is an absolute floor in target units.

@@ -66,6 +66,11 @@ struct ResidualModelOptions {
   FitOptions fit;            ///< per output (the seed is offset by the output index for restarts)
   ResampleOptions resample;  ///< used when a validation set is given
   int threads = 2;           ///< outputs fitted concurrently (1: sequential)
+  /// Empty, or one lower bound per output on the fitted noise std (target units): output i fits with
+  /// min_noise_std = max(fit.min_noise_std, noise_floor(i)). sensor_noise_floor (noise_floor.hpp)
+  /// derives it from the sensors and the process noise.
+  Vector noise_floor;
+  /// Throws std::invalid_argument naming the field; `fit` also checks noise_floor's size.
   void validate() const;
 };
 

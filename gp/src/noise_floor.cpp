@@ -1,0 +1,45 @@
+#include "gpilqg/gp/noise_floor.hpp"
+
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace gpilqg::gp {
+
+Vector sensor_noise_floor(const StepModel& simulator, const ResidualData& data, const VectorCRef& observation_std) {
+  const int n = simulator.state_dim(), m = simulator.control_dim();
+  if (data.inputs.cols() != n + m)
+    throw std::invalid_argument("sensor_noise_floor: data has " + std::to_string(data.inputs.cols()) +
+                                " inputs; expected n + m = " + std::to_string(n + m));
+  if (observation_std.size() != 0 && observation_std.size() != n)
+    throw std::invalid_argument("sensor_noise_floor: observation_std has " + std::to_string(observation_std.size()) +
+                                " entries; expected " + std::to_string(n) + " (one per state) or none");
+  if (observation_std.size() != 0 && !((observation_std.array() >= 0.0).all() && observation_std.allFinite()))
+    throw std::invalid_argument("sensor_noise_floor: observation_std must be finite and >= 0");
+  if (data.size() == 0) return Vector::Zero(n);
+
+  const Vector sensor_variance =
+      observation_std.size() != 0 ? Vector(observation_std.array().square()) : Vector(Vector::Zero(n));
+  const auto workspace = simulator.make_workspace();
+  StepJacobians jacobians;
+  jacobians.resize(n, m);
+  DiffusionColumns columns;
+  Vector x_next(n);
+  Vector smallest = Vector::Constant(n, std::numeric_limits<double>::infinity());
+  for (int r = 0; r < data.size(); ++r) {
+    const Vector z = data.inputs.row(r).transpose();
+    Vector variance = sensor_variance;
+    if (observation_std.size() != 0) {
+      simulator.step(z.head(n), z.tail(m), x_next, &jacobians, *workspace);
+      variance += jacobians.A.cwiseAbs2() * sensor_variance;
+    }
+    if (simulator.noise_dim() > 0) {
+      simulator.noise(z.head(n), z.tail(m), columns, false, *workspace);
+      variance += simulator.dt() * columns.columns.cwiseAbs2().rowwise().sum();
+    }
+    smallest = smallest.cwiseMin(variance);
+  }
+  return smallest.cwiseSqrt();
+}
+
+}  // namespace gpilqg::gp
