@@ -70,6 +70,7 @@ void write_record(Hdf5Writer& h5, const std::string& g, const IterationRecord& r
                r.hyperparameters.empty() ? 0 : r.hyperparameters.front().size());
   for (std::size_t i = 0; i < r.hyperparameters.size(); ++i) hyper.row(static_cast<Eigen::Index>(i)) = r.hyperparameters[i].transpose();
   h5.write_matrix(g + "/hyperparameters", hyper);
+  h5.write_vector(g + "/noise_floor", r.noise_floor);
 }
 
 int read_int(const Hdf5Reader& h5, const std::string& path) { return static_cast<int>(h5.read_scalar(path)); }
@@ -108,6 +109,7 @@ IterationRecord read_record(const Hdf5Reader& h5, const std::string& g) {
   r.repeated = h5.read_scalar(g + "/repeated") != 0.0;
   const Matrix hyper = h5.read_matrix(g + "/hyperparameters");
   for (Eigen::Index i = 0; i < hyper.rows(); ++i) r.hyperparameters.push_back(hyper.row(i).transpose());
+  r.noise_floor = h5.read_vector(g + "/noise_floor");
   return r;
 }
 

@@ -11,6 +11,7 @@
 ///              final_backward_failed}   (the DDP summary without its per-iteration trace)
 ///   /iter_<k>/evaluation/{mean_cost, costs, example_x, example_u, diverged, seconds}
 ///   /iter_<k>/hyperparameters (outputs x D+2; 0 x 0 without a GP)
+///   /iter_<k>/noise_floor (outputs; empty without a GP)
 ///   /model                   the final residual model (gp_io.hpp layout) when final_model is one
 ///
 /// Plan models are code or GPs: on reading, only the last iteration's plan gets a model (the restored

@@ -139,9 +139,11 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     inputs.fit = fit_options(c, seed, name, data.size());
     inputs.variant = c.config.gp_variant;
     inputs.threads = c.threads;
+    inputs.observation_std = c.config.observation_std;
     GpRound round = plan_gp_ilqg_round(task, c.models.simulator, inputs);
     record.fit_seconds = round.fit_seconds;
     record.hyperparameters = std::move(round.hyperparameters);
+    record.noise_floor = std::move(round.noise_floor);
     return std::move(round.plan);
   };
   return learning_loop(c, name, std::move(initial), seed, planner);

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "gpilqg/gp/noise_floor.hpp"
+
 namespace gpilqg {
 
 GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const StepModel>& simulator,
@@ -30,6 +32,8 @@ GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const Step
   gp::ResidualModelOptions options;
   options.fit = in.fit;
   options.threads = std::max(1, in.threads);
+  options.noise_floor = gp::sensor_noise_floor(*simulator, all, in.observation_std);
+  round.noise_floor = options.noise_floor;
   auto model = std::make_shared<const gp::ResidualModel>(gp::ResidualModel::fit(
       simulator, all, *in.backend, options, nullptr, previous != nullptr ? &validation : nullptr, previous));
   round.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

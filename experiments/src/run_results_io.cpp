@@ -12,6 +12,7 @@
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/core/version.hpp"
+#include "gpilqg/experiments/normalised_cost.hpp"
 
 namespace gpilqg {
 namespace {
@@ -41,10 +42,19 @@ void write_algorithm(Hdf5Writer& h5, const std::string& group, const TaskResults
   const auto& first = task.seeds.front()[a];
   const std::size_t iterations = first.iterations.size();
   const Matrix cost = per_iteration_and_seed(task, a, [](const IterationRecord& r) { return r.evaluation.mean_cost; });
-  const Matrix reference_cost =
-      per_iteration_and_seed(task, reference, [](const IterationRecord& r) { return r.evaluation.mean_cost; });
   h5.write_matrix(group + "/cost", cost);
-  h5.write_matrix(group + "/normalised_cost", Matrix(cost.array() / reference_cost.array()));
+  Matrix normalised(cost.rows(), cost.cols()), standard_error(cost.rows(), cost.cols());
+  for (Eigen::Index k = 0; k < cost.rows(); ++k)
+    for (Eigen::Index s = 0; s < cost.cols(); ++s) {
+      const auto& seed_runs = task.seeds[static_cast<std::size_t>(s)];
+      const auto& record = seed_runs[a].iterations[static_cast<std::size_t>(k)];
+      const auto& reference_record = seed_runs[reference].iterations[static_cast<std::size_t>(k)];
+      const NormalisedCost c = normalised_cost(record.evaluation.costs, reference_record.evaluation.costs);
+      normalised(k, s) = c.value;
+      standard_error(k, s) = c.standard_error;
+    }
+  h5.write_matrix(group + "/normalised_cost", normalised);
+  h5.write_matrix(group + "/normalised_cost_se", standard_error);
   h5.write_matrix(group + "/time_fit", per_iteration_and_seed(task, a, [](const IterationRecord& r) { return r.fit_seconds; }));
   h5.write_matrix(group + "/time_solve", per_iteration_and_seed(task, a, [](const IterationRecord& r) { return r.plan.solve_seconds; }));
   h5.write_matrix(group + "/time_rollouts", per_iteration_and_seed(task, a, [](const IterationRecord& r) { return r.rollout_seconds; }));
@@ -102,17 +112,21 @@ void write_algorithm(Hdf5Writer& h5, const std::string& group, const TaskResults
         if (!record.hyperparameters.empty()) P = u64(record.hyperparameters[i].size());
     std::vector<double> hyper;
     Matrix fitted(static_cast<Eigen::Index>(iterations), static_cast<Eigen::Index>(S));
+    Matrix floor = Matrix::Zero(static_cast<Eigen::Index>(iterations), static_cast<Eigen::Index>(S));
     for (std::size_t k = 0; k < iterations; ++k)
       for (std::size_t s = 0; s < S; ++s) {
         const auto& record = task.seeds[s][a].iterations[k];
         const bool has = !record.hyperparameters.empty();
         fitted(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(s)) = has ? 1.0 : 0.0;
+        if (has && record.noise_floor.size() != 0)
+          floor(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(s)) = record.noise_floor(static_cast<Eigen::Index>(i));
         for (std::size_t j = 0; j < P; ++j)
           hyper.push_back(has ? record.hyperparameters[i](static_cast<Eigen::Index>(j)) : 0.0);
       }
     const std::string g = group + "/gp/" + state_names[i];
     h5.write_array(g + "/hyper", {u64(iterations), u64(S), u64(P)}, hyper);
     h5.write_matrix(g + "/fitted", fitted);
+    h5.write_matrix(g + "/noise_floor", floor);
   }
 }
 
@@ -208,8 +222,8 @@ void write_run_results_to(Hdf5Writer& h5, const std::string& root, const RunResu
 namespace {
 
 /// The per-iteration matrices (K+1 x S) of an algorithm's group.
-constexpr std::array<std::string_view, 10> kIterationBySeed = {
-    "cost", "normalised_cost", "time_fit", "time_solve", "time_rollouts", "time_evaluation",
+constexpr std::array<std::string_view, 11> kIterationBySeed = {
+    "cost", "normalised_cost", "normalised_cost_se", "time_fit", "time_solve", "time_rollouts", "time_evaluation",
     "data_rows", "repeated", "diverged", "policy_change"};
 /// The datasets of an algorithm's iter_<k>/ group (S x ...).
 constexpr std::array<std::string_view, 8> kPlanBySeed = {"x", "u", "K", "k", "eval_x", "eval_u", "predicted_cost", "solve_time"};
@@ -244,7 +258,7 @@ std::optional<std::size_t> seed_axis(std::string_view dataset) {
   if (dataset == "converged_at") return 0;
   if (is_one_of(iteration_leaf(dataset), kPlanBySeed)) return 0;
   const std::string_view gp = gp_leaf(dataset);
-  if (gp == "hyper" || gp == "fitted") return 1;
+  if (gp == "hyper" || gp == "fitted" || gp == "noise_floor") return 1;
   return std::nullopt;
 }
 

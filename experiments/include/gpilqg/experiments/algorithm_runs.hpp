@@ -33,6 +33,7 @@ struct IterationRecord {
   double rollout_seconds = 0.0;  ///< data-collection rollouts after this iteration's plan
   double policy_change = -1.0;   ///< AffinePolicy::distance to the previous iteration (-1: none)
   std::vector<Vector> hyperparameters;  ///< per state output: [log l (n+m); log sf; log sn] (empty: no GP)
+  Vector noise_floor;  ///< per state output: the lower bound on sn (gp/noise_floor.hpp; empty: no GP)
   bool repeated = false;        ///< a copy of the previous iteration (converged or fixed model)
 };
 

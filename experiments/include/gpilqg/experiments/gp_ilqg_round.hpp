@@ -9,7 +9,8 @@
 ///    x' - phi_sim(x, u) (gp/residual_model.hpp). With the previous round's GP it is warm-started
 ///    from that GP's hyperparameters and the paper's re-sample rule decides, on the newest rows (the
 ///    rows with the largest round label), whether the previous training points are kept
-///    (gp/resample.hpp). Then Robust-iLQG (F and G = diag(sigma(z))) or, as an ablation, iLQG on the
+///    (gp/resample.hpp). No output may fit a noise std below what the sensors and the process noise
+///    put into its targets (gp/noise_floor.hpp). Then Robust-iLQG (F and G = diag(sigma(z))) or, as an ablation, iLQG on the
 ///    GP mean solves the task on simulator + GP, warm-started from the previous round's controls.
 
 #include <memory>
@@ -31,12 +32,16 @@ struct GpRoundInputs {
   gp::FitOptions fit;     ///< seed, restarts and evaluations of the hyperparameter fit
   DdpVariant variant = DdpVariant::RobustILQG;  ///< with data: RobustILQG (the paper) or ILQG (GP mean)
   int threads = 2;        ///< threads fitting the GP's outputs concurrently (the results do not depend on it)
+  /// The sensors' noise std per state (empty: none). With the simulator's process noise it sets every
+  /// output's floor on the fitted noise std (gp/noise_floor.hpp).
+  Vector observation_std;
 };
 
 struct GpRound {
   Plan plan;  ///< plan.model is the simulator (no data) or the fitted gp::ResidualModel
   double fit_seconds = 0.0;
   std::vector<Vector> hyperparameters;  ///< per state: [log l (n+m); log sf; log sn] (empty: no GP)
+  Vector noise_floor;                   ///< per state: the floor on sn the fit used (empty: no GP)
 };
 
 /// The round (see the file comment). Throws std::invalid_argument for inconsistent inputs (data of

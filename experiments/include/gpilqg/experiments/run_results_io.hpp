@@ -44,7 +44,7 @@
 namespace gpilqg {
 
 /// The root's schema_version: the version of the layout above.
-inline constexpr std::int64_t kRunResultsSchemaVersion = 1;
+inline constexpr std::int64_t kRunResultsSchemaVersion = 2;
 
 /// The axis along which a dataset of /<task>/<algorithm>/ holds one slice per seed, the one table
 /// of it that the writer's layout and `gpilqg merge` share. `dataset` is relative to the algorithm's
