@@ -64,6 +64,19 @@ def draw_off_scale(ax, it, values, ceiling, color):
                         fontsize=6, color=color)
 
 
+def plain_log_labels(ax):
+    """Labels a log y axis with plain numbers (1, 2, 5, 10 rather than 10^0, 2x10^0); within about a
+    decade the minor ticks are labelled too, otherwise only the powers of ten."""
+    plain = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}")
+    ax.yaxis.set_major_formatter(plain)
+    lo, hi = ax.get_ylim()
+    if hi / lo < 30:
+        ax.yaxis.set_minor_formatter(plain)
+        ax.tick_params(axis="y", which="minor", labelsize=7)
+    else:
+        ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+
+
 def plot_cost(task, group, out):
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
     seeds = 1
@@ -86,6 +99,7 @@ def plot_cost(task, group, out):
     ax.set_yscale("log")
     if off_scale:
         ax.set_ylim(top=COST_CEILING)
+    plain_log_labels(ax)
     band = f"mean, band: min-max over {seeds} seeds" if seeds > 1 else "1 seed"
     ax.set_title(f"{task} ({band}; log scale)", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)

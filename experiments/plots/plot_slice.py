@@ -76,7 +76,7 @@ def draw_slice(title, group, path):
     bottom.set_xlabel(with_unit(inp, in_unit))
 
     subtitle = "corrected near the measurements, the simulator with the prior's band far from them"
-    top.set_title(f"{title}: {output} along {inp}, the other inputs at a measured point\n{subtitle}", fontsize=9)
+    top.set_title(f"{title}: next {output} against {inp}, the other inputs at a measured point\n{subtitle}", fontsize=9)
     for ax in (top, bottom):
         ax.grid(True, alpha=0.3)
     fig.tight_layout()
