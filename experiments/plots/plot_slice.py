@@ -46,7 +46,7 @@ def draw_slice(title, group, path):
     out_unit, in_unit = text(s.attrs, "output_unit"), text(s.attrs, "input_unit")
     data_z = s["data_z"][()]
     has_residual = "data_residual" in s
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(6.0, 5.6), sharex=True, gridspec_kw=dict(height_ratios=[3, 2]))
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(6.0, 6.2), sharex=True, gridspec_kw=dict(height_ratios=[3, 2]))
     n_data = len(data_z)
     near = f"{n_data} measurements within one length-scale of the slice"
     if not has_residual:
@@ -64,7 +64,6 @@ def draw_slice(title, group, path):
     else:
         top.scatter(data_z, s["data_y"][()], label=near, **marker)
     top.set_ylabel(with_unit(f"next {output}", out_unit))
-    top.legend(fontsize=7, loc="best")
 
     bottom.fill_between(z, mean - sim - 1.96 * std, mean - sim + 1.96 * std, color="tab:blue", alpha=0.2, linewidth=0)
     bottom.axhline(0.0, color="tab:red")
@@ -75,11 +74,13 @@ def draw_slice(title, group, path):
     bottom.set_ylabel(with_unit(f"next {output} - simulator", out_unit), fontsize=8)
     bottom.set_xlabel(with_unit(inp, in_unit))
 
-    subtitle = "corrected near the measurements, the simulator with the prior's band far from them"
-    top.set_title(f"{title}: next {output} against {inp}, the other inputs at a measured point\n{subtitle}", fontsize=9)
+    top.set_title(f"{title}: next {output} against {inp}, other inputs at a measured point\n"
+                  "corrected near the data, the simulator with the prior's band far from it", fontsize=8)
     for ax in (top, bottom):
         ax.grid(True, alpha=0.3)
-    fig.tight_layout()
+    # Below the panels, where it hides neither the curves nor the measurements.
+    fig.legend(*top.get_legend_handles_labels(), loc="lower center", ncol=2, fontsize=7, frameon=False)
+    fig.tight_layout(rect=(0, 0.09, 1, 1))
     fig.savefig(path, dpi=130)
     plt.close(fig)
 
