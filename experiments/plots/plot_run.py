@@ -145,6 +145,7 @@ def plot_controls(task, group, dt, system, out):
             s.pop("label", None)
     for j in range(m):
         within = [u[j] for u in controls.values() if np.abs(u[j]).max() <= CONTROL_OFF_SCALE * peak[j]]
+        within = within or [u[j] for u in controls.values()]  # the reference itself all zero
         lo, hi = min(v.min() for v in within), max(v.max() for v in within)
         pad = 0.05 * max(hi - lo, 1e-12)
         axes[j, 0].set_ylim(lo - pad, hi + pad)
