@@ -3,20 +3,24 @@
 
 usage: /usr/bin/python3 plot_run.py RESULT.h5 OUT_DIR
 
-Writes, per task: <task>_cost.png (normalised cost against iteration, mean and a min-max band over
-seeds: the paper's Figures 2a, 2b, 3a, 3b), <task>_controls.png (the final policies' controls,
-Figure 2c), for the quadrotor <task>_trajectories.png (paths and height, Figure 3c), and for the
-first task with a learned model <task>_gp_slice.png (the GP with the simulator as its mean, Figure 1).
+Writes, per task: <task>_cost.png (normalised cost against iteration on a log axis, mean and a
+min-max band over seeds: the paper's Figures 2a, 2b, 3a, 3b), <task>_controls.png (the final policies'
+controls, Figure 2c), for the quadrotor <task>_trajectories.png (paths and height, Figure 3c), and for
+every task with a learned model <task>_gp_slice.png (the GP with the simulator as its mean, Figure 1;
+drawn by plot_slice.py). A diverged algorithm does not set the scale: costs above COST_CEILING and
+controls beyond CONTROL_OFF_SCALE times the true model's policy's are named in the legend instead.
 """
 import os
 import sys
 
 import h5py
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from plot_slice import draw_slice  # noqa: E402  (beside this script)
 
 STYLE = {
     "ilqg_real": dict(color="black", linestyle="--", label="iLQG, true model"),
@@ -40,22 +44,66 @@ def algorithms(group):
     return names
 
 
+# Normalised costs above this are failures whose size tells nothing more (a diverged PDDP reaches
+# 1e20): the cost axis stops here and such points are drawn on its top edge, marked and labelled.
+COST_CEILING = 1e4
+
+
+def cost_series(group, name):
+    """Iterations, mean normalised cost over seeds and the band (min, max) over seeds."""
+    cost = group[name]["normalised_cost"][()]  # iterations x seeds
+    return np.arange(cost.shape[0]), cost.mean(axis=1), cost.min(axis=1), cost.max(axis=1), cost.shape[1]
+
+
+def draw_off_scale(ax, it, values, ceiling, color):
+    """Marks the points above `ceiling` on the axis' top edge with their values."""
+    for i, v in zip(it, values):
+        if v > ceiling:
+            ax.plot([i], [ceiling], marker="^", color=color, markersize=6, clip_on=False, zorder=4)
+            ax.annotate(f"{v:.0e}", (i, ceiling), textcoords="offset points", xytext=(0, -10), ha="center",
+                        fontsize=6, color=color)
+
+
+def plain_log_labels(ax):
+    """Labels a log y axis with plain numbers (1, 2, 5, 10 rather than 10^0, 2x10^0); within about a
+    decade the minor ticks are labelled too, otherwise only the powers of ten."""
+    plain = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}")
+    ax.yaxis.set_major_formatter(plain)
+    lo, hi = ax.get_ylim()
+    if hi / lo < 30:
+        ax.yaxis.set_minor_formatter(plain)
+        ax.tick_params(axis="y", which="minor", labelsize=7)
+    else:
+        ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+
+
 def plot_cost(task, group, out):
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
+    seeds = 1
+    off_scale = False
     for name in algorithms(group):
-        cost = group[name]["normalised_cost"][()]  # iterations x seeds
-        it = np.arange(cost.shape[0])
-        mean = cost.mean(axis=1)
+        it, mean, lo, hi, seeds = cost_series(group, name)
         s = style(name)
-        ax.plot(it, mean, marker="o", markersize=3, **s)
-        if cost.shape[1] > 1:
-            ax.fill_between(it, cost.min(axis=1), cost.max(axis=1), color=s.get("color"), alpha=0.15, linewidth=0)
+        above = mean > COST_CEILING
+        if above.any():
+            off_scale = True
+            s["label"] += f" (above {COST_CEILING:.0e}: up to {mean.max():.0e})"
+        line, = ax.plot(it, np.minimum(mean, COST_CEILING), marker="o", markersize=3, **s)
+        draw_off_scale(ax, it, mean, COST_CEILING, line.get_color())
+        if seeds > 1:
+            ax.fill_between(it, np.minimum(lo, COST_CEILING), np.minimum(hi, COST_CEILING), color=line.get_color(),
+                            alpha=0.15, linewidth=0)
     ax.set_xlabel("iteration")
+    ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
     ax.set_ylabel("cost / cost of iLQG on the true model")
     ax.set_yscale("log")
-    ax.set_title(f"{task} (mean, band: min-max over {cost.shape[1]} seed(s))", fontsize=9)
+    if off_scale:
+        ax.set_ylim(top=COST_CEILING)
+    plain_log_labels(ax)
+    band = f"mean, band: min-max over {seeds} seeds" if seeds > 1 else "1 seed"
+    ax.set_title(f"{task} ({band}; log scale)", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="center right" if off_scale else "best")
     fig.tight_layout()
     fig.savefig(os.path.join(out, f"{task}_cost.png"), dpi=130)
     plt.close(fig)
@@ -65,19 +113,43 @@ def last_iteration(alg):
     return max(int(k.split("_")[1]) for k in alg if k.startswith("iter_"))
 
 
-def plot_controls(task, group, dt, out):
+# Axis labels of the controls of the built-in systems (others: u1, u2, ...).
+CONTROL_LABELS = {
+    "cartpole": ["force [N]"],
+    "quadrotor": [f"rotor {j} thrust u{j} [N]" for j in range(1, 5)],
+}
+# A policy whose controls exceed this many times the largest of the true model's policy has diverged;
+# the axis is scaled to the others and the diverged one is named in the legend with its peak.
+CONTROL_OFF_SCALE = 10.0
+
+
+def plot_controls(task, group, dt, system, out):
     names = [n for n in algorithms(group) if n != "gp_ilqg" or "gp_ilqg" in group.attrs["algorithms"].astype(str)]
-    first = group[names[0]]
-    m = first[f"iter_{last_iteration(first)}"]["eval_u"].shape[1]
-    fig, axes = plt.subplots(m, 1, figsize=(5.5, 2.2 * m + 0.8), squeeze=False)
+    controls = {}
     for name in names:
         alg = group[name]
-        u = alg[f"iter_{last_iteration(alg)}"]["eval_u"][0]  # first seed: m x T
+        controls[name] = alg[f"iter_{last_iteration(alg)}"]["eval_u"][0]  # first seed: m x T
+    m = controls[names[0]].shape[0]
+    reference = controls.get("ilqg_real", np.concatenate(list(controls.values()), axis=1))
+    peak = np.maximum(np.abs(reference).max(axis=1), 1e-12)  # per control
+    labels = CONTROL_LABELS.get(system, [])
+    fig, axes = plt.subplots(m, 1, figsize=(5.5, 2.2 * m + 0.8), squeeze=False, sharex=True)
+    for name, u in controls.items():
         t = np.arange(u.shape[1]) * dt
+        s = style(name)
+        diverged = np.abs(u).max(axis=1) > CONTROL_OFF_SCALE * peak
+        if diverged.any():
+            s["label"] += f" (off scale: |u| up to {np.abs(u).max():.0e})"
         for j in range(m):
-            axes[j, 0].step(t, u[j], where="post", **style(name))
+            axes[j, 0].step(t, u[j], where="post", **s)
+            s.pop("label", None)
     for j in range(m):
-        axes[j, 0].set_ylabel(f"u{j + 1}" if m > 1 else "force [N]")
+        within = [u[j] for u in controls.values() if np.abs(u[j]).max() <= CONTROL_OFF_SCALE * peak[j]]
+        within = within or [u[j] for u in controls.values()]  # the reference itself all zero
+        lo, hi = min(v.min() for v in within), max(v.max() for v in within)
+        pad = 0.05 * max(hi - lo, 1e-12)
+        axes[j, 0].set_ylim(lo - pad, hi + pad)
+        axes[j, 0].set_ylabel(labels[j] if j < len(labels) else f"u{j + 1}", fontsize=8)
         axes[j, 0].grid(True, alpha=0.3)
     axes[-1, 0].set_xlabel("time [s]")
     axes[0, 0].legend(fontsize=7)
@@ -111,25 +183,6 @@ def plot_quadrotor(task, group, dt, out):
     plt.close(fig)
 
 
-def plot_slice(task, group, out):
-    s = group["figure1"]
-    z, mean, std = s["grid"][()], s["mean"][()], s["std"][()]
-    fig, ax = plt.subplots(figsize=(5.5, 3.6))
-    ax.fill_between(z, mean - 1.96 * std, mean + 1.96 * std, color="tab:blue", alpha=0.2, label="95% band")
-    ax.plot(z, mean, color="tab:blue", label="simulator + GP")
-    ax.plot(z, s["simulator"][()], color="tab:red", label="simulator (the GP's mean)")
-    ax.plot(z, s["truth"][()], color="black", linestyle="--", label="real world")
-    ax.scatter(s["data_z"][()], s["data_y"][()], s=6, color="tab:gray", label="measurements near the slice")
-    ax.set_xlabel(str(s.attrs["input"]))
-    ax.set_ylabel(f"next {s.attrs['output']}")
-    ax.set_title("corrected near the data, the simulator far from it", fontsize=9)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, f"{task}_gp_slice.png"), dpi=130)
-    plt.close(fig)
-
-
 def main():
     if len(sys.argv) != 3:
         sys.exit("usage: plot_run.py RESULT.h5 OUT_DIR")
@@ -142,11 +195,11 @@ def main():
             group = f[task]
             dt = float(group.attrs["dt"])
             plot_cost(task, group, out)
-            plot_controls(task, group, dt, out)
+            plot_controls(task, group, dt, system, out)
             if system == "quadrotor":
                 plot_quadrotor(task, group, dt, out)
             if "figure1" in group:
-                plot_slice(task, group, out)
+                draw_slice(task, group, os.path.join(out, f"{task}_gp_slice.png"))
     print(f"figures written to {out}")
 
 

@@ -313,7 +313,7 @@ void write_figure1(Hdf5Writer& h5, const Parts& parts, const TaskPlan& plan) {
   }
   if (part.task(plan.name)->figure1.empty()) return;
   as_input_error(part.file, [&] {
-    for (const char* name : {"output", "input"})
+    for (const char* name : {"output", "input", "output_unit", "input_unit"})
       if (part.h5->has_attribute(group, name)) h5.attribute(group, name, part.h5->string_attribute(group, name));
   });
 }

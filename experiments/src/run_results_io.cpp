@@ -12,6 +12,7 @@
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/core/version.hpp"
+#include "gpilqg/experiments/model_slice_io.hpp"
 #include "gpilqg/experiments/normalised_cost.hpp"
 
 namespace gpilqg {
@@ -159,24 +160,6 @@ void write_data(Hdf5Writer& h5, const std::string& group, const TaskResults& tas
   h5.write_vector(group + "/data/iteration", iteration_of_row);
 }
 
-void write_slice(Hdf5Writer& h5, const std::string& group, const ModelSlice& s, const SystemSignature& signature) {
-  if (s.grid.size() == 0) return;
-  std::vector<std::string> inputs;
-  for (const auto& q : signature.states) inputs.push_back(q.name);
-  for (const auto& q : signature.controls) inputs.push_back(q.name);
-  const std::string g = group + "/figure1";
-  h5.write_vector(g + "/grid", s.grid);
-  h5.write_vector(g + "/simulator", s.simulator);
-  h5.write_vector(g + "/mean", s.mean);
-  h5.write_vector(g + "/std", s.std);
-  h5.write_vector(g + "/truth", s.truth);
-  h5.write_vector(g + "/data_z", s.data_z);
-  h5.write_vector(g + "/data_y", s.data_y);
-  h5.write_vector(g + "/base", s.base);
-  h5.attribute(g, "output", signature.states[static_cast<std::size_t>(s.output)].name);
-  h5.attribute(g, "input", inputs[static_cast<std::size_t>(s.input)]);
-}
-
 std::size_t index_of(const std::vector<std::string>& names, const std::string& name) {
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return i;
@@ -215,7 +198,7 @@ void write_run_results_to(Hdf5Writer& h5, const std::string& root, const RunResu
     for (std::size_t a = 0; a < task.algorithms.size(); ++a)
       write_algorithm(h5, group + "/" + task.algorithms[a], task, a, reference, state_names);
     if (compared) h5.link(group + "/gp_ilqg", group + "/" + main_gp);
-    write_slice(h5, group, task.slice, signature);
+    write_model_slice(h5, group, task.slice, signature);
   }
 }
 

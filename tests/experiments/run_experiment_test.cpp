@@ -100,13 +100,15 @@ TEST(RunExperiment, ModelSliceReturnsToTheSimulatorFarFromTheData) {
   const auto& gp = find(r.tasks[0], 0, "gp_ilqg");
   const auto* model = dynamic_cast<const gp::ResidualModel*>(gp.final_model.get());
   ASSERT_NE(model, nullptr);
-  // Six length-scales beyond the data on either side: the corrected model is the simulator and the
-  // standard deviation is the prior's sf (the paper's Figure 1).
+  // kSliceMargin length-scales beyond the data on either side, where every measurement's covariance
+  // with the slice is below sf^2 exp(-8): the corrected model is the simulator and the standard
+  // deviation is the prior's sf (the paper's Figure 1).
   const double sf = std::sqrt(model->output(s.output).prior_variance());
   for (const Eigen::Index end : {Eigen::Index{0}, s.grid.size() - 1}) {
-    EXPECT_NEAR(s.mean(end), s.simulator(end), 1e-3 * sf);
-    EXPECT_NEAR(s.std(end), sf, 1e-3 * sf);
+    EXPECT_NEAR(s.mean(end), s.simulator(end), 1e-2 * sf);
+    EXPECT_NEAR(s.std(end), sf, 1e-2 * sf);
   }
+  EXPECT_EQ(s.data_residual.size(), s.data_z.size());
   EXPECT_LT(s.std.minCoeff(), 0.5 * sf);  // and it is corrected near the data
 }
 
@@ -136,6 +138,8 @@ TEST(RunExperiment, ResultFileHasTheDocumentedLayoutAndPlots) {
   EXPECT_EQ(shape_of(h5, "/first/gp_ilqg/iter_2/predicted_cost"), Shape({2}));
   EXPECT_EQ(shape_of(h5, "/first/gp_ilqg/gp/theta_dot/hyper"), Shape({3, 2, 7}));
   EXPECT_EQ(shape_of(h5, "/second/figure1/grid"), Shape({401}));
+  EXPECT_EQ(shape_of(h5, "/second/figure1/length_scales"), Shape({5}));
+  EXPECT_EQ(shape_of(h5, "/second/figure1/data_residual"), shape_of(h5, "/second/figure1/data_z"));
   const hsize_t rows = static_cast<hsize_t>(find(r.tasks[1], 0, "gp_ilqg").data.size() +
                                             find(r.tasks[1], 1, "gp_ilqg").data.size());
   EXPECT_EQ(shape_of(h5, "/second/data/dx"), Shape({rows, 4}));

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gpilqg/experiments/algorithm_runs.hpp"
+#include "gpilqg/experiments/model_slice.hpp"
 #include "gpilqg/experiments/run_config.hpp"
 
 namespace gpilqg {
@@ -28,20 +29,6 @@ struct RunOptions {
   int threads = 2;
 };
 
-/// A 1-D picture of the learned model (the paper's Figure 1): one state output of the GP-corrected
-/// step against one input, the other inputs held at a measured point, out to two data widths or six length-scales
-/// (whichever is more) beyond the data on both sides.
-struct ModelSlice {
-  int output = 0, input = 0;
-  Vector base;        ///< the measured point z* the slice goes through
-  Vector grid;        ///< values of z_input
-  Vector simulator;   ///< phi_sim(z)_output: the simulator's next state (the GP's mean function)
-  Vector mean;        ///< phi_sim + mu: the corrected model
-  Vector std;         ///< sqrt(var): the GP's latent standard deviation
-  Vector truth;       ///< the real world's mean next state
-  Vector data_z, data_y;  ///< measured transitions near the slice: z_input and x'_output
-};
-
 struct TaskResults {
   std::vector<std::string> algorithms;            ///< names, in order
   std::vector<std::vector<AlgorithmRun>> seeds;   ///< [seed][algorithm]
@@ -55,9 +42,5 @@ struct RunResults {
 };
 
 RunResults run_experiment(const RunConfig& config, const RunOptions& options);
-
-/// The slice through the measured point nearest the data's mean, for the output with the largest
-/// signal variance and its most relevant input (shortest length-scale relative to the data's spread).
-ModelSlice model_slice(const StepModel& world, const StepModel& model, const TransitionData& data);
 
 }  // namespace gpilqg

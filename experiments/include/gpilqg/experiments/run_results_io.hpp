@@ -21,8 +21,7 @@
 ///   /<task>/<algorithm>/iter_<k>/{eval_x, eval_u} (S x n x T+1, S x m x T): the first evaluation rollout
 ///   /<task>/<algorithm>/gp/<state>/hyper (K+1 x S x D+2): [log l; log sf; log sn], zeros where
 ///                           gp/<state>/fitted (K+1 x S) is 0 (no GP yet); gp_ilqg algorithms only
-///   /<task>/figure1/{grid, simulator, mean, std, truth, data_z, data_y, base}: the 1-D model slice,
-///                           attrs output, input (names)
+///   /<task>/figure1/...     the 1-D model slice (the paper's Figure 1), model_slice_io.hpp
 ///   /<task>/gp_ilqg         a soft link to gp_ilqg_<first backend> when GP backends are compared
 ///
 /// The file is written to a temporary name in the same folder and renamed into place, so a reader
