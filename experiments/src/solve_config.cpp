@@ -15,14 +15,17 @@ SolveConfig read_solve_config(const std::filesystem::path& file) {
 }
 
 SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string>& extra_sections,
-                              const std::string& default_algorithm) {
+                              const std::string& default_algorithm,
+                              const std::vector<std::string>& extra_noise_keys) {
   std::vector<std::string> sections = {"system", "noise", "problem", "solver"};
   sections.insert(sections.end(), extra_sections.begin(), extra_sections.end());
   f.only_keys("", sections);
   f.require_section("system");
   f.require_section("problem");
   f.only_keys("system", {"name", "preset", "integrator", "dt", "substeps"});
-  f.only_keys("noise", {"actuator_additive", "actuator_multiplicative", "state"});
+  std::vector<std::string> noise_keys = {"actuator_additive", "actuator_multiplicative", "state"};
+  noise_keys.insert(noise_keys.end(), extra_noise_keys.begin(), extra_noise_keys.end());
+  f.only_keys("noise", noise_keys);
   f.only_keys("problem", {"horizon", "x0", "goal", "Q", "R", "Qf", "u_min", "u_max", "u_init"});
   f.only_keys("solver", {"algorithm", "max_iterations", "tolerance", "gradient_tolerance", "regularization",
                          "max_seconds"});

@@ -268,9 +268,18 @@ TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
                    {"fast.csv", "episode 0", "0.05"});
   std::string text = test::kTinyPlan;
   text.replace(text.find("max_iterations = 30"), 19, "max_iterations = 30\nalgorithm = \"ilqr\"");
-  expect_bad_input(plan(write(dir / "ilqr.toml", text), "--out " + quote(dir / "x.h5")), {"ilqr.toml:line 21", "solver.algorithm"});
+  expect_bad_input(plan(write(dir / "ilqr.toml", text), "--out " + quote(dir / "x.h5")), {"ilqr.toml:line 22", "solver.algorithm"});
   expect_bad_input(plan(write(dir / "gp.toml", std::string(test::kTinyPlan) + "points = 3\n"), "--out " + quote(dir / "x.h5")),
-                   {"gp.toml:line 27", "gp.points"});
+                   {"gp.toml:line 28", "gp.points"});
+  // Sensor noise of the wrong size, and negative.
+  text = test::kTinyPlan;
+  text.replace(text.find("observation = [0.001, "), 22, "observation = [");
+  expect_bad_input(plan(write(dir / "sensors.toml", text), "--out " + quote(dir / "x.h5")),
+                   {"sensors.toml:line 9", "noise.observation"});
+  text = test::kTinyPlan;
+  text.replace(text.find("observation = [0.001"), 20, "observation = [-0.001");
+  expect_bad_input(plan(write(dir / "negative.toml", text), "--out " + quote(dir / "x.h5")),
+                   {"negative.toml:line 9", "noise.observation", "negative"});
   // A start beyond the divergence bound (the loader of `gpilqg solve`, shared).
   text = test::kTinyPlan;
   text.replace(text.find("x0 = [0.0"), 9, "x0 = [1e300");

@@ -57,6 +57,7 @@ substeps = 10
 dt = 0.05
 [noise]
 actuator_multiplicative = [0.02]
+observation = [0.001, 0.001, 0.001, 0.001]
 [problem]
 horizon = 15
 x0 = [0.0, 0.0, 0.3, 0.0]

@@ -42,11 +42,12 @@ struct SolveConfig {
 /// Reads and validates a config; throws InputError naming the file, line and field.
 SolveConfig read_solve_config(const std::filesystem::path& file);
 
-/// The same schema inside a config with more tables (`gpilqg plan`'s [gp]): `extra_sections` are
-/// allowed beside the four above (the caller reads them), and [solver] algorithm defaults to
-/// `default_algorithm`.
+/// The same schema inside a config with more (`gpilqg plan`'s [gp] and [noise] observation):
+/// `extra_sections` are allowed beside the four above and `extra_noise_keys` in [noise] (the caller
+/// reads them), and [solver] algorithm defaults to `default_algorithm`.
 SolveConfig read_solve_config(const TomlFields& fields, const std::vector<std::string>& extra_sections,
-                              const std::string& default_algorithm);
+                              const std::string& default_algorithm,
+                              const std::vector<std::string>& extra_noise_keys = {});
 
 /// The config's simulator: [system] (its preset, integrator, sub-steps) with [noise], at step dt.
 std::shared_ptr<const StepModel> make_solve_model(const SolveConfig& config);
