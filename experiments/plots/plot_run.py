@@ -50,9 +50,16 @@ COST_CEILING = 1e4
 
 
 def cost_series(group, name):
-    """Iterations, mean normalised cost over seeds and the band (min, max) over seeds."""
+    """Iterations, mean normalised cost over seeds, the band (min, max) over seeds, the number of seeds
+    and the standard error of the mean from the evaluation rollouts, sqrt(sum_s se_s^2) / S (None when
+    the file has no `normalised_cost_se` or a seed's could not be estimated, -1 with one rollout)."""
     cost = group[name]["normalised_cost"][()]  # iterations x seeds
-    return np.arange(cost.shape[0]), cost.mean(axis=1), cost.min(axis=1), cost.max(axis=1), cost.shape[1]
+    se = None
+    if "normalised_cost_se" in group[name]:
+        per_seed = group[name]["normalised_cost_se"][()]
+        if (per_seed >= 0).all():
+            se = np.sqrt((per_seed ** 2).sum(axis=1)) / cost.shape[1]
+    return np.arange(cost.shape[0]), cost.mean(axis=1), cost.min(axis=1), cost.max(axis=1), cost.shape[1], se
 
 
 def draw_off_scale(ax, it, values, ceiling, color):
@@ -81,8 +88,9 @@ def plot_cost(task, group, out):
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
     seeds = 1
     off_scale = False
+    bars = False
     for name in algorithms(group):
-        it, mean, lo, hi, seeds = cost_series(group, name)
+        it, mean, lo, hi, seeds, se = cost_series(group, name)
         s = style(name)
         above = mean > COST_CEILING
         if above.any():
@@ -90,6 +98,11 @@ def plot_cost(task, group, out):
             s["label"] += f" (above {COST_CEILING:.0e}: up to {mean.max():.0e})"
         line, = ax.plot(it, np.minimum(mean, COST_CEILING), marker="o", markersize=3, **s)
         draw_off_scale(ax, it, mean, COST_CEILING, line.get_color())
+        if se is not None and (se > 0).any():
+            on_scale = mean <= COST_CEILING
+            ax.errorbar(it[on_scale], mean[on_scale], yerr=se[on_scale], fmt="none", ecolor=line.get_color(),
+                        elinewidth=1.0, capsize=2.5)
+            bars = True
         if seeds > 1:
             ax.fill_between(it, np.minimum(lo, COST_CEILING), np.minimum(hi, COST_CEILING), color=line.get_color(),
                             alpha=0.15, linewidth=0)
@@ -101,7 +114,9 @@ def plot_cost(task, group, out):
         ax.set_ylim(top=COST_CEILING)
     plain_log_labels(ax)
     band = f"mean, band: min-max over {seeds} seeds" if seeds > 1 else "1 seed"
-    ax.set_title(f"{task} ({band}; log scale)", fontsize=9)
+    if bars:
+        band += "; bars: ±1 standard error of the evaluation"
+    ax.set_title(f"{task}\n({band}; log scale)", fontsize=8)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="center right" if off_scale else "best")
     fig.tight_layout()

@@ -44,7 +44,7 @@ struct RunArguments {
 void print_summary(const RunResults& results) {
   for (std::size_t t = 0; t < results.tasks.size(); ++t) {
     const TaskResults& task = results.tasks[t];
-    std::cout << fmt::format("\n{} (normalised cost: mean over {} seed(s) of cost / ilqg_real's; iterations 0..{})\n",
+    std::cout << fmt::format("\n{} (normalised cost, cost / ilqg_real's: mean±std over {} seed(s); iterations 0..{})\n",
                              results.config.tasks[t].name, task.seeds.size(), results.config.iterations);
     std::size_t reference = 0;
     for (std::size_t a = 0; a < task.algorithms.size(); ++a)
