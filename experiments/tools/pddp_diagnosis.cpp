@@ -6,7 +6,11 @@
 //
 //   pddp_diagnosis SYSTEM DATA.csv ROWS MAX_ITERATIONS [TASK_INDEX] [SEED] [MAX_SECONDS]
 //
-// Not part of the suite; built on request (target gpilqg_pddp_diagnosis).
+// DATA.csv may be "synthetic": ROWS real-world transitions scattered around ilqg_real's plan.
+// Variants (environment): DIAG_U_INIT (initial thrust per rotor), DIAG_U_MIN / DIAG_U_MAX (limits),
+// DIAG_LAMBDA0 (initial regularisation), DIAG_REG ("control" or "value"), DIAG_START_REFERENCE=1
+// (start from ilqg_real's controls), DIAG_MIN_NOISE (floor on every GP's noise std).
+// Not part of the suite; built on request (target gpilqg_pddp_diagnosis). Results: docs/experiments.md.
 
 #include <cmath>
 #include <cstdlib>
