@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -13,6 +14,9 @@
 
 namespace gpilqg {
 namespace {
+
+/// A DdpOptions::max_seconds that never binds (the options require a finite value).
+constexpr double kNoWallTimeLimit = std::numeric_limits<double>::max();
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -174,8 +178,7 @@ DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uin
     problem.horizon = c.task.horizon;
     problem.u_min = c.config.u_min;
     problem.u_max = c.config.u_max;
-    DdpOptions options = c.config.solver;
-    options.max_iterations = c.config.pddp_max_iterations;
+    const DdpOptions options = pddp_solver_options(c.config);
     const Matrix u_start = previous != nullptr ? previous->policy.u_bar : Matrix(c.config.u_init.replicate(1, c.task.horizon));
     const auto solve_start = std::chrono::steady_clock::now();
     PddpResult result = solve_pddp(problem, u_start, options);
@@ -194,6 +197,13 @@ DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uin
 }
 
 }  // namespace
+
+DdpOptions pddp_solver_options(const RunConfig& config) {
+  DdpOptions options = config.solver;
+  options.max_iterations = config.pddp_max_iterations;
+  options.max_seconds = kNoWallTimeLimit;
+  return options;
+}
 
 AlgorithmRun run_pddp_on_data_of(const TaskContext& c, const AlgorithmRun& source, std::uint64_t seed) {
   return learning_loop(c, "pddp", TransitionData{}, seed, pddp_planner(c, "pddp", seed), &source);

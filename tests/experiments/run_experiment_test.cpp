@@ -11,6 +11,7 @@
 #include <H5Cpp.h>
 #include <gtest/gtest.h>
 
+#include "gpilqg/experiments/algorithm_runs.hpp"
 #include "gpilqg/experiments/plot_script.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
 #include "gpilqg/gp/residual_model.hpp"
@@ -33,6 +34,20 @@ const AlgorithmRun& find(const TaskResults& task, std::size_t seed, const std::s
   for (const auto& run : task.seeds.at(seed))
     if (run.name == name) return run;
   throw std::runtime_error("no algorithm " + name);
+}
+
+TEST(RunExperiment, PddpSolvesStopAtTheirIterationCapNotAtAWallTime) {
+  // The quadrotor's PDDP iterations take 3 to 50 s each (N = 160 to 640): with DdpOptions' default
+  // 60 s wall-time cap (what config.solver carries, since [solver] has no max_seconds) its solves
+  // stopped after 2 to 6 of [pddp] max_iterations = 10, at a point set by the machine's load (issue 18).
+  const RunConfig config = load_run_config("quadrotor", std::nullopt);
+  ASSERT_EQ(config.solver.max_seconds, DdpOptions{}.max_seconds);
+  const DdpOptions options = pddp_solver_options(config);
+  EXPECT_EQ(options.max_iterations, config.pddp_max_iterations);
+  EXPECT_GE(options.max_seconds, 1e12);  // never the limit
+  EXPECT_NO_THROW(options.validate());
+  EXPECT_EQ(options.gradient_tolerance, config.solver.gradient_tolerance);
+  EXPECT_EQ(options.cost_tolerance, config.solver.cost_tolerance);
 }
 
 TEST(RunExperiment, WithoutNoiseTheTrueModelsPolicyCostsWhatItsSolverPredicted) {

@@ -70,6 +70,11 @@ AlgorithmRun run_fixed_model(const TaskContext& context, const std::string& name
 AlgorithmRun run_gp_ilqg(const TaskContext& context, const std::string& name, const gp::GpBackend& backend,
                          TransitionData initial, std::uint64_t seed);
 
+/// The solver options of PDDP's plans: [solver] with [pddp] max_iterations as the only cap. No wall-time
+/// limit: DdpOptions' default 60 s used to stop the quadrotor's PDDP solves after 2 to 6 of their 10
+/// iterations, at a point that depended on the machine's load (issue 18).
+DdpOptions pddp_solver_options(const RunConfig& config);
+
 /// PDDP on the data `source` had at each of its iterations (no rollouts of its own).
 AlgorithmRun run_pddp_on_data_of(const TaskContext& context, const AlgorithmRun& source, std::uint64_t seed);
 
