@@ -1,4 +1,4 @@
-// Diagnosis of one PDDP plan of `gpilqg run` (issue 18, point 4): fits PDDP's GPs to the first
+// Diagnosis of one PDDP plan of `gpilqg run` (docs/experiments.md, Quadrotor): fits PDDP's GPs to the first
 // `rows` transitions of a CSV (x, u, x' - x per row, as /<task>/data of a run result), solves PDDP as
 // pddp_planner does, and reports what the plan predicts, what it does on the GP mean, the simulator
 // and the real world (open loop and with its feedback, with and without noise), the GP's one-step

@@ -39,7 +39,7 @@ const AlgorithmRun& find(const TaskResults& task, std::size_t seed, const std::s
 TEST(RunExperiment, PddpSolvesStopAtTheirIterationCapNotAtAWallTime) {
   // The quadrotor's PDDP iterations take 3 to 50 s each (N = 160 to 640): with DdpOptions' default
   // 60 s wall-time cap (what config.solver carries, since [solver] has no max_seconds) its solves
-  // stopped after 2 to 6 of [pddp] max_iterations = 10, at a point set by the machine's load (issue 18).
+  // stopped after 2 to 6 of [pddp] max_iterations = 10, at a point set by the machine's load.
   const RunConfig config = load_run_config("quadrotor", std::nullopt);
   ASSERT_EQ(config.solver.max_seconds, DdpOptions{}.max_seconds);
   const DdpOptions options = pddp_solver_options(config);
