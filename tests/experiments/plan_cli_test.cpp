@@ -69,6 +69,13 @@ fs::path write(const fs::path& file, const std::string& text) {
   return file;
 }
 
+/// test::kTinyPlan with its first `from` replaced by `to`.
+std::string tiny_plan_with(const std::string& from, const std::string& to) {
+  std::string text = test::kTinyPlan;
+  text.replace(text.find(from), from.size(), to);
+  return text;
+}
+
 test::CommandResult plan(const fs::path& config, const std::string& arguments) {
   return test::run_cli("plan " + quote(config) + " " + arguments);
 }
@@ -266,29 +273,23 @@ TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   ASSERT_EQ(test::run_cli("simulate --system cartpole --episodes 1 --steps 20 --dt 0.02 --out " + quote(dir / "fast.csv")).status, 0);
   expect_bad_input(plan(config, "--data " + quote(dir / "fast.csv") + " --out " + quote(dir / "x.h5")),
                    {"fast.csv", "episode 0", "0.05"});
-  std::string text = test::kTinyPlan;
-  text.replace(text.find("max_iterations = 30"), 19, "max_iterations = 30\nalgorithm = \"ilqr\"");
-  expect_bad_input(plan(write(dir / "ilqr.toml", text), "--out " + quote(dir / "x.h5")), {"ilqr.toml:line 22", "solver.algorithm"});
+  expect_bad_input(plan(write(dir / "ilqr.toml", tiny_plan_with("max_iterations = 30", "max_iterations = 30\nalgorithm = \"ilqr\"")),
+                        "--out " + quote(dir / "x.h5")),
+                   {"ilqr.toml:line 22", "solver.algorithm"});
   expect_bad_input(plan(write(dir / "gp.toml", std::string(test::kTinyPlan) + "points = 3\n"), "--out " + quote(dir / "x.h5")),
                    {"gp.toml:line 28", "gp.points"});
-  // Sensor noise of the wrong size, and negative.
-  text = test::kTinyPlan;
-  text.replace(text.find("observation = [0.001, "), 22, "observation = [");
-  expect_bad_input(plan(write(dir / "sensors.toml", text), "--out " + quote(dir / "x.h5")),
+  // Sensor noise of the wrong size, and negative; a start beyond the divergence bound (the loader of
+  // `gpilqg solve`, shared).
+  expect_bad_input(plan(write(dir / "sensors.toml", tiny_plan_with("observation = [0.001, ", "observation = [")),
+                        "--out " + quote(dir / "x.h5")),
                    {"sensors.toml:line 9", "noise.observation"});
-  text = test::kTinyPlan;
-  text.replace(text.find("observation = [0.001"), 20, "observation = [-0.001");
-  expect_bad_input(plan(write(dir / "negative.toml", text), "--out " + quote(dir / "x.h5")),
+  expect_bad_input(plan(write(dir / "negative.toml", tiny_plan_with("observation = [0.001", "observation = [-0.001")),
+                        "--out " + quote(dir / "x.h5")),
                    {"negative.toml:line 9", "noise.observation", "negative"});
-  // A start beyond the divergence bound (the loader of `gpilqg solve`, shared).
-  text = test::kTinyPlan;
-  text.replace(text.find("x0 = [0.0"), 9, "x0 = [1e300");
-  expect_bad_input(plan(write(dir / "far.toml", text), "--out " + quote(dir / "x.h5")),
+  expect_bad_input(plan(write(dir / "far.toml", tiny_plan_with("x0 = [0.0", "x0 = [1e300")), "--out " + quote(dir / "x.h5")),
                    {"far.toml:line", "field 'problem.x0': entry 0 is 1e+300; expected |value| <= 1e+12"});
   // A previous round of another horizon.
-  text = test::kTinyPlan;
-  text.replace(text.find("horizon = 15"), 12, "horizon = 12");
-  expect_bad_input(plan(write(dir / "short.toml", text), "--previous " + p0 + " --out " + quote(dir / "x.h5")),
+  expect_bad_input(plan(write(dir / "short.toml", tiny_plan_with("horizon = 15", "horizon = 12")), "--previous " + p0 + " --out " + quote(dir / "x.h5")),
                    {"p0.h5", "horizon", "15", "12"});
   // A measurement file is no policy file.
   ASSERT_EQ(test::run_cli("simulate --system cartpole --episodes 1 --steps 20 --dt 0.05 --out " + quote(dir / "log.h5")).status, 0);
