@@ -2,6 +2,8 @@
 /// GP per state that learns only its one-step error, d(x, u) = x'_measured - phi_sim(x, u). It is a
 /// StepModel (step and Jacobians of simulator + GP mean), and predicts the correction with its std.
 
+#include <optional>
+
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
@@ -12,6 +14,7 @@
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/gp/backend_registry.hpp"
+#include "gpilqg/gp/noise_floor.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 
 namespace gpilqg::python {
@@ -24,7 +27,8 @@ correction and its std.)")
       .def_static(
           "fit",
           [](const std::shared_ptr<StepModel>& simulator, const MeasurementSet& data, const std::string& backend,
-             int exact_points, int inducing, int frequencies, int restarts, int max_evaluations, std::uint64_t seed) {
+             int exact_points, int inducing, int frequencies, int restarts, int max_evaluations, std::uint64_t seed,
+             const std::optional<Vector>& observation_std) {
             gp::BackendSettings settings;
             settings.exact_points = exact_points;
             settings.inducing = inducing;
@@ -41,14 +45,25 @@ correction and its std.)")
             options.fit.seed = seed;
             LongCall call;
             return call.run<std::shared_ptr<gp::ResidualModel>>([&] {
-              return std::make_shared<gp::ResidualModel>(gp::ResidualModel::fit(simulator, data, *made, options));
+              const gp::ResidualData residuals = gp::make_residual_data(*simulator, data);
+              if (observation_std) {
+                try {
+                  options.noise_floor = gp::sensor_noise_floor(*simulator, residuals, *observation_std);
+                } catch (const std::invalid_argument& e) {
+                  throw InputError(std::string("observation_std: ") + e.what());
+                }
+              }
+              return std::make_shared<gp::ResidualModel>(gp::ResidualModel::fit(simulator, residuals, *made, options));
             });
           },
           py::arg("simulator"), py::arg("data"), py::arg("backend") = "exact", py::arg("exact_points") = 300,
           py::arg("inducing") = 100, py::arg("frequencies") = 100, py::arg("restarts") = 1,
-          py::arg("max_evaluations") = 150, py::arg("seed") = 1,
+          py::arg("max_evaluations") = 150, py::arg("seed") = 1, py::arg("observation_std") = py::none(),
           R"(Fits one GP per state on the one-step errors of simulator (a StepModel at the data's dt) on
-data (a MeasurementSet), with the backend's hyperparameters by NLopt. Runs without the GIL.)")
+data (a MeasurementSet), with the backend's hyperparameters by NLopt. observation_std (one std per
+state, optional): the sensors' noise; with the simulator's process noise it sets each GP's lowest
+noise std (gp/noise_floor.hpp), so that the GP does not explain sensor noise as dynamics. Runs
+without the GIL.)")
       .def("predict",
            [](const gp::ResidualModel& model, const Matrix& x, const Matrix& u) {
              const int n = model.state_dim(), mdim = model.control_dim();

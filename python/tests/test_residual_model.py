@@ -41,3 +41,18 @@ def test_the_step_is_the_simulator_plus_the_gp_mean_and_beats_the_simulator(real
     assert np.linalg.norm(model_error) < 0.3 * np.linalg.norm(simulator_error)
     with pytest.raises(gpilqg.InputError, match="expected"):
         model.predict(x[:, :3], u)
+
+
+def test_the_sensors_noise_sets_each_gps_lowest_noise_std(real_data):
+    """With observation_std every output's fitted noise std is at least what two measurements of a step
+    carry, sqrt(sigma_i^2 + sum_j A_ij^2 sigma_j^2), about sigma_i sqrt(2) since A is close to I over one
+    0.02 s step (no process noise in this simulator)."""
+    simulator = gpilqg.StepModel("cartpole", dt=0.02, integrator="rk4", substeps=10)
+    train = gpilqg.MeasurementSet("cartpole", [(e.t, e.x, e.u) for e in real_data.episodes[:3]])
+    sensors = np.full(4, 0.01)  # 20 times the data's 0.0005: the floor must bind
+    model = gpilqg.ResidualModel.fit(simulator, train, exact_points=150, restarts=0, max_evaluations=40,
+                                     observation_std=sensors)
+    noise_std = np.exp([h[-1] for h in model.hyperparameters])
+    assert (noise_std >= 0.01 * np.sqrt(2) * 0.99).all(), noise_std
+    with pytest.raises(gpilqg.InputError, match="observation_std"):
+        gpilqg.ResidualModel.fit(simulator, train, observation_std=np.full(3, 0.01))
