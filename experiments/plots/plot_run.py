@@ -115,7 +115,7 @@ def plot_cost(task, group, out):
     plain_log_labels(ax)
     band = f"mean, band: min-max over {seeds} seeds" if seeds > 1 else "1 seed"
     if bars:
-        band += "; bars: ±1 standard error of the evaluation"
+        band += "; bars: ±1 standard error"
     ax.set_title(f"{task}\n({band}; log scale)", fontsize=8)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="center right" if off_scale else "best")
