@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
-#include <limits>
 
 #include <fmt/format.h>
 
@@ -14,9 +13,6 @@
 
 namespace gpilqg {
 namespace {
-
-/// A DdpOptions::max_seconds that never binds (the options require a finite value).
-constexpr double kNoWallTimeLimit = std::numeric_limits<double>::max();
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -200,8 +196,7 @@ DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uin
 
 DdpOptions pddp_solver_options(const RunConfig& config) {
   DdpOptions options = config.solver;
-  options.max_iterations = config.pddp_max_iterations;
-  options.max_seconds = kNoWallTimeLimit;
+  options.max_iterations = config.pddp_max_iterations;  // with [solver]'s no wall-time limit (run_config.hpp)
   return options;
 }
 

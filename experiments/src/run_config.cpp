@@ -1,6 +1,7 @@
 #include "gpilqg/experiments/run_config.hpp"
 
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -145,6 +146,10 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
   c.solver.max_iterations = f.integer_in("solver.max_iterations", 1, limits::kMaxSolverIterations);
   c.solver.cost_tolerance = f.number("solver.tolerance");
   c.solver.gradient_tolerance = f.number("solver.gradient_tolerance");
+  // Iterations are a run's only limit on a solve: DdpOptions' default 60 s wall-time cap stopped the
+  // quadrotor's full-horizon Robust-iLQG solves on 600 GP points part-way (WallTime) when the machine
+  // was loaded, so results depended on the load. The largest double never binds (a finite value is required).
+  c.solver.max_seconds = std::numeric_limits<double>::max();
   const std::string gp_algorithm = f.string("solver.gp_algorithm");
   if (gp_algorithm == "robust_ilqg") c.gp_variant = DdpVariant::RobustILQG;
   else if (gp_algorithm == "ilqg") c.gp_variant = DdpVariant::ILQG;

@@ -36,12 +36,13 @@ const AlgorithmRun& find(const TaskResults& task, std::size_t seed, const std::s
   throw std::runtime_error("no algorithm " + name);
 }
 
-TEST(RunExperiment, PddpSolvesStopAtTheirIterationCapNotAtAWallTime) {
-  // The quadrotor's PDDP iterations take 3 to 50 s each (N = 160 to 640): with DdpOptions' default
-  // 60 s wall-time cap (what config.solver carries, since [solver] has no max_seconds) its solves
-  // stopped after 2 to 6 of [pddp] max_iterations = 10, at a point set by the machine's load.
+TEST(RunExperiment, SolvesStopAtTheirIterationCapNotAtAWallTime) {
+  // The quadrotor's PDDP iterations take 3 to 50 s each (N = 160 to 640), and its full-horizon
+  // Robust-iLQG solves on 600 GP points 40 to 60 s: with DdpOptions' default 60 s wall-time cap
+  // (a run's [solver] has no max_seconds) they stopped part-way, at a point set by the machine's load.
   const RunConfig config = load_run_config("quadrotor", std::nullopt);
-  ASSERT_EQ(config.solver.max_seconds, DdpOptions{}.max_seconds);
+  EXPECT_GE(config.solver.max_seconds, 1e12);  // gp_ilqg's solves and MPC windows: never the limit
+  EXPECT_NO_THROW(config.solver.validate());
   const DdpOptions options = pddp_solver_options(config);
   EXPECT_EQ(options.max_iterations, config.pddp_max_iterations);
   EXPECT_GE(options.max_seconds, 1e12);  // never the limit

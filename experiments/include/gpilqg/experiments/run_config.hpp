@@ -70,7 +70,7 @@ struct RunConfig {
   // [gp]
   GpSettings gp;
   // [solver]
-  DdpOptions solver;  ///< variant chosen per algorithm
+  DdpOptions solver;  ///< variant chosen per algorithm; no wall-time limit (iterations are the only one)
   /// The variant GP-ILQG solves with: RobustILQG (the paper: F and the GP's G) or ILQG (an ablation
   /// that ignores the GP's uncertainty and plans on its mean).
   DdpVariant gp_variant = DdpVariant::RobustILQG;
