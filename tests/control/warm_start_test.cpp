@@ -35,19 +35,17 @@ struct PendulumPair {
                      Vector::Constant(2, 100.0).asDiagonal(), (Vector(2) << 0.3, 0.0).finished()};
   Vector x0 = Vector::Zero(2);
 
-  /// iLQR on `model` from the controls `start`.
-  DdpResult optimum(const StepModel& model, const Matrix& start) const {
+  /// The optimum on the planned model: what the previous round hands over.
+  AffinePolicy previous() const {
     DdpProblem p;
-    p.model = &model;
+    p.model = &planned;
     p.cost = &cost;
     p.x0 = x0;
     p.horizon = kT;
     DdpOptions o;
     o.variant = DdpVariant::ILQR;
-    return DdpSolver(o).solve(p, start);
+    return DdpSolver(o).solve(p, Matrix::Zero(1, kT)).policy;
   }
-  /// The optimum on the planned model: what the previous round hands over.
-  AffinePolicy previous() const { return optimum(planned, Matrix::Zero(1, kT)).policy; }
 };
 
 /// The closed loop written out for a linear model: u_t = u_bar_t + k_t + K_t (x_t - x_bar_t), x' = A x + B u.
@@ -88,7 +86,14 @@ TEST(WarmStart, OnAChangedUnstableModelTheClosedLoopStaysNearTheOptimum) {
   EXPECT_GT(w.other_cost, 10.0 * optimum);  // open loop: the pendulum falls
   EXPECT_LT(w.cost, 2.0 * optimum);         // closed loop: it does not
   // And the changed model's own optimum is near the closed loop, far from the open loop.
-  const double new_optimum = s.optimum(s.changed, w.controls).nominal_cost;
+  DdpProblem p;
+  p.model = &s.changed;
+  p.cost = &s.cost;
+  p.x0 = s.x0;
+  p.horizon = kT;
+  DdpOptions o;
+  o.variant = DdpVariant::ILQR;
+  const double new_optimum = DdpSolver(o).solve(p, w.controls).nominal_cost;
   EXPECT_LT(w.cost - new_optimum, 0.1 * (w.other_cost - new_optimum));
 }
 
