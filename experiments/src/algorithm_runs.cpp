@@ -87,6 +87,8 @@ AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, Transi
   return run;
 }
 
+Matrix warm_start(const Plan* previous) { return previous != nullptr ? previous->policy.u_bar : Matrix(); }
+
 gp::FitOptions fit_options(const TaskContext& c, std::uint64_t seed, const std::string& name, int data_rows) {
   gp::FitOptions options;
   options.restarts = c.config.gp.restarts;
@@ -133,7 +135,7 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     // The previous iteration's GP (warm start, re-sample rule) is the model its plan was made on.
     inputs.previous_model =
         previous != nullptr ? std::dynamic_pointer_cast<const gp::ResidualModel>(previous->model) : nullptr;
-    inputs.previous_policy = previous != nullptr ? &previous->policy : nullptr;
+    inputs.previous_u_bar = warm_start(previous);
     inputs.fit = fit_options(c, seed, name, data.size());
     inputs.variant = c.config.gp_variant;
     inputs.threads = c.threads;

@@ -4,33 +4,21 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "gpilqg/control/warm_start.hpp"
 #include "gpilqg/gp/noise_floor.hpp"
 
 namespace gpilqg {
-namespace {
-
-/// The controls a round's solve on `model` starts from: the previous policy's (warm_start.hpp), or
-/// none (task.u_init) in the first round.
-Matrix initial_controls(const DdpTask& task, const StepModel& model, const AffinePolicy* previous) {
-  return previous != nullptr ? warm_start_controls(model, *task.cost, *previous, task.x0).controls : Matrix();
-}
-
-}  // namespace
 
 GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const StepModel>& simulator,
                            const GpRoundInputs& in) {
   if (in.data == nullptr || in.backend == nullptr)
     throw std::invalid_argument("plan_gp_ilqg_round: data and backend are required");
   const int m = simulator->control_dim();
-  const AffinePolicy* previous_policy = in.previous_policy;
-  if (previous_policy != nullptr && (previous_policy->u_bar.rows() != m || previous_policy->horizon() != task.horizon ||
-                                     previous_policy->x_bar.rows() != simulator->state_dim()))
-    throw std::invalid_argument("plan_gp_ilqg_round: the previous policy is not of the task's horizon and the simulator's sizes");
+  if (in.previous_u_bar.size() && (in.previous_u_bar.rows() != m || in.previous_u_bar.cols() != task.horizon))
+    throw std::invalid_argument("plan_gp_ilqg_round: the previous controls are not m x horizon");
   const TransitionData& data = *in.data;
   GpRound round;
   if (data.size() == 0) {
-    round.plan = plan_with_ddp(task, simulator, DdpVariant::ILQG, initial_controls(task, *simulator, previous_policy));
+    round.plan = plan_with_ddp(task, simulator, DdpVariant::ILQG, in.previous_u_bar);
     return round;
   }
   const auto start = std::chrono::steady_clock::now();
@@ -51,7 +39,7 @@ GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const Step
   round.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const int D = static_cast<int>(all.inputs.cols());
   for (int i = 0; i < model->state_dim(); ++i) round.hyperparameters.push_back(model->output(i).parameters().head(D + 2));
-  round.plan = plan_with_ddp(task, model, in.variant, initial_controls(task, *model, previous_policy));
+  round.plan = plan_with_ddp(task, model, in.variant, in.previous_u_bar);
   return round;
 }
 

@@ -81,11 +81,10 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   inputs.fit.max_evaluations = gp_settings.max_evaluations;
   inputs.fit.seed = gp_fit_seed(request.seed, 0, kAlgorithm, data.size());
   int round = data.size() > 0 ? 1 : 0;
-  PolicyFile previous;  // outlives the round: inputs.previous_policy points into it
   if (request.previous) {
-    previous = read_policy_file(*request.previous);
+    const PolicyFile previous = read_policy_file(*request.previous);
     check_previous(previous, *request.previous, c, signature);
-    inputs.previous_policy = &previous.policy;
+    inputs.previous_u_bar = previous.policy.u_bar;
     round = previous.round + 1;
     if (!previous.model_backend.empty()) {
       if (previous.model_backend != gp_settings.backend)

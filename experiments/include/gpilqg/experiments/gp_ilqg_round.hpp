@@ -11,11 +11,7 @@
 ///    rows with the largest round label), whether the previous training points are kept
 ///    (gp/resample.hpp). No output may fit a noise std below what the sensors and the process noise
 ///    put into its targets (gp/noise_floor.hpp). Then Robust-iLQG (F and G = diag(sigma(z))) or, as an ablation, iLQG on the
-///    GP mean solves the task on simulator + GP.
-///
-/// Every solve after the first starts from the previous round's policy in closed loop on the new
-/// model (control/warm_start.hpp), not from its nominal controls open loop, which on an unstable
-/// system fall away from the trajectory the previous round optimised.
+///    GP mean solves the task on simulator + GP, warm-started from the previous round's controls.
 
 #include <memory>
 #include <vector>
@@ -32,7 +28,7 @@ struct GpRoundInputs {
   const TransitionData* data = nullptr;  ///< every transition so far, labelled by round
   const gp::GpBackend* backend = nullptr;
   std::shared_ptr<const gp::ResidualModel> previous_model;  ///< the previous round's GP (null: none)
-  const AffinePolicy* previous_policy = nullptr;  ///< the previous round's policy (null: start from task.u_init)
+  Matrix previous_u_bar;  ///< the previous round's nominal controls, m x T (empty: task.u_init)
   gp::FitOptions fit;     ///< seed, restarts and evaluations of the hyperparameter fit
   DdpVariant variant = DdpVariant::RobustILQG;  ///< with data: RobustILQG (the paper) or ILQG (GP mean)
   int threads = 2;        ///< threads fitting the GP's outputs concurrently (the results do not depend on it)
@@ -49,7 +45,7 @@ struct GpRound {
 };
 
 /// The round (see the file comment). Throws std::invalid_argument for inconsistent inputs (data of
-/// another size than the simulator's, a previous policy of another shape).
+/// another size than the simulator's, a previous u_bar of another shape).
 GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const StepModel>& simulator,
                            const GpRoundInputs& inputs);
 
