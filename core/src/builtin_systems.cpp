@@ -75,12 +75,10 @@ std::vector<LibraryEffect> cartpole_library() {
   using namespace effect_bases;
   std::vector<LibraryEffect> out;
   out.push_back(linear_force_entry("cart_viscous_friction", {"b", "N s/m", 1.0}, "Q_x = -b x_dot", 2, viscous(0, 1)));
-  out.push_back(linear_force_entry("cart_coulomb_friction", {"mu", "N", 1.0}, "Q_x = -mu tanh(x_dot / 0.05)", 2,
-                                   coulomb(0, 1)));
+  out.push_back(coulomb_friction_entry("cart_coulomb_friction", {"mu", "N", 1.0}, "x", "x_dot", 2, 0, 1));
   out.push_back(linear_force_entry("pole_viscous_damping", {"c", "N m s/rad", 0.1}, "Q_theta = -c theta_dot", 2,
                                    viscous(1, 3)));
-  out.push_back(linear_force_entry("pole_coulomb_friction", {"tau", "N m", 0.1},
-                                   "Q_theta = -tau tanh(theta_dot / 0.05)", 2, coulomb(1, 3)));
+  out.push_back(coulomb_friction_entry("pole_coulomb_friction", {"tau", "N m", 0.1}, "theta", "theta_dot", 2, 1, 3));
   out.push_back(linear_force_entry("external_force_x", {"F", "N", 1.0}, "Q_x = F", 2, constant(0)));
   out.push_back(linear_force_entry("quadratic_drag", {"c_d", "N s^2/m^2", 0.1}, "Q_x = -c_d |x_dot| x_dot", 2,
                                    quadratic_drag(1, 1)));
@@ -114,11 +112,15 @@ std::vector<SystemEntry> builtin_system_entries() {
   out[0].description = "cart-pole: point mass on a massless pole (sim: pole 1 m, real: 1.3 m)";
   out[0].build = build_cartpole;
   out[0].effects = cartpole_library();
+  out[0].same_physics = {{"external_force_x", "constant_force:x"}};
   out[0].default_run_config = embedded::kRunCartpoleToml;
   out[1].name = "quadrotor";
   out[1].description = "quadrotor: van den Berg's model (sim: mass 0.5 kg, real: 0.7 kg)";
   out[1].build = build_quadrotor;
   out[1].effects = quadrotor_library();
+  out[1].same_physics = {{"external_force_x", "constant_force:px"},
+                         {"external_force_y", "constant_force:py"},
+                         {"external_force_z", "constant_force:pz"}};
   out[1].default_run_config = embedded::kRunQuadrotorToml;
   return out;
 }

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <fmt/format.h>
 
 #include "gpilqg/core/input_delay.hpp"
 
@@ -15,12 +19,15 @@ LinearForceEffect::Basis viscous(int component, int velocity) {
   };
 }
 
-LinearForceEffect::Basis coulomb(int component, int velocity) {
+LinearForceEffect::Basis coulomb(int component, int velocity, double width) {
+  if (!(width > 0.0) || !std::isfinite(width))
+    throw std::invalid_argument("Coulomb friction: smoothing velocity v0 = " + std::to_string(width) +
+                                "; expected a finite v0 > 0");
   // g = -tanh(v / w), dg/dv = -(1 - tanh^2) / w.
   return [=](const VectorCRef& x, double theta, VectorRef Q, Matrix* dQ_dx) {
-    const double t = std::tanh(x(velocity) / kCoulombWidth);
+    const double t = std::tanh(x(velocity) / width);
     Q(component) -= theta * t;
-    if (dQ_dx != nullptr) (*dQ_dx)(component, velocity) -= theta * (1.0 - t * t) / kCoulombWidth;
+    if (dQ_dx != nullptr) (*dQ_dx)(component, velocity) -= theta * (1.0 - t * t) / width;
   };
 }
 
@@ -52,6 +59,29 @@ LibraryEffect force_entry(ForceEffectPtr force) {
   e.linear = force->linear_in_parameters();
   e.force = std::move(force);
   return e;
+}
+
+LibraryEffect coulomb_friction_entry(std::string name, EffectParameter parameter, const std::string& coordinate,
+                                     const std::string& velocity, int force_dim, int component, int velocity_index,
+                                     double width) {
+  LibraryEffect::Smoothing smoothing;
+  smoothing.velocity = velocity_index;
+  smoothing.width = width;
+  smoothing.at = [=](double v0) {
+    return std::make_shared<const LinearForceEffect>(
+        name, parameter, fmt::format("Q_{} = -{} tanh({} / {:.4g})", coordinate, parameter.name, velocity, v0), force_dim,
+        effect_bases::coulomb(component, velocity_index, v0));
+  };
+  LibraryEffect e = force_entry(smoothing.at(width));
+  e.smoothing = std::move(smoothing);
+  return e;
+}
+
+LibraryEffect constant_force_entry(const std::string& coordinate, const std::string& force, const std::string& unit,
+                                   int force_dim, int component) {
+  return linear_force_entry("constant_force:" + coordinate, {"F", unit, 1.0},
+                            fmt::format("{} = F (a constant offset on {})", force, coordinate), force_dim,
+                            effect_bases::constant(component));
 }
 
 LibraryEffect linear_force_entry(std::string name, EffectParameter parameter, std::string formula, int force_dim,

@@ -50,8 +50,34 @@ const BasisForceDeclaration* user_declaration(const LibraryEffect& effect) {
   return basis == nullptr ? nullptr : &basis->declaration();
 }
 
+LibraryEffect with_smoothing(const LibraryEffect& effect, double v0) {
+  if (!effect.smoothing)
+    throw std::invalid_argument(fmt::format("effect '{}' has no smoothing velocity v0; only Coulomb friction has one",
+                                            effect.name));
+  if (!(v0 > 0.0) || !std::isfinite(v0))
+    throw std::invalid_argument(fmt::format("effect '{}': smoothing velocity v0 = {}; expected a finite v0 > 0",
+                                            effect.name, v0));
+  LibraryEffect out = effect;
+  out.force = effect.smoothing->at(v0);
+  out.formula = out.force->formula();
+  out.smoothing->width = v0;
+  return out;
+}
+
+namespace {
+
+/// `effect` at the smoothing velocity `model` gives it, if any.
+LibraryEffect as_in_model(const LibraryEffect& effect, const ModelSpec& model) {
+  const auto it = model.smoothing.find(effect.name);
+  if (!effect.smoothing || it == model.smoothing.end() || it->second == effect.smoothing->width) return effect;
+  return with_smoothing(effect, it->second);
+}
+
+}  // namespace
+
 std::vector<LibraryEffect> candidate_effects(const ModelSpec& model) {
-  std::vector<LibraryEffect> out = effect_library(model.system);
+  std::vector<LibraryEffect> out;
+  for (const LibraryEffect& e : effect_library(model.system)) out.push_back(as_in_model(e, model));
   out.insert(out.end(), model.user_effects.begin(), model.user_effects.end());
   return out;
 }
@@ -60,7 +86,7 @@ std::string candidate_names(const ModelSpec& model) { return joined_names(candid
 
 LibraryEffect find_candidate(const ModelSpec& model, std::string_view name) {
   for (const LibraryEffect& e : effect_library(model.system))
-    if (e.name == name) return e;
+    if (e.name == name) return as_in_model(e, model);
   for (const LibraryEffect& e : model.user_effects)
     if (e.name == name) return e;
   throw std::invalid_argument(fmt::format("unknown effect '{}' for system '{}'; expected one of: {}", name, model.system,
@@ -138,6 +164,7 @@ ModelSpec ModelSpec::with(const LibraryEffect& effect, const VectorCRef& values)
           replaced = true;
         }
       if (!replaced) out.forces.emplace_back(effect.name, values);
+      if (effect.smoothing) out.smoothing[effect.name] = effect.smoothing->width;
       if (!in_library(system, effect.name)) {
         // A user effect: the model carries its declaration (the latest one of its name).
         auto same = std::find_if(out.user_effects.begin(), out.user_effects.end(),
@@ -176,6 +203,7 @@ std::vector<std::string> ModelSpec::describe() const {
     std::string text = name + ":";
     for (std::size_t i = 0; i < e.parameters.size(); ++i)
       text += fmt::format(" {} = {:.6g} {}", e.parameters[i].name, values(static_cast<Eigen::Index>(i)), e.parameters[i].unit);
+    if (e.smoothing) text += fmt::format(" (v0 = {:.4g})", e.smoothing->width);
     lines.push_back(text);
   }
   return lines;

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "builtin_systems.hpp"
+#include "gpilqg/core/effect_builders.hpp"
 #include "gpilqg/core/generalised_forces.hpp"
 #include "gpilqg/core/mujoco_system.hpp"
 
@@ -32,7 +33,19 @@ void complete_system_entry(SystemEntry& entry) {
   }
   if (!probe) throw std::invalid_argument(fmt::format("system '{}' ({}): its builder returned nothing", entry.name, entry.origin));
   if (entry.parameters.empty()) entry.parameters = probe->parameters();
-  entry.generalised_forces = dynamic_cast<const GeneralisedForceInput*>(probe.get()) != nullptr;
+  const auto* forces = dynamic_cast<const GeneralisedForceInput*>(probe.get());
+  entry.generalised_forces = forces != nullptr;
+  if (forces == nullptr) return;
+  // A constant generalised force on every coordinate: an offset almost every real machine has.
+  const auto components = static_cast<int>(forces->generalised_forces().size());
+  for (const GeneralisedCoordinate& c : generalised_coordinates(*probe)) {
+    const std::string name = "constant_force:" + c.name;
+    if (std::any_of(entry.effects.begin(), entry.effects.end(), [&](const LibraryEffect& e) { return e.name == name; }))
+      continue;
+    entry.effects.push_back(constant_force_entry(c.name, c.force,
+                                                 forces->generalised_forces()[static_cast<std::size_t>(c.component)].unit,
+                                                 components, c.component));
+  }
 }
 
 struct SystemRegistry::State {

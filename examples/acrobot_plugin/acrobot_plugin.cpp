@@ -6,7 +6,7 @@
 /// | name                                   | parameter     | enters as                           |
 /// |----------------------------------------|---------------|-------------------------------------|
 /// | joint_viscous_damping:theta1, :theta2  | b [N m s/rad] | Q_j = -b theta_j_dot                |
-/// | joint_coulomb_friction:theta1, :theta2 | tau [N m]     | Q_j = -tau tanh(theta_j_dot / 0.05) |
+/// | joint_coulomb_friction:theta1, :theta2 | tau [N m]     | Q_j = -tau tanh(theta_j_dot / v0)   |
 /// | actuator_gain                          | k [-]         | the applied torque is k tau         |
 /// | param:<name>                           | the value     | recalibrates a mass or a length     |
 
@@ -64,9 +64,8 @@ std::vector<LibraryEffect> acrobot_effects() {
   }
   for (int joint = 0; joint < 2; ++joint) {
     const std::string q = "theta" + std::to_string(joint + 1);
-    out.push_back(gpilqg::linear_force_entry("joint_coulomb_friction:" + q, {"tau", "N m", 0.1},
-                                             "Q_" + q + " = -tau tanh(" + q + "_dot / 0.05)", 2,
-                                             coulomb(joint, joint + 2)));
+    out.push_back(gpilqg::coulomb_friction_entry("joint_coulomb_friction:" + q, {"tau", "N m", 0.1}, q, q + "_dot", 2,
+                                                 joint, joint + 2));
   }
   out.push_back(gpilqg::actuator_gain_entry());
   out.push_back(gpilqg::input_delay_entry());

@@ -153,7 +153,7 @@ std::string run(const std::string& system, const ConfigSource& source, int seeds
 
 py::object diagnose(const py::object& system, const py::object& data, const std::string& model,
                     const std::string& preset, const std::vector<std::string>& add, bool auto_select,
-                    const std::vector<int>& horizons, const std::string& integrator, double heldout, int gp_points,
+                    const std::string& search, const std::vector<int>& horizons, const std::string& integrator, double heldout, int gp_points,
                     int gp_restarts, const std::string& backend, std::uint64_t seed, const py::object& progress) {
   diagnosis::DiagnoseRequest request;
   request.system = py::isinstance<py::str>(system) ? system.cast<std::string>() : system_from_python(system)->name();
@@ -161,6 +161,7 @@ py::object diagnose(const py::object& system, const py::object& data, const std:
   request.preset = preset;
   request.add = add;
   request.auto_select = auto_select;
+  request.search = search;
   request.horizons = horizons;
   request.integrator = integrator;
   request.heldout = heldout;
@@ -259,13 +260,13 @@ Call it as policy(t, x). Arrays have one row per time step: x_bar (T+1, n), u_ba
   const diagnosis::DiagnoseRequest defaults;
   m.def("diagnose", &diagnose, py::arg("system"), py::arg("data"), py::arg("model") = "",
         py::arg("preset") = defaults.preset, py::arg("add") = std::vector<std::string>{},
-        py::arg("auto") = false, py::arg("horizons") = defaults.horizons, py::arg("integrator") = defaults.integrator, py::arg("heldout") = defaults.heldout,
+        py::arg("auto") = false, py::arg("search") = defaults.search, py::arg("horizons") = defaults.horizons, py::arg("integrator") = defaults.integrator, py::arg("heldout") = defaults.heldout,
         py::arg("gp_points") = defaults.gp_points, py::arg("gp_restarts") = defaults.gp_restarts,
         py::arg("backend") = defaults.backend, py::arg("seed") = defaults.seed, py::arg("progress") = py::none(), R"(
 Compares the model with the measurements and names the missing physical effect: the same dict as
-`gpilqg diagnose --json` (DESIGN.md section 6), with the same options (model: a model file; add:
-["EFFECT", "EFFECT=VALUE", ...]; auto: --auto, several effects by forward selection, the path under
-"selection"; horizons: --horizons, the k of the k-step predictions). system: a registry name or gpilqg.Dynamics registered by name;
+`gpilqg diagnose --json` (docs/formats.md), with the same options (model: a model file; add:
+["EFFECT", "EFFECT=VALUE", ...]; auto: --auto, several effects, the path under "selection"; search:
+--search, "subsets" or "forward"; horizons: --horizons, the k of the k-step predictions). system: a registry name or gpilqg.Dynamics registered by name;
 data: a MeasurementSet or a file. progress(line): one line after the residual GP and after every fitted
 effect; Ctrl-C stops the call at the next of these points.)");
 }

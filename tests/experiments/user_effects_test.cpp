@@ -107,7 +107,7 @@ TEST(UserEffects, DiagnoseCliFindsAddsAndWritesTheDeclaredEffect) {
   const auto unknown = test::run_cli(base + " --add cart_springs");
   EXPECT_EQ(unknown.status, 2);
   EXPECT_NE(unknown.err.find("unknown effect 'cart_springs'"), std::string::npos) << unknown.err;
-  EXPECT_NE(unknown.err.find("param:pole_length, cart_spring"), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("constant_force:theta, cart_spring"), std::string::npos) << unknown.err;
 }
 
 TEST(UserEffects, ModelFileRoundTrips) {

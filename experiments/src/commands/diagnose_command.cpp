@@ -138,8 +138,10 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--preset", r.preset, "Preset without --model: sim or real")->capture_default_str();
   cmd->add_option("--add", r.add, "Add a library effect, EFFECT or EFFECT=VALUE (fitted without a value; repeatable)");
   cmd->add_flag("--auto", r.auto_select,
-                "Add several effects in one call: forward selection with joint refits, stopped when the held-out "
-                "improvement is no longer significant; --write-model writes the final model");
+                "Add several effects in one call: the best set of up to 4 effects on held-out data (or --search "
+                "forward), every set refitted jointly; --write-model writes the final model");
+  cmd->add_option("--search", r.search, "How --auto searches: subsets (every set of up to 4 effects) or forward")
+      ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the report");
   cmd->add_option("--out", o->out, "Write the HDF5 report here");
   cmd->add_option("--plots", o->plots, "Write PNG plots into this folder (needs matplotlib and h5py)");

@@ -48,6 +48,10 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
     throw InputError(std::string("--backend: ") + e.what());
   }
   d.auto_select = o.auto_select;
+  if (o.search == "subsets") d.search = SearchMethod::Subsets;
+  else if (o.search == "forward") d.search = SearchMethod::Forward;
+  else throw InputError(fmt::format("--search '{}': expected 'subsets' (every set of up to {} effects) or 'forward'",
+                                    o.search, d.max_subset));
   d.heldout_fraction = o.heldout;
   d.horizons = o.horizons;
   d.gp.points = o.gp_points;

@@ -5,10 +5,12 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/input_delay.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
+#include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -25,7 +27,9 @@ void DiagnosisOptions::validate() const {
   require(gp.points >= 10, "'gp.points' must be >= 10");
   require(gp.restarts >= 0 && gp.threads >= 1, "'gp.restarts' must be >= 0 and 'gp.threads' >= 1");
   require(bins >= 1 && max_lag >= 0, "'bins' must be >= 1 and 'max_lag' >= 0");
-  require(alias_threshold > 0.0 && alias_threshold <= 1.0, "'alias_threshold' must be in (0, 1]");
+  require(alias_gain >= 0.0 && alias_gain < 1.0, "'alias_gain' must be in [0, 1)");
+  require(max_subset >= 1 && max_subset <= 6, "'max_subset' must be in 1..6");
+  require(explained_left_ratio >= 1.0, "'explained_left_ratio' must be >= 1");
   require(structure_threshold >= 0.0 && floor_tolerance >= 1.0, "'structure_threshold' >= 0, 'floor_tolerance' >= 1");
   require(min_explained >= 0.0 && min_step_explained >= 0.0 && min_z >= 0.0 && relative_to_gp >= 0.0,
           "thresholds must be >= 0");
@@ -78,6 +82,8 @@ Matrix shares(Matrix sensitivity) {
   return sensitivity;
 }
 
+void judge_remainder(Verdict& v, const DiagnosisOptions& o);
+
 Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   Verdict v;
   if (r.model_diverges) {
@@ -102,21 +108,65 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   const EffectFit& f = best.fit;
   const bool large = f.explained >= o.min_explained;
   const bool significant = f.z_score >= o.min_z;
-  const bool enough = f.explained >= o.relative_to_gp * r.gp_explained_total;
-  char buffer[256];
-  std::snprintf(buffer, sizeof buffer, "the best candidate '%s' removes %.1f%% of the held-out residual (z = %.1f); the GP removes %.1f%%",
-                f.effect.c_str(), 100.0 * f.explained, f.z_score, 100.0 * r.gp_explained_total);
-  v.reason = buffer;
-  if (large && significant && enough) {
-    v.status = "explained";
-    v.effect = f;
-    for (const auto& a : best.aliases) v.aliases.push_back(a.effect);
-  } else {
+  v.left = 1.0 - f.explained;
+  v.gp_left = 1.0 - r.gp_explained_total;
+  v.reason = fmt::format("the best candidate '{}' removes {:.1f}% of the held-out residual (z = {:.1f}); the GP removes {:.1f}%",
+                         f.effect, 100.0 * f.explained, f.z_score, 100.0 * r.gp_explained_total);
+  if (!large || !significant) {
     v.status = "unexplained";
-    v.reason += large && significant ? ", so the residual's structure is mostly something else"
-                                     : ", not a significant reduction";
+    v.reason += ", not a significant reduction";
+    return v;
   }
+  if (f.explained < o.relative_to_gp * r.gp_explained_total) {
+    v.status = "unexplained";
+    v.reason += ", so the residual's structure is mostly something else";
+    return v;
+  }
+  v.effect = f;
+  for (const auto& a : best.aliases) v.aliases.push_back(a.effect);
+  judge_remainder(v, o);
   return v;
+}
+
+/// "explained" or "partly_explained" from what the proposed effects leave (v.left) against what the GP
+/// leaves (v.gp_left), shares of the diagnosed model's weighted held-out squared residual. A wrong
+/// effect can remove much of a residual (a Coulomb term alone takes 90% of what viscous friction,
+/// Coulomb friction and a constant force do together); it cannot leave as little as a flexible model
+/// of everything learnable from (x, u). What it leaves beyond that is structure it does not account
+/// for, and its interval assumes a model that the data reject.
+void judge_remainder(Verdict& v, const DiagnosisOptions& o) {
+  if (v.left <= o.explained_left_ratio * v.gp_left) {
+    v.status = "explained";
+    return;
+  }
+  v.status = "partly_explained";
+  v.reason += fmt::format(": what is left is {:.1f} times what the GP leaves (at most {:g} for \"explained\"), so the "
+                          "data reject the model with {} alone; its interval assumes that model",
+                          v.gp_left > 0.0 ? v.left / v.gp_left : 0.0, o.explained_left_ratio,
+                          v.effects.empty() ? std::string("this effect") : std::string("these effects"));
+}
+
+/// The verdict once --auto has chosen its set: what the whole set leaves (each step's share is of
+/// what the step before left, so the shares multiply).
+void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0, const DiagnosisOptions& o) {
+  if (selection.steps.empty() || !v.effect) return;
+  double left = 1.0;
+  for (const SelectionStep& step : selection.steps) left *= 1.0 - step.fit.explained;
+  v.left = left;
+  // The last step's joint fit holds every chosen effect; those M_0 had are not new.
+  const std::vector<LibraryEffect> candidates = candidate_effects(m0);
+  const std::vector<RefitEffect> had = model_effects(m0, candidates);
+  const auto is_new = [&](const std::string& name) {
+    return std::none_of(had.begin(), had.end(), [&](const RefitEffect& r) { return r.effect->name == name; });
+  };
+  const EffectFit& last = selection.steps.back().fit;
+  v.effects.clear();
+  if (is_new(last.effect)) v.effects.push_back(last.effect);
+  for (const EffectValues& e : last.refitted)
+    if (is_new(e.effect)) v.effects.push_back(e.effect);
+  v.reason = fmt::format("the {} effect(s) chosen by --auto ({}) remove {:.1f}% of the held-out residual; the GP removes {:.1f}%",
+                         v.effects.size(), fmt::join(v.effects, ", "), 100.0 * (1.0 - left), 100.0 * (1.0 - v.gp_left));
+  judge_remainder(v, o);
 }
 
 }  // namespace
@@ -130,7 +180,6 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   // A model file's data carry the model's name (<mujoco model="...">), not the file's path.
   if (const std::string model_name = system_signature(R.system).name; set.system.name != model_name)
     throw std::invalid_argument("the data are of system '" + set.system.name + "'; the model is '" + model_name + "'");
-  R.model_before = o.model;
   R.state_names = names_of(set.system.states);
   R.control_names = names_of(set.system.controls);
   R.input_names = R.state_names;
@@ -142,23 +191,28 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   R.samples = R.data.size();
   const Transitions& data = R.data;
   const int n = static_cast<int>(R.state_names.size());
+  // The model as given; below, with the smoothing of its Coulomb candidates fitted to the data.
+  ModelSpec model0 = o.model;
 
   // The model as given, its residual and GP.
   // One-step predictions of a model (its input delay applied to the measured inputs).
-  const FitContext settings{&data, o.model, o.integrator, R.dt, o.substeps, Vector(), Matrix()};
+  const FitContext settings{&data, model0, o.integrator, R.dt, o.substeps, Vector(), Matrix()};
   const auto residual_of_model = [&](const ModelSpec& model) { return residual_of(data, model_predictions(model, settings)); };
-  const auto before_step = make_step_model(o.model, o.integrator, R.dt, o.substeps);
-  const Matrix residual_before = residual_of_model(o.model);
+  const auto before_step = make_step_model(model0, o.integrator, R.dt, o.substeps);
+  const Matrix residual_before = residual_of_model(model0);
   ResidualGp gp_before = fit_residual_gp(before_step, data, residual_before, o.gp);
   if (o.progress) o.progress("residual GP of the model fitted");
+  const Vector weights_before = floor_weights(data, residual_before, gp_before);
+  // Coulomb candidates absent from the model: their smoothing velocity from the data (velocity_scales.hpp).
+  model0 = with_fitted_smoothing(FitContext{&data, model0, o.integrator, R.dt, o.substeps, weights_before, residual_before});
+  R.model_before = model0;
 
   // Effects to add: given values first (kept as given), then the others fitted jointly on the training
   // episodes, together with the effects the model already has (refitted from their current values).
-  R.model = o.model;
+  R.model = model0;
   // The library and the model's declared effects; effects below point into it.
-  const std::vector<LibraryEffect> candidates = candidate_effects(o.model);
+  const std::vector<LibraryEffect> candidates = candidate_effects(model0);
   Matrix residual = residual_before;
-  const Vector weights_before = floor_weights(data, residual_before, gp_before);
   std::vector<const LibraryEffect*> to_fit;
   std::vector<std::string> given;
   for (const EffectRequest& request : o.add) {
@@ -259,7 +313,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   // 3. Which: one effect (the verdict), or several by forward selection (--auto).
   const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual};
   const std::vector<RefitEffect> present = o.auto_select ? model_effects(R.model, candidates) : std::vector<RefitEffect>{};
-  if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_threshold, o.progress, present, o.gp.threads);
+  if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_gain, o.progress, present, o.gp.threads);
   // The GP sees (x_t, u_t) only: the residual of an effect of the input history (input_delay) looks
   // like noise to it. An effect that removes a large and significant share of the held-out residual
   // shows that the residual is not at its floor, whatever the GP found.
@@ -269,16 +323,24 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   R.verdict = decide(R, o);
   if (o.auto_select && !R.model_diverges) {
     SelectionOptions so;
-    so.alias_threshold = o.alias_threshold;
+    so.method = o.search;
+    so.max_subset = o.max_subset;
+    so.alias_gain = o.alias_gain;
     so.min_explained = o.min_step_explained;
     so.min_z = o.min_z;
     so.threads = o.gp.threads;
     so.progress = o.progress;
     // Step 1 is the verdict: its ranking is the first step's, and without an explained verdict nothing is added.
-    if (R.verdict.status == "explained")
+    if (R.verdict.effect) {
       R.selection = select_effects(context, so, R.ranking);
-    else
-      R.selection = Selection{{}, R.model, R.ranking, "no effect is added: " + R.verdict.reason};
+      judge_selection(R.verdict, *R.selection, R.model, o);
+    } else {
+      R.selection = Selection{};
+      R.selection->method = o.search;
+      R.selection->model = R.model;
+      R.selection->rejected = R.ranking;
+      R.selection->stop_reason = "no effect is added: " + R.verdict.reason;
+    }
   }
 
   // 4. Add: the four models on the held-out episodes.
@@ -301,7 +363,7 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
     R.residual_after = residual_of_model(R.model_next);
     for (const SelectionStep& s : R.selection->steps)
       R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + s.fit.effect;
-  } else if (R.verdict.status == "explained") {
+  } else if (R.verdict.effect) {
     proposed = R.model.with(named(candidates, R.verdict.effect->effect), R.verdict.effect->estimate);
     R.model_next = proposed;
     with_effect = &proposed;
@@ -329,10 +391,10 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   const auto applied = [](const ModelSpec& model) -> ControlSource {
     return [delay = model.input_delay](const MatrixCRef& u) { return delay_controls(Matrix(u), delay); };
   };
-  std::vector<FreeRunModel> runs{{"sim", before_step, applied(o.model)}};
+  std::vector<FreeRunModel> runs{{"sim", before_step, applied(model0)}};
   if (with_effect != nullptr)
     runs.push_back({"sim+effect", make_step_model(R.model_next, o.integrator, R.dt, o.substeps), applied(R.model_next)});
-  runs.push_back({"sim+GP", gp_before.model, applied(o.model)});
+  runs.push_back({"sim+GP", gp_before.model, applied(model0)});
   R.free_run = free_run(set, R.heldout_episode_index, runs);
   return R;
 }

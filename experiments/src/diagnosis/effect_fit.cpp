@@ -17,6 +17,7 @@
 #include "gpilqg/core/fork_join.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
+#include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -65,6 +66,10 @@ struct EffectSet {
     offset.push_back(offset.back() + static_cast<Eigen::Index>(effect.parameters.size()));
   }
   Eigen::Index size() const { return offset.back(); }
+  /// True when every effect is linear in its parameters (LibraryEffect::linear).
+  bool linear() const {
+    return std::all_of(effects.begin(), effects.end(), [](const LibraryEffect* e) { return e->linear; });
+  }
   Eigen::Index length(std::size_t e) const { return offset[e + 1] - offset[e]; }
   const EffectParameter& parameter(Eigen::Index j) const {
     std::size_t e = 0;
@@ -141,6 +146,14 @@ double nlopt_objective(unsigned p, const double* x, double* gradient, void* data
   }
 }
 
+/// The batch length of the significance test: context.batch when set, else ceil(sqrt(N)) of the N
+/// held-out rows (at least 10), the classical batch-means rule: batches grow with the record, so the
+/// serial correlation of a long record sampled fast (1 kHz) stays inside a batch.
+int heldout_batch_length(const FitContext& c, int rows) {
+  if (c.batch > 0) return c.batch;
+  return std::max(10, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(rows)))));
+}
+
 /// Held-out scores of theta_hat against the model (step 4).
 void score_heldout(const EffectSet& set, const Vector& theta, const FitContext& c, EffectFit& fit) {
   const std::vector<int> rows = c.data->rows(true);
@@ -154,6 +167,7 @@ void score_heldout(const EffectSet& set, const Vector& theta, const FitContext& 
   std::vector<double> d_batches, b_batches;
   double d_total = 0.0, b_total = 0.0;
   int previous_episode = -1, in_batch = 0;
+  const int batch = heldout_batch_length(c, static_cast<int>(rows.size()));
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const auto seg = static_cast<Eigen::Index>(k) * n;
     const Vector rb = before.segment(seg, n), ra = after.segment(seg, n);
@@ -161,7 +175,7 @@ void score_heldout(const EffectSet& set, const Vector& theta, const FitContext& 
     fit.heldout_rmse_after += ra.cwiseQuotient(sqrt_w).cwiseAbs2();
     const double b = rb.squaredNorm(), d = b - ra.squaredNorm();
     const int episode = c.data->episode[static_cast<std::size_t>(rows[k])];
-    if (episode != previous_episode || in_batch == c.batch) {
+    if (episode != previous_episode || in_batch == batch) {
       d_batches.push_back(0.0);
       b_batches.push_back(0.0);
       in_batch = 0;
@@ -237,13 +251,41 @@ std::pair<Vector, Vector> confidence_interval(const EffectSet& set, const Vector
 
 }  // namespace
 
-double regressor_correlation(const Vector& a, const Vector& b) {
-  const double na = a.norm(), nb = b.norm();
-  if (na == 0.0 || nb == 0.0 || a.size() != b.size()) return 0.0;
-  return std::min(1.0, std::abs(a.dot(b)) / (na * nb));
+Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows) {
+  const auto step = make_step_model(model, settings.integrator, settings.dt, settings.substeps);
+  return weighted_residual(*step, applied_controls(*settings.data, model.input_delay), settings, rows, nullptr);
 }
 
 namespace {
+
+EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& theta_ls, const Vector& theta_hat,
+                     const Vector& ci_low, const Vector& ci_high, EffectFit fit);
+
+/// One Gauss-Newton step from `theta` (updated in place when it lowers S) for a set of linear effects;
+/// returns S at the final theta.
+double refine_linear(const EffectSet& set, Vector& theta, const Vector& lower, const Vector& upper, const FitContext& c,
+                     const std::vector<int>& rows) {
+  bool finite = true;
+  const Vector r = weighted_residual_at(set, theta, c, rows, &finite);
+  const double at_theta = finite ? r.squaredNorm() : std::numeric_limits<double>::infinity();
+  const Matrix J = regressor(set, theta, c, rows);
+  if (!J.allFinite()) return at_theta;
+  const Vector next = clamp_to(theta + J.colPivHouseholderQr().solve(r), lower, upper);
+  if (!next.allFinite()) return at_theta;
+  bool next_finite = true;
+  double at_next = std::numeric_limits<double>::infinity();
+  try {
+    const Vector rn = weighted_residual_at(set, next, c, rows, &next_finite);
+    if (next_finite) at_next = rn.squaredNorm();
+  } catch (const std::invalid_argument&) {
+    // outside what the model accepts: keep theta
+  }
+  if (at_next < at_theta) {
+    theta = next;
+    return at_next;
+  }
+  return at_theta;
+}
 
 /// Steps 1-4 on the stacked parameters of `set`, from `initial`.
 EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext& c) {
@@ -270,6 +312,15 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
     const Vector r_initial = weighted_residual_at(set, initial, c, training);
     const Vector delta = J.colPivHouseholderQr().solve(r_initial);
     theta_ls = clamp_to(initial + delta, lower, upper);
+    if (set.linear()) {
+      // 2'. Effects linear in their parameters: S is quadratic in theta up to the integrator, so one
+      // more Gauss-Newton step from theta_LS reaches the minimum; no derivative-free search is needed.
+      theta_hat = theta_ls;
+      fit.training_objective_after = refine_linear(set, theta_hat, lower, upper, c, training);
+      std::tie(ci_low, ci_high) = confidence_interval(set, theta_hat, c, training);
+      score_heldout(set, theta_hat, c, fit);
+      return finish_fit(set, initial, theta_ls, theta_hat, ci_low, ci_high, std::move(fit));
+    }
 
     // 2. Nonlinear refit of S(theta) with NLopt, in a box around theta_LS inside the physical range.
     const Vector radius = 2.0 * delta.cwiseAbs() + 0.05 * scale;
@@ -308,10 +359,18 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
   }
   // 4. Held-out scores; then each effect's slice.
   score_heldout(set, theta_hat, c, fit);
+  return finish_fit(set, initial, theta_ls, theta_hat, ci_low, ci_high, std::move(fit));
+}
+
+/// Each effect's slice of the stacked estimates into `fit` (the candidate) and fit.refitted (the others).
+EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& theta_ls, const Vector& theta_hat,
+                     const Vector& ci_low, const Vector& ci_high, EffectFit fit) {
   for (std::size_t e = 0; e < set.effects.size(); ++e) {
     const Eigen::Index at = set.offset[e], length = set.length(e);
-    EffectValues values{set.effects[e]->name, set.effects[e]->parameters, initial.segment(at, length),
-                        theta_hat.segment(at, length), ci_low.segment(at, length), ci_high.segment(at, length)};
+    const auto& smoothing = set.effects[e]->smoothing;
+    EffectValues values{set.effects[e]->name,          set.effects[e]->parameters,   initial.segment(at, length),
+                        theta_hat.segment(at, length), ci_low.segment(at, length), ci_high.segment(at, length),
+                        smoothing ? smoothing->width : 0.0};
     if (e == 0) {
       fit.effect = values.effect;
       fit.parameters = values.parameters;
@@ -320,6 +379,7 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
       fit.estimate = values.estimate;
       fit.ci_low = values.ci_low;
       fit.ci_high = values.ci_high;
+      fit.smoothing = values.smoothing;
     } else {
       fit.refitted.push_back(std::move(values));
     }
@@ -361,6 +421,7 @@ EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, co
   fit.parameters = effect.parameters;
   fit.initial = c.model.current_values(effect);
   fit.linear_estimate = fit.estimate = fit.ci_low = fit.ci_high = values;
+  if (effect.smoothing) fit.smoothing = effect.smoothing->width;
   const std::vector<int> training = c.data->rows(false);
   EffectSet set;
   set.add(effect);
@@ -382,7 +443,7 @@ bool same_physics(const SystemEntry& entry, const std::string& a, const std::str
 
 }  // namespace
 
-std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold,
+std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_gain,
                                        const std::function<void(const std::string&)>& progress,
                                        const std::vector<RefitEffect>& refit, int threads) {
   const SystemEntryPtr system = find_system(context.model.system);
@@ -411,6 +472,15 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_t
   });
   std::stable_sort(fits.begin(), fits.end(),
                    [](const EffectFit& a, const EffectFit& b) { return a.explained > b.explained; });
+  // Aliases: the joint fit of the pair does no better than either alone, or the same physics by
+  // declaration. An effect that explains nothing alone is nobody's alias.
+  const LinearisedFits joint(context, fits, refit, threads);
+  const auto aliases = [&](int i, int j) {
+    if (same_physics(*system, fits[static_cast<std::size_t>(i)].effect, fits[static_cast<std::size_t>(j)].effect))
+      return true;
+    if (joint.gain({j}, {}) < alias_gain) return false;
+    return joint.gain({i, j}, {i}) < alias_gain && joint.gain({i, j}, {j}) < alias_gain;
+  };
   std::vector<bool> used(fits.size(), false);
   std::vector<RankedEffect> out;
   for (std::size_t i = 0; i < fits.size(); ++i) {
@@ -419,10 +489,7 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_t
     RankedEffect entry{fits[i], {}};
     for (std::size_t j = i + 1; j < fits.size(); ++j) {
       if (used[j]) continue;
-      // Aliases: nearly collinear regressors on these data, or the same physics by declaration.
-      if (regressor_correlation(fits[i].regressor, fits[j].regressor) < alias_threshold &&
-          !same_physics(*system, fits[i].effect, fits[j].effect))
-        continue;
+      if (!aliases(static_cast<int>(i), static_cast<int>(j))) continue;
       used[j] = true;
       entry.aliases.push_back(fits[j]);
     }

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/experiments/diagnosis/subset_search.hpp"
+
 namespace gpilqg::diagnosis {
 
 const LibraryEffect& named(const std::vector<LibraryEffect>& candidates, std::string_view name) {
@@ -35,19 +37,22 @@ std::vector<RefitEffect> model_effects(const ModelSpec& model, const std::vector
   return out;
 }
 
-namespace {
+const char* to_string(SearchMethod method) { return method == SearchMethod::Subsets ? "subsets" : "forward"; }
 
-/// M_0 with the effect of `fit` and those it refitted at their joint estimates.
 ModelSpec model_after(const ModelSpec& base, const EffectFit& fit, const std::vector<LibraryEffect>& candidates) {
   ModelSpec model = base.with(named(candidates, fit.effect), fit.estimate);
   for (const EffectValues& v : fit.refitted) model = model.with(named(candidates, v.effect), v.estimate);
   return model;
 }
 
+namespace {
+
 /// True when the joint 95% interval of `v` contains `value` in every parameter.
 bool interval_contains(const EffectValues& v, const Vector& value) {
   return (v.ci_low.array() <= value.array()).all() && (value.array() <= v.ci_high.array()).all();
 }
+
+}  // namespace
 
 /// The backward check after a step. An effect chosen at an earlier step whose joint 95% interval now
 /// contains its value in M_0 (a force of 0, a gain of 1, the preset's parameter, no delay) is no
@@ -77,11 +82,11 @@ EffectFit without_redundant(EffectFit fit, const FitContext& context, const FitC
   }
 }
 
-}  // namespace
-
 Selection select_effects(const FitContext& context, const SelectionOptions& o, std::vector<RankedEffect> first) {
   if (context.data == nullptr) throw std::invalid_argument("select_effects: no data");
+  if (o.method == SearchMethod::Subsets) return select_subsets(context, o, std::move(first));
   Selection S;
+  S.method = SearchMethod::Forward;
   S.model = context.model;
   const std::vector<LibraryEffect> candidates = candidate_effects(context.model);
   std::vector<RefitEffect> chosen = model_effects(context.model, candidates);
@@ -93,7 +98,7 @@ Selection select_effects(const FitContext& context, const SelectionOptions& o, s
     }
     std::vector<RankedEffect> ranking =
         k == 1 && !first.empty() ? std::move(first)
-                                 : rank_effects(step_context, o.alias_threshold, o.progress, chosen, o.threads);
+                                 : rank_effects(step_context, o.alias_gain, o.progress, chosen, o.threads);
     if (ranking.empty()) {
       S.stop_reason = "no candidate effect is left";
       break;

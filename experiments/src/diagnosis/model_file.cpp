@@ -89,6 +89,17 @@ ModelSpec read_model_file(const std::filesystem::path& file, const std::string& 
       if (node.is_table()) {
         std::vector<std::string> allowed;
         for (const auto& p : effect->parameters) allowed.push_back(p.name);
+        // Coulomb friction's smoothing velocity (the library's default when absent).
+        if (effect->smoothing) {
+          allowed.push_back("v0");
+          if (fields.has(path + ".v0")) {
+            const double v0 = fields.number(path + ".v0");
+            if (!(v0 > 0.0) || !std::isfinite(v0))
+              fields.fail(path + ".v0", fmt::format("is {}; expected a finite smoothing velocity v0 > 0 [{}/s]", v0,
+                                                    effect->parameters[0].unit == "N" ? "m" : "rad"));
+            effect = with_smoothing(*effect, v0);
+          }
+        }
         fields.only_keys(path, allowed);
         for (std::size_t i = 0; i < effect->parameters.size(); ++i)
           values(static_cast<Eigen::Index>(i)) = fields.number(path + "." + effect->parameters[i].name);
@@ -125,6 +136,7 @@ std::string model_file_text(const ModelSpec& model, const std::vector<std::strin
       std::string table;
       for (std::size_t i = 0; i < effect.parameters.size(); ++i)
         table += fmt::format("{}{} = {}", i == 0 ? "" : ", ", effect.parameters[i].name, values(static_cast<Eigen::Index>(i)));
+      if (effect.smoothing) table += fmt::format(", v0 = {}", effect.smoothing->width);
       out += fmt::format("{} = {{ {} }}   # {}\n", toml_key(name), table, effect.formula);
     }
   }

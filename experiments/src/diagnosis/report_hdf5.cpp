@@ -253,6 +253,7 @@ void write_selection(Hdf5Writer& h5, const DiagnosisReport& r) {
   h5.write_vector("/selection/z_score", z);
   h5.attribute("/selection", "effect", effects);
   h5.attribute("/selection", "stop_reason", r.selection->stop_reason);
+  h5.attribute("/selection", "method", std::string(to_string(r.selection->method)));
 }
 
 }  // namespace

@@ -48,7 +48,11 @@ json values_json(const EffectValues& v) {
     ci[v.parameters[i].name] = {v.ci_low(k), v.ci_high(k)};
     initial[v.parameters[i].name] = v.initial(k);
   }
-  return {{"effect", v.effect}, {"parameters", parameters}, {"parameter_ci95", ci}, {"initial", initial}};
+  return {{"effect", v.effect},
+          {"parameters", parameters},
+          {"parameter_ci95", ci},
+          {"initial", initial},
+          {"smoothing_v0", v.smoothing > 0.0 ? json(v.smoothing) : json(nullptr)}};
 }
 
 json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
@@ -63,6 +67,7 @@ json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
           {"units", units},
           {"initial", parameters_json(f, f.initial)},
           {"linear_estimate", parameters_json(f, f.linear_estimate)},
+          {"smoothing_v0", f.smoothing > 0.0 ? json(f.smoothing) : json(nullptr)},
           {"explained", f.explained},
           {"explained_ci95", {f.explained - f.explained_ci, f.explained + f.explained_ci}},
           {"z_score", f.z_score},
@@ -163,7 +168,8 @@ nlohmann::json report_json(const DiagnosisReport& r) {
     entry["alias_fits"] = alias_fits;
     ranking.push_back(entry);
   }
-  json verdict = {{"status", r.verdict.status}, {"reason", r.verdict.reason}, {"aliases", r.verdict.aliases}};
+  json verdict = {{"status", r.verdict.status},           {"reason", r.verdict.reason}, {"aliases", r.verdict.aliases},
+                  {"effects", r.verdict.effects},         {"left", r.verdict.left},     {"gp_left", r.verdict.gp_left}};
   if (r.verdict.effect) {
     verdict["effect"] = r.verdict.effect->effect;
     verdict["parameters"] = parameters_json(*r.verdict.effect, r.verdict.effect->estimate);
@@ -200,7 +206,10 @@ nlohmann::json report_json(const DiagnosisReport& r) {
       entry["model"] = model_file_text(step.model);
       steps.push_back(entry);
     }
-    selection = {{"steps", steps}, {"stop_reason", r.selection->stop_reason}, {"model", model_file_text(r.selection->model)}};
+    selection = {{"method", to_string(r.selection->method)},
+                 {"steps", steps},
+                 {"stop_reason", r.selection->stop_reason},
+                 {"model", model_file_text(r.selection->model)}};
   }
   json heldout_ids = r.heldout_episode_ids;
   return {{"system", r.system},

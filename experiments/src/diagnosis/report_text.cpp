@@ -24,11 +24,16 @@ std::string parameter_text(const std::vector<EffectParameter>& parameters, const
   return out;
 }
 
+/// ", v0 = ..." for Coulomb friction (its smoothing velocity), else nothing.
+std::string smoothing_text(double v0) { return v0 > 0.0 ? fmt::format(", v0 = {:.3g}", v0) : std::string(); }
+
 std::string parameter_text(const EffectFit& f, bool interval) {
-  return parameter_text(f.parameters, f.estimate, f.ci_low, f.ci_high, interval);
+  return parameter_text(f.parameters, f.estimate, f.ci_low, f.ci_high, interval) + smoothing_text(f.smoothing);
 }
 
-std::string parameter_text(const EffectValues& v) { return parameter_text(v.parameters, v.estimate, v.ci_low, v.ci_high, true); }
+std::string parameter_text(const EffectValues& v) {
+  return parameter_text(v.parameters, v.estimate, v.ci_low, v.ci_high, true) + smoothing_text(v.smoothing);
+}
 
 std::string model_text(const ModelSpec& model) {
   std::string out = fmt::format("{} preset '{}'", model.system, to_string(model.preset));
@@ -209,14 +214,16 @@ void which_section(const DiagnosisReport& r, std::string& out) {
 
 void selection_section(const DiagnosisReport& r, std::string& out) {
   if (!r.selection) return;
-  out += "\n3b. Several effects (--auto): forward selection, every step refitting the chosen effects jointly\n";
+  out += r.selection->method == SearchMethod::Subsets
+             ? "\n3b. Several effects (--auto): the best set of each size on the held-out episodes, every set fitted jointly\n"
+             : "\n3b. Several effects (--auto): forward selection, every step refitting the chosen effects jointly\n";
   int k = 1;
   for (const SelectionStep& step : r.selection->steps) {
     const EffectFit& f = step.fit;
     out += fmt::format("   step {}: + {}: {}\n", k++, f.effect, parameter_text(f, true));
     for (const EffectValues& v : f.refitted) out += fmt::format("           refitted {}: {}\n", v.effect, parameter_text(v));
     for (const std::string& name : step.removed)
-      out += fmt::format("           removed {}: its joint interval contains its value without it\n", name);
+      out += fmt::format("           removed {}\n", name);
     out += fmt::format("           removes {} +- {} of the held-out residual left (z = {:.1f}); held-out rmse:", percent(f.explained),
                        percent(f.explained_ci), f.z_score);
     for (std::size_t i = 0; i < r.state_names.size(); ++i) {

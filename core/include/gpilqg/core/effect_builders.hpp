@@ -13,14 +13,16 @@
 
 namespace gpilqg::effect_bases {
 
-/// Width of the tanh that smooths Coulomb friction (DESIGN.md sections 5 and 10) [m/s or rad/s].
-inline constexpr double kCoulombWidth = 0.05;
+/// The smoothing velocity v0 of Coulomb friction, tanh(qdot / v0), when nothing chose another
+/// [m/s or rad/s]: a model file or `--effect` without `v0`. The diagnosis chooses v0 from the data of
+/// the coordinate instead (diagnosis/velocity_scales.hpp).
+inline constexpr double kDefaultCoulombWidth = 0.05;
 
 /// Each basis adds theta g(x) to Q and theta dg/dx to dQ/dx (LinearForceEffect::Basis).
 /// g = -x(velocity) on `component`: viscous friction or damping.
 LinearForceEffect::Basis viscous(int component, int velocity);
-/// g = -tanh(x(velocity) / 0.05) on `component`: Coulomb friction, smoothed.
-LinearForceEffect::Basis coulomb(int component, int velocity);
+/// g = -tanh(x(velocity) / width) on `component`: Coulomb friction, smoothed over `width` (> 0).
+LinearForceEffect::Basis coulomb(int component, int velocity, double width = kDefaultCoulombWidth);
 /// g = e_component: a constant generalised force.
 LinearForceEffect::Basis constant(int component);
 /// g_i = -|v_i| v_i for `components` velocities starting at x(first_velocity): quadratic drag.
@@ -36,6 +38,19 @@ LibraryEffect linear_force_entry(std::string name, EffectParameter parameter, st
 
 /// A library entry of kind Force for any force effect.
 LibraryEffect force_entry(ForceEffectPtr force);
+
+/// Coulomb friction on one coordinate, Q_<coordinate> = -<parameter> tanh(<velocity> / v0), with its
+/// smoothing (LibraryEffect::smoothing) so that the same entry can be made at another v0
+/// (with_smoothing). `coordinate` and `velocity` are the names in the formula ("x", "x_dot");
+/// `component` the force component, `velocity_index` the state index of the velocity.
+LibraryEffect coulomb_friction_entry(std::string name, EffectParameter parameter, const std::string& coordinate,
+                                     const std::string& velocity, int force_dim, int component, int velocity_index,
+                                     double width = effect_bases::kDefaultCoulombWidth);
+
+/// A constant generalised force on one coordinate, "constant_force:<coordinate>": Q_<coordinate> = F,
+/// an offset or bias (gravity-compensation error, cable and hose forces, a sensor's offset).
+LibraryEffect constant_force_entry(const std::string& coordinate, const std::string& force, const std::string& unit,
+                                   int force_dim, int component);
 
 /// "actuator_gain" (k, the applied input is k u, on every control).
 LibraryEffect actuator_gain_entry();

@@ -6,14 +6,21 @@
 /// | name                     | parameter      | enters as                                           |
 /// |--------------------------|----------------|-----------------------------------------------------|
 /// | cart_viscous_friction    | b [N s/m]      | Q_x = -b x_dot                                      |
-/// | cart_coulomb_friction    | mu [N]         | Q_x = -mu tanh(x_dot / 0.05)                        |
+/// | cart_coulomb_friction    | mu [N]         | Q_x = -mu tanh(x_dot / v0)                          |
 /// | pole_viscous_damping     | c [N m s/rad]  | Q_theta = -c theta_dot                              |
-/// | pole_coulomb_friction    | tau [N m]      | Q_theta = -tau tanh(theta_dot / 0.05)               |
+/// | pole_coulomb_friction    | tau [N m]      | Q_theta = -tau tanh(theta_dot / v0)                 |
 /// | actuator_gain            | k [-]          | the applied input is k u                            |
 /// | external_force_x, _y, _z | F [N]          | constant force on the body (cart: x only)           |
 /// | quadratic_drag           | c_d [N s^2/m^2]| -c_d abs(v) v on the translational velocity         |
 /// | param:<name>             | the value      | recalibrates one physical parameter                 |
 /// | input_delay              | d [steps]      | the applied input is u(t - d) (input_delay.hpp)     |
+/// | constant_force:<coord>   | F [N or N m]   | Q_<coord> = F, an offset on every coordinate        |
+///
+/// Coulomb friction is smoothed over a velocity v0 (LibraryEffect::smoothing): a sign function has no
+/// derivative at 0, and measured velocities near 0 are noise. v0 is a property of the model
+/// (ModelSpec::smoothing): 0.05 (kDefaultCoulombWidth) unless the model says otherwise; the diagnosis
+/// chooses it from the data of each coordinate. `constant_force:<coord>` is added to every system with
+/// a generalised-force map, for each of its coordinates (complete_system_entry).
 ///
 /// `quadratic_drag` is elementwise, F_i = -c_d |v_i| v_i (the cart: Q_x = -c_d |x_dot| x_dot; the
 /// quadrotor: per world axis, drag of a body with the same area in every direction along the axes).
@@ -25,7 +32,9 @@
 /// model file's [[user_effects]]): basis forces on one coordinate (basis_force.hpp). The diagnosis fits,
 /// ranks and adds the model's candidates, candidate_effects(model): the library, then those.
 
+#include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -54,7 +63,18 @@ struct LibraryEffect {
   ForceEffectPtr force;                    ///< kind == Force only
   std::string recalibrated;                ///< kind == Recalibration: the parameter's name, e.g. "pole_length"
                                            ///< (for MuJoCo's actuator_gain:<a>, the parameter "<a>.gain")
+  /// Coulomb friction, -tau tanh(qdot / v0): its smoothing velocity and the same force at another v0.
+  struct Smoothing {
+    int velocity = -1;   ///< state index of qdot
+    double width = 0.0;  ///< v0 [m/s or rad/s], > 0
+    std::function<ForceEffectPtr(double v0)> at;
+  };
+  std::optional<Smoothing> smoothing;      ///< Coulomb friction only (coulomb_friction_entry)
 };
+
+/// `effect` (which has a smoothing) at the smoothing velocity `v0`: its force and formula rebuilt.
+/// Throws std::invalid_argument when the effect has no smoothing or v0 is not finite and > 0.
+LibraryEffect with_smoothing(const LibraryEffect& effect, double v0);
 
 /// Every effect of the library that applies to `system` (a registered name or a MuJoCo model file,
 /// system_registry.hpp), in the entry's fixed order; for the built-in systems: forces, actuator_gain,
@@ -93,6 +113,9 @@ struct ModelSpec {
   /// applied input to xdot): whoever drives the model with measured or commanded inputs applies it
   /// (delay_controls, input_delay.hpp): the diagnosis's predictions, the simulated world.
   double input_delay = 0.0;
+  /// Smoothing velocities v0 of Coulomb effects (LibraryEffect::smoothing) by effect name, where they
+  /// differ from the entry's default; candidate_effects and find_candidate return the entries at these.
+  std::map<std::string, double> smoothing;
 
   /// The model's Dynamics (an EffectDynamics when it has a gain other than 1 or forces), with `noise`;
   /// without the input delay (see input_delay).
@@ -116,7 +139,8 @@ struct ModelSpec {
 };
 
 /// The candidates the diagnosis fits for `model` (ranking, --add, forward selection): the system's
-/// library (effect_library), then the model's user effects in declaration order.
+/// library (effect_library), then the model's user effects in declaration order; Coulomb effects at
+/// the model's smoothing velocities (ModelSpec::smoothing).
 std::vector<LibraryEffect> candidate_effects(const ModelSpec& model);
 
 /// The candidate of `model` called `name` (a copy: it stays valid when the model changes). Throws

@@ -16,7 +16,8 @@ struct DiagnoseRequest {
   std::string model_file;        ///< a model file (TOML); empty: `preset`
   std::string preset = "sim";
   std::vector<std::string> add;  ///< EFFECT or EFFECT=VALUE
-  bool auto_select = false;      ///< --auto: forward selection of several effects
+  bool auto_select = false;      ///< --auto: several effects
+  std::string search = "subsets";  ///< --search: how --auto searches, "subsets" or "forward"
   std::string integrator = "rk4";
   double heldout = 0.3;          ///< fraction of the episodes held out
   std::vector<int> horizons = {1, 10, 50};  ///< k of the k-step predictions (distinct, >= 1)
@@ -30,7 +31,7 @@ struct DiagnoseRequest {
 inline constexpr std::size_t kMaxHorizonCount = 32;
 
 /// The diagnosis options of a request. Throws InputError naming the option (`--preset`, `--add`,
-/// `--integrator`, `--heldout`, `--horizons`, `--gp-points`, `--gp-restarts`, `--backend`) or the model
+/// `--search`, `--integrator`, `--heldout`, `--horizons`, `--gp-points`, `--gp-restarts`, `--backend`) or the model
 /// file.
 DiagnosisOptions diagnosis_options(const DiagnoseRequest& request);
 

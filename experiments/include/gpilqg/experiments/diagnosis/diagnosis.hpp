@@ -25,10 +25,12 @@
 ///    the noise floor by more than `floor_tolerance`, and no effect removes a large and significant
 ///    share of the held-out residual (explained >= min_explained, z >= min_z: the GP sees (x_t, u_t)
 ///    only, so the error of an input delay looks like noise to it). Nothing is proposed then.
-///  - otherwise "explained" when the best alias group removes a significant share of the held-out
-///    residual: explained >= min_explained, z score >= min_z, and explained >= relative_to_gp times what
-///    the GP (a flexible model of everything learnable) removes on the same rows. A wrong effect can
-///    still soak up some of the residual; it cannot match the GP.
+///  - otherwise, when the best alias group removes a significant share of the held-out residual
+///    (explained >= min_explained, z score >= min_z) and at least relative_to_gp (half) of what the
+///    GP (a flexible model of everything learnable) removes on the same rows: "explained" if what it
+///    leaves is at most explained_left_ratio (1.5) times what the GP leaves, "partly_explained" if it
+///    leaves more. A wrong effect can soak up much of the residual; it cannot match the GP. With
+///    --auto the same rule judges the chosen set.
 ///  - "unexplained" otherwise: the residual has structure no effect of the library accounts for.
 ///
 /// Before all of these: "model_diverges" when the model's prediction diverges (not finite, or a state
@@ -71,16 +73,24 @@ struct DiagnosisOptions {
   GpSettings gp;
   int bins = 5;                           ///< quantile bins per input
   int max_lag = 20;                       ///< cross-correlation and residual autocorrelation lags
-  double alias_threshold = 0.95;          ///< |regressor correlation| that makes two effects aliases
+  /// Two effects are aliases when their joint fit removes less than this share of the held-out
+  /// residual either leaves alone (rank_effects).
+  double alias_gain = 0.05;
   double structure_threshold = 0.1;       ///< GP held-out explained fraction above which a state is structured
   double floor_tolerance = 1.05;          ///< held-out RMSE / noise floor above which a state is structured
   double min_explained = 0.1;             ///< "explained" needs at least this held-out fraction ...
   double min_z = 3.0;                     ///< ... this significance ...
-  double relative_to_gp = 0.5;            ///< ... and this share of what the GP explains
+  double relative_to_gp = 0.5;            ///< ... and this share of what the GP explains ("partly_explained")
   bool rank = true;                       ///< false: skip the ranking (faster; verdict from the GP only)
   /// --auto: add several effects by forward selection with joint refits (effect_selection.hpp); the
   /// final model becomes model_next.
   bool auto_select = false;
+  SearchMethod search = SearchMethod::Subsets;  ///< --auto: best subsets (subset_search.hpp) or forward
+  int max_subset = 4;                          ///< --auto with subsets: the largest set searched
+  /// "explained" needs the effects to leave at most this multiple of what the GP leaves on the
+  /// held-out rows (weighted squared residual); a significant effect that leaves more is "partly
+  /// explained" (see decide in diagnosis.cpp).
+  double explained_left_ratio = 1.5;
   /// --auto: a step after the first adds its effect when it removes at least this share of the held-out
   /// residual left (and z >= min_z). Lower than min_explained: once the large effects are in, a real one
   /// can be a small share of a remainder that noise dominates; z is the test, this only keeps
@@ -122,9 +132,15 @@ struct ModelScore {
 };
 
 struct Verdict {
-  std::string status;                    ///< "explained", "unexplained", "consistent", "model_diverges"
-  std::optional<EffectFit> effect;       ///< the proposed effect (status "explained")
+  /// "explained", "partly_explained", "unexplained", "consistent", "model_diverges"
+  std::string status;
+  std::optional<EffectFit> effect;       ///< the proposed effect ("explained" and "partly_explained")
   std::vector<std::string> aliases;
+  /// --auto: every effect of the chosen model beyond M_0's (empty without --auto).
+  std::vector<std::string> effects;
+  /// Shares of the diagnosed model's weighted held-out squared residual left by the proposed
+  /// effect(s) and by the GP (1 when nothing is proposed).
+  double left = 1.0, gp_left = 1.0;
   std::string reason;                    ///< one sentence: why this verdict
 };
 

@@ -30,9 +30,8 @@
 /// so it accounts for the correlation between the effects). Forward selection (effect_selection.hpp)
 /// and `--add` use them.
 ///
-/// Aliases: two effects whose weighted regressors are nearly collinear (|cos angle| >= 0.95, the
-/// uncentred correlation that governs least-squares identifiability) cannot be told apart on these
-/// data; they are reported as one group under the best of them.
+/// Aliases: two effects that a joint fit cannot separate on these data (rank_effects) are reported
+/// as one group under the best of them.
 
 #include <functional>
 #include <string>
@@ -53,7 +52,9 @@ struct FitContext {
   int substeps = 1;
   Vector weights;                       ///< n, w_i = 1 / sigma_i^2
   Matrix residual;                      ///< N x n, the model's one-step residual at every row
-  int batch = 25;                       ///< batch length of the held-out significance test
+  /// Batch length of the held-out significance test; 0: ceil(sqrt(N)) of the N held-out rows, at
+  /// least 10 (24 on 600 held-out rows, 87 on 7,500).
+  int batch = 0;
 };
 
 /// The model integrated as configured.
@@ -64,6 +65,10 @@ std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integra
 /// integrator, dt and substeps of `settings` are used.
 Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int* diverged = nullptr);
 
+/// sqrt(w_i) (x_{t+1,i} - phi_i(x_t, u_t)) of `model` stacked over `rows` (index k n + i), integrated
+/// and weighted as `settings` says; a diverged prediction counts as x_t (see one_step_predictions).
+Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows);
+
 /// The values of one effect inside a joint fit: where it started, where it ended, its 95% interval.
 struct EffectValues {
   std::string effect;
@@ -71,6 +76,7 @@ struct EffectValues {
   Vector initial;          ///< the start of the fit
   Vector estimate;         ///< the joint estimate
   Vector ci_low, ci_high;  ///< 95% interval from the joint covariance
+  double smoothing = 0.0;  ///< Coulomb friction: its smoothing velocity v0 (LibraryEffect::smoothing); else 0
 };
 
 struct EffectFit {
@@ -80,6 +86,7 @@ struct EffectFit {
   Vector linear_estimate;    ///< theta_LS
   Vector estimate;           ///< theta_hat (NLopt)
   Vector ci_low, ci_high;    ///< 95% interval of theta_hat
+  double smoothing = 0.0;    ///< Coulomb friction: its smoothing velocity v0 (LibraryEffect::smoothing); else 0
   int evaluations = 0;       ///< NLopt objective evaluations
   double training_objective_before = 0.0;  ///< S(theta_0)
   double training_objective_after = 0.0;   ///< S(theta_hat)
@@ -118,8 +125,6 @@ EffectFit fit_jointly(const LibraryEffect& effect, const std::vector<RefitEffect
 /// ci_low = ci_high = values. Throws std::invalid_argument for values the effect does not accept.
 EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, const FitContext& context);
 
-/// |cos angle| between two regressors (0 when either is zero).
-double regressor_correlation(const Vector& a, const Vector& b);
 
 /// One entry of the ranking: the best effect of an alias group and the others of the group.
 struct RankedEffect {
@@ -127,13 +132,16 @@ struct RankedEffect {
   std::vector<EffectFit> aliases;
 };
 
-/// Fits every effect of the library and ranks the alias groups by held-out explained fraction
-/// (greedy grouping: the best remaining effect takes every remaining effect whose regressor correlation
-/// with it is >= alias_threshold).
+/// Fits every candidate effect and ranks the alias groups by held-out explained fraction. Two effects
+/// are aliases when their joint fit cannot separate them: the pair, fitted together on the training
+/// rows, removes less than `alias_gain` of the held-out residual that either leaves alone (each alone
+/// does what both do; linearised_fits.hpp), or the system declares them the same physics. Grouping is
+/// greedy: the best remaining effect takes every remaining effect that is its alias.
 /// `progress` (optional) receives one line per fitted effect and may throw to stop the ranking.
 /// `refit` (forward selection): effects already chosen, refitted jointly with every candidate
-/// (fit_jointly); they and their aliases are not candidates. `threads` candidates are fitted at once.
-std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_threshold = 0.95,
+/// (fit_jointly); they and their declared aliases are not candidates. `threads` candidates are
+/// fitted at once.
+std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_gain = 0.05,
                                        const std::function<void(const std::string&)>& progress = {},
                                        const std::vector<RefitEffect>& refit = {}, int threads = 1);
 

@@ -1,6 +1,10 @@
 #pragma once
 /// @file effect_selection.hpp
-/// Several missing effects in one call (`gpilqg diagnose --auto`): forward selection with joint refits.
+/// Several missing effects in one call (`gpilqg diagnose --auto`). Two searches share these types:
+/// the best-subset search (subset_search.hpp, the default), which finds sets whose members are weak
+/// alone, and the forward selection below, kept for comparison (`--search forward`).
+///
+/// Forward selection with joint refits.
 ///
 /// Start from the diagnosed model M_0 with its one-step residual r_0 and the noise-floor weights
 /// w_i = 1 / floor_i^2 (diagnosis.hpp). The effects M_0 already has (model_effects) are refitted
@@ -51,8 +55,16 @@ const LibraryEffect& named(const std::vector<LibraryEffect>& candidates, std::st
 /// candidate_effects(model) (or a superset) and outlive the result.
 std::vector<RefitEffect> model_effects(const ModelSpec& model, const std::vector<LibraryEffect>& candidates);
 
+/// How --auto searches: every subset of up to max_subset effects (subset_search.hpp), or forward.
+enum class SearchMethod { Subsets, Forward };
+
+/// "subsets" or "forward".
+const char* to_string(SearchMethod method);
+
 struct SelectionOptions {
-  double alias_threshold = 0.95;
+  SearchMethod method = SearchMethod::Subsets;
+  int max_subset = 4;           ///< subsets: the largest set searched
+  double alias_gain = 0.05;     ///< rank_effects' alias rule
   double min_explained = 0.05;  ///< step 3: explained >= this ...
   double min_z = 3.0;           ///< ... and z >= this
   int max_steps = 10;           ///< at most this many effects
@@ -69,13 +81,23 @@ struct SelectionStep {
 };
 
 struct Selection {
-  std::vector<SelectionStep> steps;       ///< the effects added, in order
+  SearchMethod method = SearchMethod::Subsets;
+  std::vector<SelectionStep> steps;       ///< the effects added, in order (subsets: one step per accepted size)
   ModelSpec model;                        ///< the final model (M_0 when nothing was added)
   std::vector<RankedEffect> rejected;     ///< the candidates of the step that stopped the selection
   std::string stop_reason;                ///< one sentence
 };
 
-/// Runs the selection from context.model = M_0 (context.residual its residual, context.weights the
+/// M_0 (`base`) with the effect of `fit` and those it refitted at their joint estimates.
+ModelSpec model_after(const ModelSpec& base, const EffectFit& fit, const std::vector<LibraryEffect>& candidates);
+
+/// The backward check: while an effect of fit.refitted that M_0 (context.model) does not have has a
+/// joint 95% interval containing its value in M_0, it is dropped (its name appended to `removed`) and
+/// the rest refitted jointly on `step_context`.
+EffectFit without_redundant(EffectFit fit, const FitContext& context, const FitContext& step_context,
+                            const std::vector<LibraryEffect>& candidates, std::vector<std::string>& removed);
+
+/// Runs the selection of options.method from context.model = M_0 (context.residual its residual, context.weights the
 /// floor weights). `first` (optional) is step 1's ranking when the caller already has it: rank_effects
 /// on the same context with refit = model_effects(M_0).
 Selection select_effects(const FitContext& context, const SelectionOptions& options,

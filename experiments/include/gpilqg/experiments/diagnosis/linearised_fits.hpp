@@ -1,0 +1,62 @@
+#pragma once
+/// @file linearised_fits.hpp
+/// Joint fits of any set of candidate effects at the cost of a small linear solve: what decides
+/// whether two effects are aliases, and the screening of the best-subset search (subset_search.hpp).
+///
+/// Around the base model B (the fit context's model with the effects being refitted at their starts,
+/// weighted one-step residual r), effect e moves the weighted prediction along a direction J_e: the
+/// secant from B to B with e at its own fitted value, (r(theta_0) - r(theta_e)) / (theta_e - theta_0),
+/// for an effect of one parameter whose fit moved it (exact for effects linear in theta, and along
+/// the fitted direction for the others: a mass, a delay), else the tangent d phi / d theta at theta_0
+/// (central differences). For a set S of candidates, together with the effects P that every fit
+/// refits, the least-squares fit on the training rows and what it leaves on the held-out rows are
+///
+///   theta_S = G_T^-1 b_T,     G = J' J, b = J' r over the columns of S and P,
+///   left_H(S) = r_H' r_H - 2 theta_S' b_H + theta_S' G_H theta_S,
+///
+/// from Gram matrices computed once over all candidates (T training rows, H held-out rows): a subset
+/// costs one solve of its own size, so every subset of up to four effects of a library can be scored.
+/// The numbers are a linearisation: the search screens with them, then refits its choice exactly
+/// (fit_jointly) and scores that on the held-out rows.
+
+#include <string>
+#include <vector>
+
+#include "gpilqg/experiments/diagnosis/effect_fit.hpp"
+
+namespace gpilqg::diagnosis {
+
+class LinearisedFits {
+ public:
+  /// Linearises the candidates `fits` (each fitted alone or with `refit`, as rank_effects does) around
+  /// context.model with every `refit` effect at its start. Candidates whose fit is not identifiable
+  /// keep zero columns (they explain nothing). `threads` candidates at once.
+  LinearisedFits(const FitContext& context, const std::vector<EffectFit>& fits, const std::vector<RefitEffect>& refit,
+                 int threads = 1);
+
+  /// The candidates, in the order of `fits`.
+  const std::vector<std::string>& names() const { return names_; }
+  int size() const { return static_cast<int>(names_.size()); }
+  /// Index of the candidate called `name`, or -1.
+  int index(const std::string& name) const;
+
+  /// The weighted held-out squared residual of B (no candidate).
+  double heldout_base() const { return base_heldout_; }
+  /// The weighted held-out squared residual left by the joint least-squares fit of the candidates
+  /// `subset` (indices) with the refitted effects, fitted on the training rows (never below 0).
+  double heldout_left(const std::vector<int>& subset) const;
+
+  /// The share of what `reference` leaves on the held-out rows that `subset` removes:
+  /// 1 - left(subset) / left(reference) (0 when the reference leaves nothing).
+  double gain(const std::vector<int>& subset, const std::vector<int>& reference) const;
+
+ private:
+  std::vector<std::string> names_;
+  std::vector<Eigen::Index> offset_{0};  ///< candidate e owns columns [offset_[e], offset_[e + 1]); then the refitted
+  Eigen::Index refit_columns_ = 0;
+  Matrix gram_train_, gram_heldout_;
+  Vector cross_train_, cross_heldout_;
+  double base_heldout_ = 0.0;
+};
+
+}  // namespace gpilqg::diagnosis

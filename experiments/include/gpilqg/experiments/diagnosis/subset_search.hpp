@@ -1,0 +1,40 @@
+#pragma once
+/// @file subset_search.hpp
+/// Several missing effects in one call (`gpilqg diagnose --auto`, the default search): the best subset
+/// of the candidates of each size up to four, scored on held-out data.
+///
+/// Forward selection adds the effect that is best alone, so it cannot find a set whose members are
+/// weak alone: on a drive with viscous friction, Coulomb friction and a constant force, an actuator
+/// gain that is a fair proxy for all three is taken first and the search stops. Every subset is
+/// scored instead, the approach of best-subset regression (Furnival and Wilson's leaps and bounds
+/// enumerate the same space), with held-out episodes as the criterion rather than an information
+/// criterion (effect_selection.hpp says why):
+///
+///  1. every candidate is fitted alone (rank_effects: step 1 of the verdict) and linearised around
+///     M_0 (linearised_fits.hpp), with the effects M_0 has refitted in every fit;
+///  2. for k = 1 .. max_subset every subset S of k candidates, except those holding two effects the
+///     system declares the same physics, is scored by the held-out residual its linearised joint
+///     fit leaves; the three best of each size are refitted exactly (fit_jointly, starting from each
+///     member's value fitted alone) and scored on the held-out rows against the model accepted so far
+///     (M_0 at first): the share of its held-out residual they remove and the batch-means z score;
+///  3. size k is accepted when its best exact fit removes at least min_explained (5%) of what the
+///     accepted model leaves, with z >= min_z (3); then the backward check of forward selection runs
+///     (an effect whose joint interval contains its value without it is dropped) and that set becomes
+///     the accepted model. A size that is not accepted does not stop the search: a larger set can
+///     still be better;
+///  4. the last accepted set is the result. The path has one step per accepted size, naming the
+///     effects new in it and (as `removed`) those of the previous set it no longer holds.
+///
+/// The linearised scores cost one small solve per subset, so the exact fits (a few per size) are
+/// what the search costs beyond the ranking. The forward selection stays available, and
+/// docs/diagnosis.md compares both on the multi-effect test sets.
+
+#include "gpilqg/experiments/diagnosis/effect_selection.hpp"
+
+namespace gpilqg::diagnosis {
+
+/// The search above; `first` is step 1's ranking when the caller already has it (rank_effects on
+/// `context` with refit = model_effects(M_0)).
+Selection select_subsets(const FitContext& context, const SelectionOptions& options, std::vector<RankedEffect> first = {});
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,38 @@
+#pragma once
+/// @file velocity_scales.hpp
+/// Scales of the effect library taken from the data, not from a constant: the smoothing velocity of
+/// Coulomb friction, Q = -tau tanh(qdot / v0).
+///
+/// A slide joint may move at 0.01 m/s and a wheel at 50 rad/s, so no single v0 suits every
+/// coordinate: 0.05 m/s turns the friction of the slow slide into a viscous term, and 0.05 rad/s is a
+/// sign function at the wheel's speeds. How sharp the switch at qdot = 0 looks in the data depends on
+/// the friction itself (a constraint is a true sign function, a lubricated contact is smoother) and
+/// on the noise of the measured velocity, which blurs the sign of small velocities. So v0 is fitted:
+/// with s the RMS of the coordinate's measured velocity about 0 on the training rows,
+///
+///   v0 = argmin over f in {0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2} of min_tau S(tau, f s),
+///
+/// S the weighted one-step training objective of the fit (effect_fit.hpp) with tau profiled out by
+/// linear least squares (the effect is linear in tau), refined by the vertex of the parabola through
+/// the best grid point and its neighbours in log v0. The grid spans the data's own scale, two
+/// decades below its RMS speed; above 0.2 s the tanh is nearly linear over the data and the term is
+/// viscous friction, which the library has. A coordinate whose measured velocity is 0 throughout
+/// keeps the library's default (kDefaultCoulombWidth). The value is reported with the effect
+/// (`v0 = ...`) and written into model files, so a model keeps the smoothing it was fitted with.
+
+#include "gpilqg/experiments/diagnosis/effect_fit.hpp"
+
+namespace gpilqg::diagnosis {
+
+/// The grid of v0 / RMS(qdot) (see the file comment).
+inline constexpr double kSmoothingGrid[] = {0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2};
+
+/// The RMS of state `velocity` over the training rows of `data` (0 when there are none).
+double training_rms(const Transitions& data, int velocity);
+
+/// context.model with a fitted smoothing velocity (see the file comment) for every Coulomb candidate
+/// that the model neither has as a force nor gives a v0 already. Needs the context's data, weights
+/// and residual (that of context.model).
+ModelSpec with_fitted_smoothing(const FitContext& context);
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,145 @@
+#include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+#include "gpilqg/core/fork_join.hpp"
+
+namespace gpilqg::diagnosis {
+
+namespace {
+
+/// The weighted residual on the training rows and on the held-out rows.
+struct Split {
+  Vector train, heldout;
+};
+
+Split residual_split(const ModelSpec& model, const FitContext& c, const std::vector<int>& train,
+                     const std::vector<int>& heldout) {
+  return {weighted_residual_of(model, c, train), weighted_residual_of(model, c, heldout)};
+}
+
+/// The columns of one effect: d phi / d theta on both row sets (a secant or central differences; see
+/// the file comment). The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
+std::pair<Matrix, Matrix> columns(const ModelSpec& base, const Split& r0, const LibraryEffect& effect, const Vector& theta0,
+                                  const Vector* fitted, const FitContext& c, const std::vector<int>& train,
+                                  const std::vector<int>& heldout) {
+  const auto p = static_cast<Eigen::Index>(effect.parameters.size());
+  Matrix JT(r0.train.size(), p), JH(r0.heldout.size(), p);
+  if (p == 1 && fitted != nullptr && fitted->size() == 1 && (*fitted)(0) != theta0(0)) {
+    const Split r = residual_split(base.with(effect, *fitted), c, train, heldout);
+    const double step = (*fitted)(0) - theta0(0);
+    JT.col(0) = (r0.train - r.train) / step;
+    JH.col(0) = (r0.heldout - r.heldout) / step;
+    return {JT, JH};
+  }
+  for (Eigen::Index j = 0; j < p; ++j) {
+    const EffectParameter& spec = effect.parameters[static_cast<std::size_t>(j)];
+    const double h = 1e-4 * std::max(std::abs(theta0(j)), spec.scale);
+    Vector plus = theta0, minus = theta0;
+    plus(j) += h;
+    minus(j) -= h;
+    double width = 2.0 * h;
+    if (minus(j) < spec.lower) {
+      minus(j) = theta0(j);
+      width = h;
+    }
+    const Split a = residual_split(base.with(effect, minus), c, train, heldout);
+    const Split b = residual_split(base.with(effect, plus), c, train, heldout);
+    JT.col(j) = (a.train - b.train) / width;
+    JH.col(j) = (a.heldout - b.heldout) / width;
+  }
+  return {JT, JH};
+}
+
+}  // namespace
+
+LinearisedFits::LinearisedFits(const FitContext& c, const std::vector<EffectFit>& fits,
+                               const std::vector<RefitEffect>& refit, int threads) {
+  const std::vector<int> train = c.data->rows(false), heldout = c.data->rows(true);
+  ModelSpec base = c.model;
+  for (const RefitEffect& r : refit) base = base.with(*r.effect, r.start);
+  const Split r0 = residual_split(base, c, train, heldout);
+
+  // Candidates first, then the refitted effects; each block of columns computed on its own.
+  struct Block {
+    LibraryEffect effect;
+    Vector theta0;
+    const Vector* fitted = nullptr;
+    bool usable = true;
+  };
+  std::vector<Block> blocks;
+  for (const EffectFit& f : fits) {
+    names_.push_back(f.effect);
+    LibraryEffect effect = find_candidate(c.model, f.effect);
+    const Vector theta0 = base.current_values(effect);
+    blocks.push_back({std::move(effect), theta0, &f.estimate, f.identifiable});
+    offset_.push_back(offset_.back() + static_cast<Eigen::Index>(f.parameters.size()));
+  }
+  for (const RefitEffect& r : refit) {
+    blocks.push_back({*r.effect, r.start, nullptr, true});
+    refit_columns_ += static_cast<Eigen::Index>(r.effect->parameters.size());
+  }
+  const Eigen::Index P = offset_.back() + refit_columns_;
+  Matrix JT = Matrix::Zero(r0.train.size(), P), JH = Matrix::Zero(r0.heldout.size(), P);
+  std::vector<Eigen::Index> at(blocks.size());
+  for (std::size_t b = 0, col = 0; b < blocks.size(); ++b) {
+    at[b] = static_cast<Eigen::Index>(col);
+    col += blocks[b].effect.parameters.size();
+  }
+  std::atomic<std::size_t> next{0};
+  ForkJoin workers;
+  workers.run(std::max(1, std::min<int>(threads, static_cast<int>(blocks.size()))), [&](int, int) {
+    for (std::size_t b = next++; b < blocks.size(); b = next++) {
+      if (!blocks[b].usable) continue;
+      auto [T, H] = columns(base, r0, blocks[b].effect, blocks[b].theta0, blocks[b].fitted, c, train, heldout);
+      if (!T.allFinite() || !H.allFinite()) continue;
+      JT.middleCols(at[b], T.cols()) = T;
+      JH.middleCols(at[b], H.cols()) = H;
+    }
+  });
+  gram_train_ = JT.transpose() * JT;
+  gram_heldout_ = JH.transpose() * JH;
+  cross_train_ = JT.transpose() * r0.train;
+  cross_heldout_ = JH.transpose() * r0.heldout;
+  base_heldout_ = r0.heldout.squaredNorm();
+}
+
+int LinearisedFits::index(const std::string& name) const {
+  const auto it = std::find(names_.begin(), names_.end(), name);
+  return it == names_.end() ? -1 : static_cast<int>(it - names_.begin());
+}
+
+double LinearisedFits::heldout_left(const std::vector<int>& subset) const {
+  std::vector<Eigen::Index> cols;
+  for (int e : subset)
+    for (Eigen::Index j = offset_[static_cast<std::size_t>(e)]; j < offset_[static_cast<std::size_t>(e) + 1]; ++j)
+      cols.push_back(j);
+  for (Eigen::Index j = 0; j < refit_columns_; ++j) cols.push_back(offset_.back() + j);
+  if (cols.empty()) return base_heldout_;
+  const auto k = static_cast<Eigen::Index>(cols.size());
+  Matrix GT(k, k), GH(k, k);
+  Vector bT(k), bH(k);
+  for (Eigen::Index a = 0; a < k; ++a) {
+    bT(a) = cross_train_(cols[static_cast<std::size_t>(a)]);
+    bH(a) = cross_heldout_(cols[static_cast<std::size_t>(a)]);
+    for (Eigen::Index b = 0; b < k; ++b) {
+      GT(a, b) = gram_train_(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
+      GH(a, b) = gram_heldout_(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
+    }
+  }
+  // The minimum-norm solution: collinear columns (aliases) share the fit instead of blowing up.
+  const Vector theta = GT.completeOrthogonalDecomposition().solve(bT);
+  if (!theta.allFinite()) return base_heldout_;
+  return std::max(0.0, base_heldout_ - 2.0 * theta.dot(bH) + theta.dot(GH * theta));
+}
+
+double LinearisedFits::gain(const std::vector<int>& subset, const std::vector<int>& reference) const {
+  const double before = heldout_left(reference);
+  return before > 0.0 ? 1.0 - heldout_left(subset) / before : 0.0;
+}
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,163 @@
+#include "gpilqg/experiments/diagnosis/subset_search.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "gpilqg/core/system_registry.hpp"
+#include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
+
+namespace gpilqg::diagnosis {
+
+namespace {
+
+/// How many of the best linearised subsets of each size are refitted exactly.
+constexpr int kExactFitsPerSize = 3;
+
+bool declared_same(const SystemEntry& entry, const std::string& a, const std::string& b) {
+  for (const auto& group : entry.same_physics)
+    if (std::find(group.begin(), group.end(), a) != group.end() && std::find(group.begin(), group.end(), b) != group.end())
+      return true;
+  return false;
+}
+
+/// The `count` subsets of size k with the least linearised held-out residual, best first.
+std::vector<std::vector<int>> best_subsets(const LinearisedFits& fits, int k, int count,
+                                           const std::vector<std::vector<bool>>& forbidden) {
+  std::vector<std::pair<double, std::vector<int>>> best;
+  std::vector<int> subset(static_cast<std::size_t>(k));
+  const int n = fits.size();
+  // Lexicographic enumeration of the k-subsets of 0..n-1.
+  for (int i = 0; i < k; ++i) subset[static_cast<std::size_t>(i)] = i;
+  while (k <= n) {
+    bool allowed = true;
+    for (int a = 0; a < k && allowed; ++a)
+      for (int b = a + 1; b < k && allowed; ++b)
+        allowed = !forbidden[static_cast<std::size_t>(subset[static_cast<std::size_t>(a)])]
+                            [static_cast<std::size_t>(subset[static_cast<std::size_t>(b)])];
+    if (allowed) {
+      const double left = fits.heldout_left(subset);
+      if (static_cast<int>(best.size()) < count || left < best.back().first) {
+        best.emplace_back(left, subset);
+        std::sort(best.begin(), best.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+        if (static_cast<int>(best.size()) > count) best.pop_back();
+      }
+    }
+    int i = k - 1;
+    while (i >= 0 && subset[static_cast<std::size_t>(i)] == n - k + i) --i;
+    if (i < 0) break;
+    ++subset[static_cast<std::size_t>(i)];
+    for (int j = i + 1; j < k; ++j) subset[static_cast<std::size_t>(j)] = subset[static_cast<std::size_t>(j - 1)] + 1;
+  }
+  std::vector<std::vector<int>> out;
+  for (auto& [left, s] : best) out.push_back(std::move(s));
+  return out;
+}
+
+}  // namespace
+
+Selection select_subsets(const FitContext& context, const SelectionOptions& o, std::vector<RankedEffect> first) {
+  if (context.data == nullptr) throw std::invalid_argument("select_subsets: no data");
+  const SystemEntryPtr system = find_system(context.model.system);
+  const std::vector<LibraryEffect> candidates = candidate_effects(context.model);
+  const std::vector<RefitEffect> present = model_effects(context.model, candidates);
+  std::vector<RankedEffect> ranking =
+      first.empty() ? rank_effects(context, o.alias_gain, o.progress, present, o.threads) : std::move(first);
+
+  // Every candidate fitted alone (aliases included), linearised around M_0.
+  std::vector<EffectFit> singles;
+  for (const RankedEffect& r : ranking) {
+    singles.push_back(r.fit);
+    singles.insert(singles.end(), r.aliases.begin(), r.aliases.end());
+  }
+  const LinearisedFits fits(context, singles, present, o.threads);
+  const auto n = static_cast<std::size_t>(fits.size());
+  std::vector<std::vector<bool>> forbidden(n, std::vector<bool>(n, false));
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b) forbidden[a][b] = a != b && declared_same(*system, singles[a].effect, singles[b].effect);
+
+  Selection S;
+  S.method = SearchMethod::Subsets;
+  S.model = context.model;
+  FitContext accepted_context = context;  // model stays M_0; residual becomes the accepted model's
+  std::vector<std::string> accepted;      // the members of the accepted set
+  std::string last_rejection;
+  const int largest = std::min<int>(o.max_subset, static_cast<int>(n));
+  for (int k = 1; k <= largest; ++k) {
+    // 2. The best linearised subsets of size k, refitted exactly against the accepted model.
+    EffectFit best;
+    bool have = false;
+    for (const std::vector<int>& subset : best_subsets(fits, k, kExactFitsPerSize, forbidden)) {
+      const EffectFit& lead = singles[static_cast<std::size_t>(subset.front())];
+      std::vector<RefitEffect> rest;
+      for (std::size_t i = 1; i < subset.size(); ++i) {
+        const EffectFit& member = singles[static_cast<std::size_t>(subset[i])];
+        rest.push_back({&named(candidates, member.effect), member.estimate});
+      }
+      rest.insert(rest.end(), present.begin(), present.end());
+      EffectFit exact = fit_jointly(named(candidates, lead.effect), rest, accepted_context, lead.estimate);
+      if (!have || exact.explained > best.explained) best = std::move(exact);
+      have = true;
+    }
+    if (!have) break;
+    std::vector<std::string> members{best.effect};
+    for (const EffectValues& v : best.refitted) members.push_back(v.effect);
+    const std::string names = fmt::format("{}", fmt::join(members, ", "));
+    if (o.progress)
+      o.progress(fmt::format("best subset of {}: {} removes {:.1f}% of the held-out residual left (z = {:.1f})", k, names,
+                             100.0 * best.explained, best.z_score));
+    // 3. Accepted when it removes a significant, not negligible share of what the accepted model leaves.
+    if (best.explained < o.min_explained || best.z_score < o.min_z) {
+      last_rejection = fmt::format(
+          "the best set of {} ({}) removes {:.1f}% of the held-out residual left (z = {:.1f}); a larger set needs at "
+          "least {:.0f}% and z >= {:g}",
+          k, names, 100.0 * best.explained, best.z_score, 100.0 * o.min_explained, o.min_z);
+      continue;
+    }
+    std::vector<std::string> removed;
+    best = without_redundant(best, context, accepted_context, candidates, removed);
+    // Present in the previous set, absent from this one (and not dropped by the backward check).
+    std::vector<std::string> now{best.effect};
+    for (const EffectValues& v : best.refitted) now.push_back(v.effect);
+    for (const std::string& name : accepted)
+      if (std::find(now.begin(), now.end(), name) == now.end() &&
+          std::find(removed.begin(), removed.end(), name) == removed.end())
+        removed.push_back(name);
+    // The lead of the step is an effect new in this set, when there is one.
+    if (std::find(accepted.begin(), accepted.end(), best.effect) != accepted.end()) {
+      for (std::size_t i = 0; i < best.refitted.size(); ++i) {
+        const std::string& name = best.refitted[i].effect;
+        if (std::find(accepted.begin(), accepted.end(), name) != accepted.end()) continue;
+        const bool from_m0 = std::any_of(present.begin(), present.end(), [&](const RefitEffect& r) { return r.effect->name == name; });
+        if (from_m0) continue;
+        EffectValues lead{best.effect, best.parameters, best.initial, best.estimate, best.ci_low, best.ci_high, best.smoothing};
+        const EffectValues swap = best.refitted[i];
+        best.refitted[i] = lead;
+        best.effect = swap.effect;
+        best.parameters = swap.parameters;
+        best.initial = best.linear_estimate = swap.initial;
+        best.estimate = swap.estimate;
+        best.ci_low = swap.ci_low;
+        best.ci_high = swap.ci_high;
+        best.smoothing = swap.smoothing;
+        break;
+      }
+    }
+    SelectionStep step{best, model_after(context.model, best, candidates), S.steps.empty() ? ranking : std::vector<RankedEffect>{},
+                       removed};
+    accepted.clear();
+    for (const std::string& name : now)
+      if (std::find(removed.begin(), removed.end(), name) == removed.end()) accepted.push_back(name);
+    accepted_context.residual = context.data->x_next - model_predictions(step.model, context);
+    S.model = step.model;
+    S.steps.push_back(std::move(step));
+  }
+  S.stop_reason = fmt::format("every set of up to {} of the {} candidates searched", largest, n);
+  if (!last_rejection.empty()) S.stop_reason += "; " + last_rejection;
+  if (S.steps.empty()) S.rejected = std::move(ranking);
+  return S;
+}
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,81 @@
+#include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <limits>
+
+namespace gpilqg::diagnosis {
+
+double training_rms(const Transitions& data, int velocity) {
+  double sum = 0.0;
+  long count = 0;
+  for (int r : data.rows(false)) {
+    const double v = data.x(r, velocity);
+    sum += v * v;
+    ++count;
+  }
+  return count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
+}
+
+namespace {
+
+/// min over tau of S(tau) for `effect` at smoothing `v0` added to the model (linear least squares on
+/// the one column the effect adds: S = |r|^2 - (J'r)^2 / J'J).
+double profiled_objective(const FitContext& c, const LibraryEffect& coulomb, double v0, const Vector& r0,
+                          const std::vector<int>& rows) {
+  const LibraryEffect effect = with_smoothing(coulomb, v0);
+  const double h = effect.parameters[0].scale;
+  const Vector r = weighted_residual_of(c.model.with(effect, Vector::Constant(1, h)), c, rows);
+  const Vector J = (r0 - r) / h;
+  const double jj = J.squaredNorm();
+  if (!(jj > 0.0) || !std::isfinite(jj)) return r0.squaredNorm();
+  const double jr = J.dot(r0);
+  return r0.squaredNorm() - jr * jr / jj;
+}
+
+/// The fitted v0 of one Coulomb candidate (the file comment), or `fallback` when its velocity is 0.
+double fitted_smoothing(const FitContext& c, const LibraryEffect& coulomb, const Vector& r0, const std::vector<int>& rows) {
+  const double rms = training_rms(*c.data, coulomb.smoothing->velocity);
+  if (!(rms > 0.0) || !std::isfinite(rms)) return coulomb.smoothing->width;
+  const auto points = static_cast<int>(std::size(kSmoothingGrid));
+  std::vector<double> objective(static_cast<std::size_t>(points));
+  int best = 0;
+  for (int i = 0; i < points; ++i) {
+    objective[static_cast<std::size_t>(i)] = profiled_objective(c, coulomb, kSmoothingGrid[i] * rms, r0, rows);
+    if (objective[static_cast<std::size_t>(i)] < objective[static_cast<std::size_t>(best)]) best = i;
+  }
+  double v0 = kSmoothingGrid[best] * rms;
+  if (best == 0 || best == points - 1) return v0;
+  // The vertex of the parabola through the best point and its neighbours, in x = log v0.
+  const double x0 = std::log(kSmoothingGrid[best - 1]), x1 = std::log(kSmoothingGrid[best]),
+               x2 = std::log(kSmoothingGrid[best + 1]);
+  const double y0 = objective[static_cast<std::size_t>(best - 1)], y1 = objective[static_cast<std::size_t>(best)],
+               y2 = objective[static_cast<std::size_t>(best + 1)];
+  const double d01 = (y1 - y0) / (x1 - x0), d12 = (y2 - y1) / (x2 - x1), curvature = (d12 - d01) / (x2 - x0);
+  if (!(curvature > 0.0)) return v0;
+  // p(x) = y0 + d01 (x - x0) + curvature (x - x0)(x - x1), p'(x) = 0 at:
+  const double x = std::clamp(0.5 * (x0 + x1) - d01 / (2.0 * curvature), x0, x2);
+  const double candidate = std::exp(x) * rms;
+  if (profiled_objective(c, coulomb, candidate, r0, rows) < y1) v0 = candidate;
+  return v0;
+}
+
+}  // namespace
+
+ModelSpec with_fitted_smoothing(const FitContext& c) {
+  ModelSpec out = c.model;
+  const std::vector<int> rows = c.data->rows(false);
+  Vector r0;
+  for (const LibraryEffect& effect : candidate_effects(c.model)) {
+    if (!effect.smoothing || c.model.smoothing.count(effect.name) > 0) continue;
+    const bool present = std::any_of(c.model.forces.begin(), c.model.forces.end(),
+                                     [&](const auto& force) { return force.first == effect.name; });
+    if (present) continue;
+    if (r0.size() == 0) r0 = weighted_residual_of(c.model, c, rows);
+    out.smoothing[effect.name] = fitted_smoothing(c, effect, r0, rows);
+  }
+  return out;
+}
+
+}  // namespace gpilqg::diagnosis
