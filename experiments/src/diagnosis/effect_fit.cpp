@@ -17,6 +17,7 @@
 #include "gpilqg/core/fork_join.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
+#include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -25,6 +26,10 @@ std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integra
 }
 
 Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int* diverged) {
+  if (settings.window > 1)
+    return simulated_predictions(*make_step_model(model, settings.integrator, settings.dt, settings.substeps),
+                                 *settings.data, applied_controls(*settings.data, model.input_delay),
+                                 all_rows(*settings.data), settings.window, diverged);
   return one_step_predictions(*make_step_model(model, settings.integrator, settings.dt, settings.substeps), *settings.data,
                               diverged, model.input_delay);
 }
@@ -41,6 +46,15 @@ Vector weighted_residual(const StepModel& model, const Matrix& u, const FitConte
   const Vector sqrt_w = c.weights.cwiseSqrt();
   Vector out(static_cast<Eigen::Index>(rows.size()) * n);
   Vector next(n);
+  if (c.window > 1) {  // simulation over windows (simulation_error.hpp)
+    int restarts = 0;
+    const Matrix predicted = simulated_predictions(model, *c.data, u, rows, c.window, &restarts);
+    if (restarts > 0 && finite != nullptr) *finite = false;
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      out.segment(static_cast<Eigen::Index>(k) * n, n) = sqrt_w.cwiseProduct(
+          (c.data->x_next.row(rows[k]) - predicted.row(static_cast<Eigen::Index>(k))).transpose());
+    return out;
+  }
   const auto workspace = model.make_workspace();
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const int r = rows[k];
