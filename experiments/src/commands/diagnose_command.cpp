@@ -1,5 +1,5 @@
 /// `gpilqg diagnose --system NAME --data FILE [--model F.toml] [--add EFFECT[=VALUE]]... [--json]
-/// [--out F.h5] [--plots DIR] [--horizons LIST]`: compare a model with measurements, see where it fails,
+/// [--out F.h5] [--plots DIR] [--horizons LIST] [--criterion one-step|simulation --window N]`: compare a model with measurements, see where it fails,
 /// learn which physical effect is missing, add it and watch the error fall (DESIGN.md sections 5, 6
 /// and 8).
 
@@ -46,6 +46,7 @@ struct DiagnoseOptions {
   std::string out;
   std::string plots;
   std::string write_model;
+  long window = 0;  ///< --window as given (request.window when the option is present)
 };
 
 /// Checks, before any work, that plots can be drawn (exit 2 with the missing packages otherwise).
@@ -160,7 +161,17 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--seed", r.seed, "Seed of the GP subsample and restarts")
       ->capture_default_str()
       ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
-  cmd->callback([&action, o] { action = [o] { return run_diagnose(*o); }; });
+  cmd->add_option("--criterion", r.criterion,
+                  "Error the effects are fitted to and scored on: one-step, or simulation over --window samples from "
+                  "measured states (finds effects too small to see in one step, e.g. light damping)")
+      ->capture_default_str();
+  auto* window = cmd->add_option("--window", o->window,
+                                 "Samples per simulation window, with --criterion simulation (e.g. a few periods of the "
+                                 "slowest motion)");
+  cmd->callback([&action, o, window] {
+    if (window->count() > 0) o->request.window = o->window;
+    action = [o] { return run_diagnose(*o); };
+  });
 }
 
 }  // namespace gpilqg::cli
