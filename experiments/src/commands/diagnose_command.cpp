@@ -66,6 +66,11 @@ std::string plugin_option(const std::string& system) {
   return origin == "built-in" ? "" : " --plugin " + origin;
 }
 
+/// " --criterion simulation --window N" when the request has them, so that the next call uses the same criterion.
+std::string criterion_options(const diagnosis::DiagnoseRequest& r) {
+  return r.window ? fmt::format(" --criterion {} --window {}", r.criterion, *r.window) : "";
+}
+
 int run_diagnose(const DiagnoseOptions& options_given) {
   const DiagnoseOptions& o = options_given;
   const diagnosis::DiagnoseRequest& r = o.request;
@@ -90,8 +95,8 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   if (!o.write_model.empty())
     diagnosis::write_model_file(o.write_model, report.model_next,
                                 {fmt::format("written by gpilqg diagnose from {} (verdict: {})", o.data, report.verdict.status),
-                                 fmt::format("next: gpilqg diagnose{} --system {} --data {} --model {}", plugin_option(r.system),
-                                             r.system, o.data, o.write_model)});
+                                 fmt::format("next: gpilqg diagnose{} --system {} --data {} --model {}{}", plugin_option(r.system),
+                                             r.system, o.data, o.write_model, criterion_options(r))});
   if (!o.plots.empty()) {
     // The script's own line goes to stdout; with --json, stdout holds the JSON document only.
     std::cout.flush();
@@ -119,8 +124,9 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   if (!o.plots.empty()) std::cout << "plots: " << o.plots << '\n';
   if (!o.write_model.empty()) std::cout << "model for the next round: " << o.write_model << '\n';
   if (report.verdict.effect && r.add.empty() && !r.auto_select)
-    std::cout << fmt::format("next: gpilqg diagnose{} --system {} --data {}{} --add {}\n", plugin_option(r.system),
+    std::cout << fmt::format("next: gpilqg diagnose{} --system {} --data {}{}{} --add {}\n", plugin_option(r.system),
                              r.system, o.data, r.model_file.empty() ? "" : " --model " + r.model_file,
+                             criterion_options(r),
                              report.verdict.effect->effect);
   return kExitSuccess;
 }
