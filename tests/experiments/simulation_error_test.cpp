@@ -202,5 +202,20 @@ TEST(SimulationError, TheRequestChecksCriterionAndWindow) {
   EXPECT_THROW(o.validate(), std::invalid_argument);
 }
 
+TEST(SimulationError, TheCommandLineTakesTheOptionsAndNamesThemInItsErrors) {
+  const fs::path dir = test::temporary_dir("simulation_error_cli");
+  write_measurements_csv(dir / "decay.csv", pendulum().data);
+  const std::string call = "diagnose --system '" + pendulum().model.string() + "' --data '" + (dir / "decay.csv").string() + "'";
+  const auto missing = test::run_cli(call + " --criterion simulation");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.err.find("--criterion simulation: expected --window N"), std::string::npos) << missing.err;
+  const auto one_step = test::run_cli(call + " --window 10");
+  EXPECT_EQ(one_step.status, 2);
+  EXPECT_NE(one_step.err.find("--window 10: windows belong to --criterion simulation"), std::string::npos) << one_step.err;
+  const auto unknown = test::run_cli(call + " --criterion pem --window 10");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_NE(unknown.err.find("--criterion 'pem': expected 'one-step' or 'simulation'"), std::string::npos) << unknown.err;
+}
+
 }  // namespace
 }  // namespace gpilqg
