@@ -113,8 +113,13 @@ def ranking(f, out):
     ax.set_yticks(y)
     ax.set_yticklabels(labels, fontsize=7)
     ax.axvline(0, color="k", lw=0.5)
-    ax.set_xlabel("held-out residual explained [%] (95% interval)")
-    ax.set_title(f"Which effect is missing (verdict: {text(f.attrs['status'])})")
+    title = f"Which effect is missing (verdict: {text(f.attrs['status'])})"
+    if text(g.attrs.get("criterion", "one-step")) == "simulation":
+        ax.set_xlabel("held-out simulation error explained [%] (95% interval)")
+        title += f"\nsimulation error over windows of {int(g.attrs['window'])} samples"
+    else:
+        ax.set_xlabel("held-out residual explained [%] (95% interval)")
+    ax.set_title(title)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "ranking.png"), dpi=110)
     plt.close(fig)

@@ -193,6 +193,22 @@ def test_diagnose_auto_equals_the_command_lines_selection(tmp_path):
     assert [k["k"] for k in report["k_step"]] == [1, 5]
 
 
+def test_diagnose_simulation_criterion_equals_the_command_lines(tmp_path):
+    data = SOURCE_DIR / "data" / "cartpole_hidden_friction.csv"
+    options = ["--criterion", "simulation", "--window", "20", "--horizons", "1", "--gp-points", "50", "--json"]
+    status, out, err = cli("diagnose", "--system", "cartpole", "--data", data, *options)
+    assert status == 0, err
+    expected = json.loads(out)
+    report = gpilqg.diagnose("cartpole", data, criterion="simulation", window=20, horizons=[1], gp_points=50)
+    assert report["criterion"] == {"name": "simulation", "window": 20, "restarts": 0} == expected["criterion"]
+    assert report["ranking"] == expected["ranking"]
+    assert gpilqg.diagnose("cartpole", data, horizons=[1], gp_points=50)["criterion"]["name"] == "one-step"
+    with pytest.raises(gpilqg.InputError, match="--criterion simulation: expected --window N"):
+        gpilqg.diagnose("cartpole", data, criterion="simulation")
+    with pytest.raises(gpilqg.InputError, match="--window 20: windows belong to --criterion simulation"):
+        gpilqg.diagnose("cartpole", data, window=20)
+
+
 def test_diagnose_a_python_system_finds_its_missing_parameter(tmp_path, python_cartpole):
     # Data of the C++ cart-pole's real preset (pole 1.3 m); the Python cart-pole's sim preset has 1 m.
     status, _, err = cli("simulate", "--system", "cartpole", "--preset", "real", "--episodes", "6", "--steps", "150",

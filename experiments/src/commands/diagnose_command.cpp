@@ -1,5 +1,5 @@
 /// `gpilqg diagnose --system NAME --data FILE [--model F.toml] [--add EFFECT[=VALUE]]... [--json]
-/// [--out F.h5] [--plots DIR] [--horizons LIST]`: compare a model with measurements, see where it fails,
+/// [--out F.h5] [--plots DIR] [--horizons LIST] [--criterion one-step|simulation --window N]`: compare a model with measurements, see where it fails,
 /// learn which physical effect is missing, add it and watch the error fall (DESIGN.md sections 5, 6
 /// and 8).
 
@@ -46,6 +46,7 @@ struct DiagnoseOptions {
   std::string out;
   std::string plots;
   std::string write_model;
+  long window = 0;  ///< --window as given (request.window when the option is present)
 };
 
 /// Checks, before any work, that plots can be drawn (exit 2 with the missing packages otherwise).
@@ -63,6 +64,11 @@ std::string plugin_option(const std::string& system) {
   if (is_model_file_name(system)) return "";
   const std::string& origin = find_system(system)->origin;
   return origin == "built-in" ? "" : " --plugin " + origin;
+}
+
+/// " --criterion simulation --window N" when the request has them, so that the next call uses the same criterion.
+std::string criterion_options(const diagnosis::DiagnoseRequest& r) {
+  return r.window ? fmt::format(" --criterion {} --window {}", r.criterion, *r.window) : "";
 }
 
 int run_diagnose(const DiagnoseOptions& options_given) {
@@ -89,8 +95,8 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   if (!o.write_model.empty())
     diagnosis::write_model_file(o.write_model, report.model_next,
                                 {fmt::format("written by gpilqg diagnose from {} (verdict: {})", o.data, report.verdict.status),
-                                 fmt::format("next: gpilqg diagnose{} --system {} --data {} --model {}", plugin_option(r.system),
-                                             r.system, o.data, o.write_model)});
+                                 fmt::format("next: gpilqg diagnose{} --system {} --data {} --model {}{}", plugin_option(r.system),
+                                             r.system, o.data, o.write_model, criterion_options(r))});
   if (!o.plots.empty()) {
     // The script's own line goes to stdout; with --json, stdout holds the JSON document only.
     std::cout.flush();
@@ -118,8 +124,9 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   if (!o.plots.empty()) std::cout << "plots: " << o.plots << '\n';
   if (!o.write_model.empty()) std::cout << "model for the next round: " << o.write_model << '\n';
   if (report.verdict.effect && r.add.empty() && !r.auto_select)
-    std::cout << fmt::format("next: gpilqg diagnose{} --system {} --data {}{} --add {}\n", plugin_option(r.system),
+    std::cout << fmt::format("next: gpilqg diagnose{} --system {} --data {}{}{} --add {}\n", plugin_option(r.system),
                              r.system, o.data, r.model_file.empty() ? "" : " --model " + r.model_file,
+                             criterion_options(r),
                              report.verdict.effect->effect);
   return kExitSuccess;
 }
@@ -162,7 +169,17 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--seed", r.seed, "Seed of the GP subsample and restarts")
       ->capture_default_str()
       ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
-  cmd->callback([&action, o] { action = [o] { return run_diagnose(*o); }; });
+  cmd->add_option("--criterion", r.criterion,
+                  "Error the effects are fitted to and scored on: one-step, or simulation over --window samples from "
+                  "measured states (finds effects too small to see in one step, e.g. light damping)")
+      ->capture_default_str();
+  auto* window = cmd->add_option("--window", o->window,
+                                 "Samples per simulation window, with --criterion simulation (e.g. a few periods of the "
+                                 "slowest motion)");
+  cmd->callback([&action, o, window] {
+    if (window->count() > 0) o->request.window = o->window;
+    action = [o] { return run_diagnose(*o); };
+  });
 }
 
 }  // namespace gpilqg::cli

@@ -47,6 +47,17 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("--backend: ") + e.what());
   }
+  const auto criterion = parse_fit_criterion(o.criterion);
+  if (!criterion) throw InputError("--criterion '" + o.criterion + "': expected 'one-step' or 'simulation'");
+  if (*criterion == FitCriterion::Simulation && !o.window)
+    throw InputError("--criterion simulation: expected --window N, the samples per simulation window (e.g. a few "
+                     "periods of the slowest motion)");
+  if (*criterion == FitCriterion::OneStep && o.window)
+    throw InputError(fmt::format("--window {}: windows belong to --criterion simulation; the criterion is one-step", *o.window));
+  if (o.window && (*o.window < 1 || *o.window > limits::kMaxHorizon))
+    throw InputError(fmt::format("--window {}: expected a whole number of samples from 1 to {}", *o.window, limits::kMaxHorizon));
+  d.criterion = *criterion;
+  d.window = o.window ? static_cast<int>(*o.window) : 1;
   d.auto_select = o.auto_select;
   if (o.search == "subsets") d.search = SearchMethod::Subsets;
   else if (o.search == "forward") d.search = SearchMethod::Forward;

@@ -33,6 +33,8 @@ void DiagnosisOptions::validate() const {
   require(structure_threshold >= 0.0 && floor_tolerance >= 1.0, "'structure_threshold' >= 0, 'floor_tolerance' >= 1");
   require(min_explained >= 0.0 && min_step_explained >= 0.0 && min_z >= 0.0 && relative_to_gp >= 0.0,
           "thresholds must be >= 0");
+  require(window >= 1 && (criterion == FitCriterion::Simulation || window == 1),
+          "'window' must be >= 1, and 1 with the one-step criterion");
 }
 
 namespace {
@@ -112,18 +114,27 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   v.gp_left = 1.0 - r.gp_explained_total;
   v.reason = fmt::format("the best candidate '{}' removes {:.1f}% of the held-out residual (z = {:.1f}); the GP removes {:.1f}%",
                          f.effect, 100.0 * f.explained, f.z_score, 100.0 * r.gp_explained_total);
+  // The GP's share is of the one-step residual: comparable with the effects' under the one-step criterion only.
+  const bool simulation = o.criterion == FitCriterion::Simulation;
+  if (simulation)
+    v.reason += fmt::format(" of the one-step residual; the effects are scored on the simulation error over windows of {} "
+                            "samples, so the GP's share is not required", o.window);
   if (!large || !significant) {
     v.status = "unexplained";
     v.reason += ", not a significant reduction";
     return v;
   }
-  if (f.explained < o.relative_to_gp * r.gp_explained_total) {
+  if (!simulation && f.explained < o.relative_to_gp * r.gp_explained_total) {
     v.status = "unexplained";
     v.reason += ", so the residual's structure is mostly something else";
     return v;
   }
   v.effect = f;
   for (const auto& a : best.aliases) v.aliases.push_back(a.effect);
+  if (simulation) {
+    v.status = "explained";
+    return v;
+  }
   judge_remainder(v, o);
   return v;
 }
@@ -166,6 +177,10 @@ void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0
     if (is_new(e.effect)) v.effects.push_back(e.effect);
   v.reason = fmt::format("the {} effect(s) chosen by --auto ({}) remove {:.1f}% of the held-out residual; the GP removes {:.1f}%",
                          v.effects.size(), fmt::join(v.effects, ", "), 100.0 * (1.0 - left), 100.0 * (1.0 - v.gp_left));
+  if (o.criterion == FitCriterion::Simulation) {
+    v.reason += " of the one-step residual (the effects are scored on the simulation error)";
+    return;
+  }
   judge_remainder(v, o);
 }
 
@@ -221,7 +236,8 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
       to_fit.push_back(&effect);
       continue;
     }
-    const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual};
+    const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual},
+                                                 o.criterion, o.window);
     R.added.push_back(score_effect(effect, *request.values, context));
     R.model = R.model.with(effect, *request.values);
     residual = residual_of_model(R.model);
@@ -235,7 +251,8 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
       const bool kept = std::find(given.begin(), given.end(), r.effect->name) != given.end();
       if (!requested && !kept) refit.push_back(r);
     }
-    const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual};
+    const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual},
+                                                 o.criterion, o.window);
     const EffectFit joint = fit_jointly(*to_fit.front(), refit, context);
     R.model = R.model.with(*to_fit.front(), joint.estimate);
     for (const EffectValues& v : joint.refitted) R.model = R.model.with(named(candidates, v.effect), v.estimate);
@@ -311,7 +328,10 @@ DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
   R.gp_explained_total = weighted_heldout_explained(data, R.residual, R.gp.mean, R.weights);
 
   // 3. Which: one effect (the verdict), or several by forward selection (--auto).
-  const FitContext context{&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual};
+  R.criterion = o.criterion;
+  R.window = o.window;
+  const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual},
+                                               o.criterion, o.window, &R.window_restarts);
   const std::vector<RefitEffect> present = o.auto_select ? model_effects(R.model, candidates) : std::vector<RefitEffect>{};
   if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_gain, o.progress, present, o.gp.threads);
   // The GP sees (x_t, u_t) only: the residual of an effect of the input history (input_delay) looks

@@ -18,6 +18,7 @@
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
+#include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -26,6 +27,10 @@ std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integra
 }
 
 Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int* diverged) {
+  if (settings.window > 1)
+    return simulated_predictions(*make_step_model(model, settings.integrator, settings.dt, settings.substeps),
+                                 *settings.data, applied_controls(*settings.data, model.input_delay),
+                                 all_rows(*settings.data), settings.window, diverged);
   return one_step_predictions(*make_step_model(model, settings.integrator, settings.dt, settings.substeps), *settings.data,
                               diverged, model.input_delay);
 }
@@ -42,6 +47,15 @@ Vector weighted_residual(const StepModel& model, const Matrix& u, const FitConte
   const Vector sqrt_w = c.weights.cwiseSqrt();
   Vector out(static_cast<Eigen::Index>(rows.size()) * n);
   Vector next(n);
+  if (c.window > 1) {  // simulation over windows (simulation_error.hpp)
+    int restarts = 0;
+    const Matrix predicted = simulated_predictions(model, *c.data, u, rows, c.window, &restarts);
+    if (restarts > 0 && finite != nullptr) *finite = false;
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      out.segment(static_cast<Eigen::Index>(k) * n, n) = sqrt_w.cwiseProduct(
+          (c.data->x_next.row(rows[k]) - predicted.row(static_cast<Eigen::Index>(k))).transpose());
+    return out;
+  }
   const auto workspace = model.make_workspace();
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const int r = rows[k];
@@ -148,10 +162,13 @@ double nlopt_objective(unsigned p, const double* x, double* gradient, void* data
 
 /// The batch length of the significance test: context.batch when set, else ceil(sqrt(N)) of the N
 /// held-out rows (at least 10), the classical batch-means rule: batches grow with the record, so the
-/// serial correlation of a long record sampled fast (1 kHz) stays inside a batch.
+/// serial correlation of a long record sampled fast (1 kHz) stays inside a batch. Rounded up to whole
+/// windows of the simulation criterion.
 int heldout_batch_length(const FitContext& c, int rows) {
-  if (c.batch > 0) return c.batch;
-  return std::max(10, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(rows)))));
+  const int batch = c.batch > 0 ? c.batch : std::max(10, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(rows)))));
+  // Whole windows under the simulation criterion: the errors within a window are strongly correlated.
+  const int window = std::max(1, c.window);
+  return (batch + window - 1) / window * window;
 }
 
 /// Held-out scores of theta_hat against the model (step 4).

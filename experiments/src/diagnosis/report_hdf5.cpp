@@ -158,6 +158,9 @@ void write_where(Hdf5Writer& h5, const DiagnosisReport& r) {
 void write_ranking(Hdf5Writer& h5, const DiagnosisReport& r) {
   const int state = worst_state(r);
   h5.attribute("/ranking", "heldout_state", r.state_names[static_cast<std::size_t>(state)]);
+  h5.attribute("/ranking", "criterion", fit_criterion_name(r.criterion));
+  h5.attribute("/ranking", "window", static_cast<std::int64_t>(r.window));
+  h5.attribute("/ranking", "window_restarts", static_cast<std::int64_t>(r.window_restarts));
   if (r.ranking.empty()) return;
   std::vector<std::string> effect, parameter, unit, aliases;
   std::vector<double> estimate, low, high, explained, explained_ci, z, before, after;

@@ -225,6 +225,7 @@ nlohmann::json report_json(const DiagnosisReport& r) {
           {"sensitivity", sensitivity},
           {"where", where_json(r)},
           {"gp_explained", r.gp_explained_total},
+          {"criterion", {{"name", fit_criterion_name(r.criterion)}, {"window", r.window}, {"restarts", r.window_restarts}}},
           {"ranking", ranking},
           {"verdict", verdict},
           {"model", model_file_text(r.model)},

@@ -188,6 +188,10 @@ void which_section(const DiagnosisReport& r, std::string& out) {
   const int worst = worst_state(r);
   out += fmt::format("\n3. Which effect is missing (fitted on training episodes, scored on held-out episodes {})\n",
                      fmt::join(r.heldout_episode_ids, ", "));
+  if (r.criterion == FitCriterion::Simulation)
+    out += fmt::format("   criterion: simulation error over windows of {} samples ({:g} s) from measured states{}\n",
+                       r.window, r.window * r.dt,
+                       r.window_restarts > 0 ? fmt::format(", {} restarts after a diverged state", r.window_restarts) : "");
   // Columns as wide as the longest name and parameter text (a MuJoCo model's effects have long names).
   std::size_t name_width = 24, parameter_width = 40;
   for (const RankedEffect& g : r.ranking) {

@@ -4,6 +4,7 @@
 /// package fill the same request, so both have the same defaults and the same error messages.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,14 +26,19 @@ struct DiagnoseRequest {
   int gp_restarts = 1;
   std::string backend = "exact";
   std::uint64_t seed = 1;
+  /// --criterion: the error effects are fitted to and scored on, "one-step" or "simulation"
+  /// (simulation_error.hpp).
+  std::string criterion = "one-step";
+  /// --window: samples per simulation window; required with "simulation", not accepted with "one-step".
+  std::optional<long> window;
 };
 
 /// At most this many k-step horizons (each stores its windows' predictions in the report).
 inline constexpr std::size_t kMaxHorizonCount = 32;
 
 /// The diagnosis options of a request. Throws InputError naming the option (`--preset`, `--add`,
-/// `--search`, `--integrator`, `--heldout`, `--horizons`, `--gp-points`, `--gp-restarts`, `--backend`) or the model
-/// file.
+/// `--search`, `--integrator`, `--heldout`, `--horizons`, `--gp-points`, `--gp-restarts`, `--backend`,
+/// `--criterion`, `--window`) or the model file.
 DiagnosisOptions diagnosis_options(const DiagnoseRequest& request);
 
 }  // namespace gpilqg::diagnosis

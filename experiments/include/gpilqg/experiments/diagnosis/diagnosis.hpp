@@ -9,7 +9,8 @@
 ///  2. where (residual_analysis.hpp): residual per episode and in bins of every input, its
 ///     cross-correlation with the controls, and the GP's relevance of every input;
 ///  3. which (effect_fit.hpp): every effect of the library fitted on the training episodes and scored
-///     on the held-out episodes, grouped into aliases, and a verdict;
+///     on the held-out episodes, grouped into aliases, and a verdict; on the one-step error, or on the
+///     simulation error over windows (criterion, simulation_error.hpp);
 ///  4. add: before and after on the held-out episodes for sim, sim + effect, sim + GP and
 ///     sim + effect + GP, with the GP's learned signal variance;
 ///  5. the tests of system identification on the held-out episodes: the whiteness of the diagnosed
@@ -31,6 +32,12 @@
 ///    leaves is at most explained_left_ratio (1.5) times what the GP leaves, "partly_explained" if it
 ///    leaves more. A wrong effect can soak up much of the residual; it cannot match the GP. With
 ///    --auto the same rule judges the chosen set.
+///    Under the simulation criterion (simulation_error.hpp) the effects are scored on the simulation
+///    error over windows, the GP on the one-step residual: the two shares are of different errors, so
+///    neither the GP's share nor what the GP leaves is required there (they are still named in the
+///    reason). What guards against a wrong effect then is the held-out test itself: a wrong effect
+///    that soaks up a simulation error on the training episodes does not remove a significant share
+///    of it on the held-out ones.
 ///  - "unexplained" otherwise: the residual has structure no effect of the library accounts for.
 ///
 /// Before all of these: "model_diverges" when the model's prediction diverges (not finite, or a state
@@ -52,6 +59,7 @@
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/free_run.hpp"
 #include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
+#include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
 #include "gpilqg/experiments/diagnosis/whiteness.hpp"
 
@@ -80,7 +88,11 @@ struct DiagnosisOptions {
   double floor_tolerance = 1.05;          ///< held-out RMSE / noise floor above which a state is structured
   double min_explained = 0.1;             ///< "explained" needs at least this held-out fraction ...
   double min_z = 3.0;                     ///< ... this significance ...
-  double relative_to_gp = 0.5;            ///< ... and this share of what the GP explains ("partly_explained")
+  double relative_to_gp = 0.5;            ///< ... and this share of what the GP explains (one-step criterion)
+  /// The error effects are fitted to and scored on (simulation_error.hpp): one-step, or simulation
+  /// over windows of `window` samples from measured states (--criterion, --window).
+  FitCriterion criterion = FitCriterion::OneStep;
+  int window = 1;                         ///< samples per window; 1 with the one-step criterion
   bool rank = true;                       ///< false: skip the ranking (faster; verdict from the GP only)
   /// --auto: add several effects by forward selection with joint refits (effect_selection.hpp); the
   /// final model becomes model_next.
@@ -179,6 +191,14 @@ struct DiagnosisReport {
   bool consistent = false;
   double gp_explained_total = 0.0;       ///< weighted, held-out
   Vector weights;                        ///< n, 1 / noise floor^2
+  /// The criterion of the fits below (ranking, verdict, added, selection): one-step or simulation
+  /// over windows of `window` samples (simulation_error.hpp).
+  FitCriterion criterion = FitCriterion::OneStep;
+  int window = 1;
+  /// Simulation criterion: simulated states of the diagnosed model that diverged, each followed by a
+  /// restart from the measurement (0 for the one-step criterion, whose divergences are counted in
+  /// non_finite_predictions).
+  int window_restarts = 0;
   std::vector<RankedEffect> ranking;
   Verdict verdict;
   /// The "add" step (present when effects were added, or when a proposal exists): the four models.

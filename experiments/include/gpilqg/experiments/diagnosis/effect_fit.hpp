@@ -1,7 +1,9 @@
 #pragma once
 /// @file effect_fit.hpp
 /// Which physical effect is missing: fit every effect of the library to the one-step residuals of the
-/// training episodes and score it on the held-out episodes.
+/// training episodes and score it on the held-out episodes. Under the simulation criterion
+/// (FitContext::window > 1, simulation_error.hpp) phi(x_t, u_t; theta) below stands for the model
+/// simulated from the measured state at the start of t's window, and every step is otherwise the same.
 ///
 /// For an effect with parameters theta (current value theta_0 in the model) the predicted next state
 /// is phi(x_t, u_t; theta) (the model with the effect, integrated like the model). With per-state
@@ -51,18 +53,24 @@ struct FitContext {
   double dt = 0.02;
   int substeps = 1;
   Vector weights;                       ///< n, w_i = 1 / sigma_i^2
-  Matrix residual;                      ///< N x n, the model's one-step residual at every row
+  Matrix residual;                      ///< N x n, the model's residual at every row (under the criterion)
   /// Batch length of the held-out significance test; 0: ceil(sqrt(N)) of the N held-out rows, at
-  /// least 10 (24 on 600 held-out rows, 87 on 7,500).
+  /// least 10 (24 on 600 held-out rows, 87 on 7,500). criterion_context makes it at least a window.
   int batch = 0;
+  /// The criterion (simulation_error.hpp): 1 for the one-step error; W > 1 for the simulation error
+  /// over windows of W rows started from measured states. criterion_context sets it with the
+  /// residual and the batch.
+  int window = 1;
 };
 
 /// The model integrated as configured.
 std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integrator integrator, double dt, int substeps);
 
 /// One-step predictions of `model` on settings.data (one_step_predictions), integrated as
-/// `settings` says and driven by the measured inputs delayed by model.input_delay. Only the data,
-/// integrator, dt and substeps of `settings` are used.
+/// `settings` says and driven by the measured inputs delayed by model.input_delay; with
+/// settings.window > 1 the simulated predictions over windows (simulated_predictions,
+/// simulation_error.hpp), `diverged` then counting the restarts. Only the data, integrator, dt,
+/// substeps and window of `settings` are used.
 Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int* diverged = nullptr);
 
 /// sqrt(w_i) (x_{t+1,i} - phi_i(x_t, u_t)) of `model` stacked over `rows` (index k n + i), integrated

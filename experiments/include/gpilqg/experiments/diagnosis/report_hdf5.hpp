@@ -16,7 +16,8 @@
 ///   /where/cross_correlation/{lags (2L + 1), values (n x m x (2L + 1)), band (n x m)}
 ///   /ranking/{estimate, ci_low, ci_high, explained, explained_ci, z_score, heldout_rmse_before,
 ///             heldout_rmse_after (G)}  attrs: heldout_state, effect, parameter_name, unit, aliases (G strings,
-///             aliases comma-separated)
+///             aliases comma-separated), criterion ("one-step" or "simulation"), window (int samples per
+///             window, 1 for one-step), window_restarts (int, simulation_error.hpp)
 ///   /add/{heldout_rmse (4 x n, rows as attribute model), signal_variance (2 x n: sim+GP, sim+effect+GP),
 ///         residual_before, residual_after (N x n: "sim" and "sim+effect"), relevance_before (n x (n + m))}
 ///         attrs: effect, model (4 strings)       (present when the report has the four models)

@@ -1,0 +1,80 @@
+#include "gpilqg/experiments/diagnosis/simulation_error.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace gpilqg::diagnosis {
+
+std::optional<FitCriterion> parse_fit_criterion(std::string_view name) {
+  if (name == "one-step") return FitCriterion::OneStep;
+  if (name == "simulation") return FitCriterion::Simulation;
+  return std::nullopt;
+}
+
+std::string fit_criterion_name(FitCriterion criterion) {
+  return criterion == FitCriterion::Simulation ? "simulation" : "one-step";
+}
+
+std::vector<int> all_rows(const Transitions& data) {
+  std::vector<int> rows(static_cast<std::size_t>(data.size()));
+  for (int r = 0; r < data.size(); ++r) rows[static_cast<std::size_t>(r)] = r;
+  return rows;
+}
+
+Matrix simulated_predictions(const StepModel& model, const Transitions& data, const Matrix& u,
+                             const std::vector<int>& rows, int window, int* restarts) {
+  if (window < 1) throw std::invalid_argument("simulated_predictions: the window must be >= 1 row");
+  const int n = model.state_dim();
+  Matrix out(static_cast<Eigen::Index>(rows.size()), n);
+  Vector x(n), next(n);
+  const auto workspace = model.make_workspace();
+  int bad = 0;
+  int previous = -2, episode_start = 0;
+  bool restart_next = true;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const int r = rows[k];
+    const int episode = data.episode[static_cast<std::size_t>(r)];
+    const bool new_episode = r == 0 || data.episode[static_cast<std::size_t>(r - 1)] != episode;
+    if (new_episode) {
+      episode_start = r;
+    } else if (r != previous + 1) {
+      // A gap in the row set: find where r's episode starts, so that r's window is the same as over all rows.
+      episode_start = r;
+      while (episode_start > 0 && data.episode[static_cast<std::size_t>(episode_start - 1)] == episode) --episode_start;
+    }
+    // Start of a window: the measured state. Inside: the simulated one.
+    const bool window_start = (r - episode_start) % window == 0;
+    if (window_start || r != previous + 1 || restart_next) x = data.x.row(r).transpose();
+    restart_next = false;
+    model.step(x, u.row(r).transpose(), next, nullptr, *workspace);
+    if (prediction_diverged(next)) {
+      ++bad;
+      out.row(static_cast<Eigen::Index>(k)) = data.x.row(r);
+      restart_next = true;  // the next row starts from its measured state
+    } else {
+      out.row(static_cast<Eigen::Index>(k)) = next.transpose();
+      x = next;
+    }
+    previous = r;
+  }
+  if (restarts != nullptr) *restarts = bad;
+  return out;
+}
+
+FitContext criterion_context(FitContext context, FitCriterion criterion, int window, int* restarts) {
+  if (window < 1) throw std::invalid_argument("criterion_context: the window must be >= 1 row");
+  if (restarts != nullptr) *restarts = 0;
+  if (criterion == FitCriterion::OneStep) {
+    context.window = 1;
+    return context;
+  }
+  context.window = window;
+  // Held-out batches are whole windows (heldout_batch_length in effect_fit.cpp): the errors within a
+  // window are strongly correlated.
+  int bad = 0;
+  if (context.data != nullptr) context.residual = context.data->x_next - model_predictions(context.model, context, &bad);
+  if (restarts != nullptr) *restarts = bad;
+  return context;
+}
+
+}  // namespace gpilqg::diagnosis
