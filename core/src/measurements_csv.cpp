@@ -1,6 +1,9 @@
 /// CSV measurement files (DESIGN.md section 4): a strict reader that names the offending line of
 /// any bad input, and a writer whose numbers read back bit for bit.
 ///
+/// A header without the leading `episode` column is a file of one episode (id 0), so a continuous
+/// record needs no column of zeros.
+///
 /// Accepted beyond the plain contract, because they carry no meaning: "\r\n" line endings, a UTF-8
 /// byte-order mark before the header, a missing final newline, and blank lines at the very end of
 /// the file. Rejected: a blank line anywhere else (it usually marks files pasted together), and
@@ -81,7 +84,7 @@ class CsvReader {
                             ? "the header line '" + join(columns_, ",") + "'"
                             : std::string("a data row (blank lines are allowed only at the end of the file)"));
 
-    check_header(lines[0]);
+    episode_column_ = check_header(lines[0]);
     if (last == 1)
       throw DataError(file_, line_location(2), "no data rows after the header",
                       "one row per time step, at least 2 rows per episode");
@@ -98,9 +101,12 @@ class CsvReader {
   /// Compares the header with the expected columns in time linear in its width (hash sets), and
   /// names at most name_list::kMaxListedNames columns of each kind, so that a header of any width
   /// gives a short message.
-  void check_header(std::string_view line) const {
+  /// Returns whether the header has the `episode` column; without it the file is one episode, id 0
+  /// (a continuous record).
+  bool check_header(std::string_view line) const {
     const std::vector<std::string_view> found = split_fields(line);
-    if (std::equal(found.begin(), found.end(), columns_.begin(), columns_.end())) return;
+    if (std::equal(found.begin(), found.end(), columns_.begin(), columns_.end())) return true;
+    if (std::equal(found.begin(), found.end(), columns_.begin() + 1, columns_.end())) return false;
     const std::unordered_set<std::string_view> known(columns_.begin(), columns_.end());
     std::unordered_set<std::string_view> seen, reported;
     std::vector<std::string> unknown, repeated, missing;
@@ -159,12 +165,18 @@ class CsvReader {
 
   void read_row(std::string_view text, long line) {
     const std::vector<std::string_view> fields = split_fields(text);
-    if (fields.size() != columns_.size())
+    // Field j is column j + skipped of columns_ (skipped = 1 without the episode column).
+    const std::size_t skipped = episode_column_ ? 0 : 1;
+    if (fields.size() != columns_.size() - skipped) {
+      const std::vector<std::string> header(columns_.begin() + static_cast<std::ptrdiff_t>(skipped), columns_.end());
       throw DataError(file_, line_location(line), fmt::format("the row has {} fields", fields.size()),
-                      fmt::format("{} fields ({})", columns_.size(), join(columns_, ",")));
-    const long id = parse_episode(fields[0], line);
-    std::vector<double> values(fields.size() - 1);
-    for (std::size_t j = 1; j < fields.size(); ++j) values[j - 1] = parse_number(fields[j], columns_[j], line);
+                      fmt::format("{} fields ({})", header.size(), join(header, ",")));
+    }
+    const long id = episode_column_ ? parse_episode(fields[0], line) : 0;
+    const std::size_t first_value = episode_column_ ? 1 : 0;
+    std::vector<double> values(fields.size() - first_value);
+    for (std::size_t j = first_value; j < fields.size(); ++j)
+      values[j - first_value] = parse_number(fields[j], columns_[j + skipped], line);
 
     if (!started_ || id != current_id_) start_episode(id, line);
     const double t = values[0];
@@ -218,6 +230,7 @@ class CsvReader {
   const std::vector<std::string> columns_;
   const std::size_t n_, m_;
 
+  bool episode_column_ = true;  // false: the header has no `episode` column, every row is episode 0
   std::vector<Episode> episodes_;
   std::map<long, long> first_lines_;  // episode id -> line of its first row
   bool started_ = false;

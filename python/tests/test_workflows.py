@@ -179,6 +179,21 @@ def test_diagnose_equals_the_command_lines_json():
         gpilqg.diagnose("cartpole", data, heldout=1.5)
 
 
+def test_diagnose_a_single_episode_record_holds_out_blocks(tmp_path):
+    # One continuous record: cut into 10 blocks, 3 held out, a gap of the longest horizon around each.
+    data = tmp_path / "record.csv"
+    status, _, err = cli("simulate", "--system", "cartpole", "--preset", "sim", "--effect", "cart_coulomb_friction=1.5",
+                         "--episodes", "1", "--steps", "600", "--out", data)
+    assert status == 0, err
+    report = gpilqg.diagnose("cartpole", data, horizons=[1, 10], gp_points=100, gp_restarts=0)
+    blocks = report["heldout_blocks"]
+    assert (blocks["count"], blocks["gap"], blocks["heldout"]) == (10, 10, [3, 6, 9])
+    assert report["heldout_episodes"] == [3, 6, 9]
+    assert report["verdict"]["effect"] == "cart_coulomb_friction"
+    with pytest.raises(gpilqg.InputError, match="expected at least 1020 samples"):
+        gpilqg.diagnose("cartpole", data)
+
+
 def test_diagnose_auto_equals_the_command_lines_selection(tmp_path):
     data = tmp_path / "two.csv"
     status, _, err = cli("simulate", "--system", "cartpole", "--preset", "sim", "--effect", "cart_coulomb_friction=1.5",

@@ -104,6 +104,29 @@ TEST(MeasurementsCsv, AcceptsCrlfByteOrderMarkMissingFinalNewlineAndTrailingBlan
   }
 }
 
+// A continuous record needs no column of zeros: without `episode` the rows are one episode, id 0,
+// and a short row names the columns of that header.
+TEST(MeasurementsCsv, HeaderWithoutEpisodeColumnIsOneEpisode) {
+  const auto dir = test::temporary_dir("measurements");
+  const MeasurementSet set = read_measurements(
+      write_text(dir / "record.csv", "t,x,x_dot,theta,theta_dot,force\n0,1,2,3,4,5\n0.5,1.5,2,3,4,6\n1,2,2,3,4,7\n"),
+      cartpole());
+  ASSERT_EQ(set.episodes.size(), 1u);
+  EXPECT_EQ(set.episodes[0].id, 0);
+  EXPECT_EQ(set.episodes[0].length(), 3);
+  EXPECT_DOUBLE_EQ(set.episodes[0].dt(), 0.5);
+  EXPECT_EQ(set.episodes[0].x(1, 0), 1.5);
+  EXPECT_EQ(set.episodes[0].u(2, 0), 7.0);
+  try {
+    read_measurements(write_text(dir / "short_row.csv", "t,x,x_dot,theta,theta_dot,force\n0,1,2,3,4,5\n0.5,1,2,3,4\n"),
+                      cartpole());
+    FAIL() << "a short row was accepted";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 3: the row has 5 fields; expected 6 fields (t,x,x_dot,theta,theta_dot,force)"),
+              std::string::npos) << e.what();
+  }
+}
+
 TEST(MeasurementsCsv, AcceptsDtWithinRelativeToleranceAndRejectsBeyond) {
   const auto dir = test::temporary_dir("measurements");
   // Times written with few digits: steps 0.0333 and 0.03330001 differ by 3e-7 relative (accepted);

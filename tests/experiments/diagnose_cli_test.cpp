@@ -63,6 +63,7 @@ TEST(DiagnoseCli, JsonHasTheFixedKeysAndNamesTheHiddenEffect) {
   EXPECT_EQ(j["verdict"]["effect"], "cart_coulomb_friction");
   EXPECT_NEAR(j["verdict"]["parameters"]["mu"].get<double>(), 1.2, 0.18);
   EXPECT_EQ(j["relevance"]["x_dot"].size(), 5u);
+  EXPECT_TRUE(j["heldout_blocks"].is_null());  // several episodes are held out whole, never cut into blocks
   EXPECT_TRUE(has_no_nan(j));
 }
 
@@ -193,6 +194,7 @@ TEST(DiagnoseCli, HorizonsAndTheTestsOfSystemIdentificationAreInEveryReport) {
     for (const char* name : {"/compare/k_5/fit_percent", "/compare/k_20/rmse", "/whiteness/autocorrelation",
                              "/whiteness/white", "/free_run/0/measured", "/free_run/0/predicted/sim+GP", "/free_run/0/fit_percent"})
       EXPECT_TRUE(h5.nameExists(name)) << name;
+    EXPECT_FALSE(h5.nameExists("/heldout_blocks"));
   }
   // The text has a section for each.
   const auto text = test::run_cli(base + " --horizons 2");

@@ -154,7 +154,7 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--plots", o->plots, "Write PNG plots into this folder (needs matplotlib and h5py)");
   cmd->add_option("--write-model", o->write_model, "Write the improved model (TOML) for the next diagnosis");
   cmd->add_option("--integrator", r.integrator, "rk4 or euler")->capture_default_str();
-  cmd->add_option("--heldout", r.heldout, "Fraction of the episodes held out")->capture_default_str();
+  cmd->add_option("--heldout", r.heldout, "Fraction of the episodes held out (of the 10 blocks for a single-episode record)")->capture_default_str();
   cmd->add_option("--horizons", r.horizons, "Horizons k of the k-step predictions, comma-separated (e.g. 1,5,20)")
       ->capture_default_str()
       ->delimiter(',')

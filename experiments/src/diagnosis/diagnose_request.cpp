@@ -27,7 +27,7 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   if (!integrator) throw InputError("--integrator '" + o.integrator + "': expected 'rk4' or 'euler'");
   d.integrator = *integrator;
   if (!(o.heldout > 0.0 && o.heldout < 1.0))
-    throw InputError(fmt::format("--heldout {}: expected a fraction of the episodes in (0, 1)", o.heldout));
+    throw InputError(fmt::format("--heldout {}: expected a fraction of the episodes (or blocks) in (0, 1)", o.heldout));
   const std::string horizons = fmt::format("{}", fmt::join(o.horizons, ","));
   if (o.horizons.empty()) throw InputError("--horizons: expected at least one horizon k >= 1");
   if (o.horizons.size() > kMaxHorizonCount)

@@ -186,21 +186,28 @@ void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0
 
 }  // namespace
 
-DiagnosisReport diagnose(const MeasurementSet& set, const DiagnosisOptions& o) {
+DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o) {
   o.validate();
-  if (set.episodes.empty()) throw std::invalid_argument("the data has no episodes");
-  check_measurement_range(set);
+  if (input.episodes.empty()) throw std::invalid_argument("the data has no episodes");
+  check_measurement_range(input);
   DiagnosisReport R;
   R.system = o.model.system;
   // A model file's data carry the model's name (<mujoco model="...">), not the file's path.
-  if (const std::string model_name = system_signature(R.system).name; set.system.name != model_name)
-    throw std::invalid_argument("the data are of system '" + set.system.name + "'; the model is '" + model_name + "'");
+  if (const std::string model_name = system_signature(R.system).name; input.system.name != model_name)
+    throw std::invalid_argument("the data are of system '" + input.system.name + "'; the model is '" + model_name + "'");
+  // One continuous record: its blocks become the episodes of every step below (heldout_blocks.hpp).
+  MeasurementSet blocks_as_episodes;
+  if (input.episodes.size() == 1) {
+    R.blocks = split_heldout_blocks(input.episodes.front(), o.heldout_fraction, heldout_block_gap(o.horizons, o.window));
+    blocks_as_episodes = block_episodes(input, *R.blocks);
+  }
+  const MeasurementSet& set = R.blocks ? blocks_as_episodes : input;
   R.state_names = names_of(set.system.states);
   R.control_names = names_of(set.system.controls);
   R.input_names = R.state_names;
   R.input_names.insert(R.input_names.end(), R.control_names.begin(), R.control_names.end());
-  R.dt = set.episodes.front().dt();
-  R.heldout_episode_index = heldout_episodes(set, o.heldout_fraction);
+  R.dt = input.episodes.front().dt();
+  R.heldout_episode_index = R.blocks ? R.blocks->heldout() : heldout_episodes(set, o.heldout_fraction);
   for (int i : R.heldout_episode_index) R.heldout_episode_ids.push_back(set.episodes[static_cast<std::size_t>(i)].id);
   R.data = make_transitions(set, R.heldout_episode_index, R.dt);
   R.samples = R.data.size();

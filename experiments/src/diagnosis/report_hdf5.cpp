@@ -109,6 +109,33 @@ void write_whiteness(Hdf5Writer& h5, const DiagnosisReport& r) {
   h5.attribute("/whiteness", "critical_value", w.critical_value);
 }
 
+/// A single record's blocks (heldout_blocks.hpp), sample ranges inclusive.
+void write_blocks(Hdf5Writer& h5, const DiagnosisReport& r) {
+  if (!r.blocks) return;
+  std::vector<int> first, last, used_first, used_last, heldout;
+  std::vector<double> t_start, t_end;
+  for (const HeldoutBlock& b : r.blocks->blocks) {
+    first.push_back(b.first);
+    last.push_back(b.end - 1);
+    used_first.push_back(b.used_first);
+    used_last.push_back(b.used_end - 1);
+    heldout.push_back(b.heldout ? 1 : 0);
+    t_start.push_back(b.t_start);
+    t_end.push_back(b.t_end);
+  }
+  h5.write_vector("/heldout_blocks/first", first);
+  h5.write_vector("/heldout_blocks/last", last);
+  h5.write_vector("/heldout_blocks/used_first", used_first);
+  h5.write_vector("/heldout_blocks/used_last", used_last);
+  h5.write_vector("/heldout_blocks/heldout", heldout);
+  h5.write_vector("/heldout_blocks/t_start", t_start);
+  h5.write_vector("/heldout_blocks/t_end", t_end);
+  h5.attribute("/heldout_blocks", "episode", static_cast<std::int64_t>(r.blocks->episode_id));
+  h5.attribute("/heldout_blocks", "samples", static_cast<std::int64_t>(r.blocks->samples));
+  h5.attribute("/heldout_blocks", "gap", static_cast<std::int64_t>(r.blocks->gap));
+  h5.attribute("/heldout_blocks", "gap_time", r.blocks->gap * r.blocks->dt);
+}
+
 void write_free_run(Hdf5Writer& h5, const DiagnosisReport& r) {
   if (r.free_run.empty()) return;
   std::vector<std::string> models;
@@ -289,6 +316,7 @@ void write_report_hdf5(const std::filesystem::path& file, const DiagnosisReport&
     write_selection(h5, r);
     write_whiteness(h5, r);
     write_free_run(h5, r);
+    write_blocks(h5, r);
     h5.close();
   });
 }

@@ -212,10 +212,34 @@ nlohmann::json report_json(const DiagnosisReport& r) {
                  {"model", model_file_text(r.selection->model)}};
   }
   json heldout_ids = r.heldout_episode_ids;
+  json blocks = nullptr;
+  if (r.blocks) {
+    json list = json::array();
+    for (std::size_t k = 0; k < r.blocks->blocks.size(); ++k) {
+      const HeldoutBlock& b = r.blocks->blocks[k];
+      list.push_back({{"block", k},
+                      {"heldout", b.heldout},
+                      {"first", b.first},
+                      {"last", b.end - 1},
+                      {"t_start", b.t_start},
+                      {"t_end", b.t_end},
+                      {"used_first", b.used_first},
+                      {"used_last", b.used_end - 1},
+                      {"dropped", b.samples() - b.used_samples()}});
+    }
+    blocks = {{"episode", r.blocks->episode_id},
+              {"samples", r.blocks->samples},
+              {"count", r.blocks->blocks.size()},
+              {"heldout", r.blocks->heldout()},
+              {"gap", r.blocks->gap},
+              {"gap_time", r.blocks->gap * r.blocks->dt},
+              {"blocks", list}};
+  }
   return {{"system", r.system},
           {"samples", r.samples},
           {"dt", r.dt},
           {"heldout_episodes", heldout_ids},
+          {"heldout_blocks", blocks},
           {"consistent", r.consistent},
           {"states", states},
           {"k_step", k_step},

@@ -87,13 +87,33 @@ std::string state_header(const DiagnosisReport& r) {
   return out + (r.state_names.size() > kStateColumns ? "  ..." : "");
 }
 
+/// What the held-out units are: blocks of one record, or episodes.
+const char* unit_name(const DiagnosisReport& r) { return r.blocks ? "block" : "episode"; }
+
+/// A single record's blocks (heldout_blocks.hpp): which are held out, and the gap.
+void blocks_section(const DiagnosisReport& r, std::string& out) {
+  const HeldoutBlocks& b = *r.blocks;
+  out += fmt::format("data: one record (episode {}, {} samples, dt = {} s) cut into {} blocks, held-out blocks {}; "
+                     "{} transitions used\n",
+                     b.episode_id, b.samples, r.dt, b.blocks.size(), fmt::join(r.heldout_episode_ids, ", "), r.samples);
+  out += fmt::format("   gap: the {} training samples ({:.4g} s) on either side of every held-out block are dropped, the "
+                     "longest k-step window\n", b.gap, b.gap * b.dt);
+  out += fmt::format("   {:<6} {:<9} {:>17} {:>25} {:>17}\n", "block", "role", "samples", "t [s]", "samples used");
+  for (std::size_t k = 0; k < b.blocks.size(); ++k) {
+    const HeldoutBlock& h = b.blocks[k];
+    out += fmt::format("   {:<6} {:<9} {:>17} {:>25} {:>17}\n", k, h.heldout ? "held out" : "training",
+                       fmt::format("{}..{}", h.first, h.end - 1), fmt::format("{:.6g}..{:.6g}", h.t_start, h.t_end),
+                       fmt::format("{}..{}", h.used_first, h.used_end - 1));
+  }
+}
+
 void whiteness_section(const DiagnosisReport& r, std::string& out) {
   const Whiteness& w = r.whiteness;
   if (w.states.empty()) return;
-  out += fmt::format("\nWhiteness of the held-out residual (one-step, autocorrelation within episodes, lags 1..{}, N = {})\n",
-                     w.max_lag, w.samples);
+  out += fmt::format("\nWhiteness of the held-out residual (one-step, autocorrelation within {}s, lags 1..{}, N = {})\n",
+                     unit_name(r), w.max_lag, w.samples);
   if (w.degrees_of_freedom == 0) {
-    out += "   no lag has a pair of samples within an episode: nothing to test\n";
+    out += fmt::format("   no lag has a pair of samples within one {}: nothing to test\n", unit_name(r));
     return;
   }
   out += fmt::format("   95% band +-{:.3f}; white when the Ljung-Box Q <= chi2_{:.2f}({}) = {:.2f} (p >= {:g})\n", w.band,
@@ -118,9 +138,9 @@ void whiteness_section(const DiagnosisReport& r, std::string& out) {
 
 void free_run_section(const DiagnosisReport& r, std::string& out) {
   if (r.free_run.empty()) return;
-  out += "\nFree-run fit (k = inf) per held-out episode: simulated from the measured x[0] with the measured controls, "
-         "fit % per state\n";
-  out += fmt::format("   {:<8} {:<11}{}\n", "episode", "model", state_header(r));
+  out += fmt::format("\nFree-run fit (k = inf) per held-out {}: simulated from the measured x[0] with the measured controls, "
+                     "fit % per state\n", unit_name(r));
+  out += fmt::format("   {:<8} {:<11}{}\n", unit_name(r), "model", state_header(r));
   for (const FreeRunEpisode& e : r.free_run) {
     bool first = true;
     for (const FreeRunTrajectory& m : e.models) {
@@ -176,7 +196,7 @@ void where_section(const DiagnosisReport& r, std::string& out) {
     }
   }
   const int worst = worst_state(r);
-  out += fmt::format("   {} residual RMSE per episode:", r.state_names[static_cast<std::size_t>(worst)]);
+  out += fmt::format("   {} residual RMSE per {}:", r.state_names[static_cast<std::size_t>(worst)], unit_name(r));
   for (Eigen::Index e = 0; e < r.episode_rms.rows(); ++e) out += fmt::format(" {:.2e}", r.episode_rms(e, worst));
   out += "\n";
 }
@@ -186,7 +206,7 @@ void which_section(const DiagnosisReport& r, std::string& out) {
     out += "\n3. Which effect is missing: not ranked, the model diverges on the data\n";
   if (r.ranking.empty()) return;
   const int worst = worst_state(r);
-  out += fmt::format("\n3. Which effect is missing (fitted on training episodes, scored on held-out episodes {})\n",
+  out += fmt::format("\n3. Which effect is missing (fitted on training {0}s, scored on held-out {0}s {1})\n", unit_name(r),
                      fmt::join(r.heldout_episode_ids, ", "));
   if (r.criterion == FitCriterion::Simulation)
     out += fmt::format("   criterion: simulation error over windows of {} samples ({:g} s) from measured states{}\n",
@@ -242,9 +262,9 @@ void selection_section(const DiagnosisReport& r, std::string& out) {
 
 void add_section(const DiagnosisReport& r, std::string& out) {
   if (r.comparison.empty()) return;
-  out += fmt::format("\n4. {} on the held-out episodes (effect = {})\n",
+  out += fmt::format("\n4. {} on the held-out {}s (effect = {})\n",
                      r.added.empty() && !r.selection ? "What adding it would do" : "Add it and watch the error fall",
-                     r.comparison_effect);
+                     unit_name(r), r.comparison_effect);
   for (const EffectFit& f : r.added) out += fmt::format("   added {}: {}\n", f.effect, parameter_text(f, true));
   for (const EffectValues& v : r.refitted) out += fmt::format("   refitted with them {}: {}\n", v.effect, parameter_text(v));
   std::vector<int> shown;
@@ -270,8 +290,11 @@ void add_section(const DiagnosisReport& r, std::string& out) {
 std::string report_text(const DiagnosisReport& r) {
   std::string out = fmt::format("gpilqg diagnose: {}\n", model_text(r.model));
   if (!r.added.empty()) out += fmt::format("  (started from {})\n", model_text(r.model_before));
-  out += fmt::format("data: {} transitions, dt = {} s, held-out episodes {}\n", r.samples, r.dt,
-                     fmt::join(r.heldout_episode_ids, ", "));
+  if (r.blocks)
+    blocks_section(r, out);
+  else
+    out += fmt::format("data: {} transitions, dt = {} s, held-out episodes {}\n", r.samples, r.dt,
+                       fmt::join(r.heldout_episode_ids, ", "));
   compare_section(r, out);
   whiteness_section(r, out);
   where_section(r, out);

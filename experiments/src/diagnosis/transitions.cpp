@@ -4,6 +4,7 @@
 
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/input_delay.hpp"
+#include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -24,14 +25,7 @@ std::vector<int> heldout_episodes(const MeasurementSet& set, double fraction) {
   if (count < 2)
     throw std::invalid_argument("the data has " + std::to_string(count) +
                                 " episode(s); expected at least 2, since the diagnosis holds whole episodes out");
-  if (!(fraction > 0.0 && fraction < 1.0))
-    throw std::invalid_argument("held-out fraction " + std::to_string(fraction) + "; expected a value in (0, 1)");
-  const int wanted = std::clamp(static_cast<int>(std::lround(count * fraction)), 1, count - 1);
-  // Spread evenly: episode i is held out when floor((i + 1) w / E) > floor(i w / E).
-  std::vector<int> out;
-  for (int i = 0; i < count; ++i)
-    if (((i + 1) * wanted) / count > (i * wanted) / count) out.push_back(i);
-  return out;
+  return heldout_indices(count, fraction);
 }
 
 Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& heldout, double dt) {

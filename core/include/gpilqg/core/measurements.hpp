@@ -5,6 +5,8 @@
 ///
 /// CSV: header `episode,t,<state names>,<control names>`, one row per time step. A row holds the
 /// state measured at time t and the control applied from t until the next row of the same episode.
+/// A file of one episode may leave the `episode` column out (header `t,<states>,<controls>`): its
+/// rows are episode 0.
 /// HDF5: /episodes/<k>/t (T), /episodes/<k>/x (T x n), /episodes/<k>/u (T x m), root attributes
 /// `system`, `state_names`, `control_names`.
 

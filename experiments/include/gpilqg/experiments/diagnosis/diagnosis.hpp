@@ -58,6 +58,7 @@
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/free_run.hpp"
+#include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
 #include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
@@ -168,7 +169,10 @@ struct DiagnosisReport {
   ModelSpec model_next;                  ///< what the next diagnosis should start from
   std::vector<std::string> state_names, control_names, input_names;
   double dt = 0.0;
-  long samples = 0;                      ///< transitions
+  long samples = 0;                      ///< transitions (of the blocks' kept samples for a single record)
+  /// A single-episode record: its blocks (heldout_blocks.hpp). Every "episode" below, its ids and
+  /// indices, is then a block: block b is episode b, id b.
+  std::optional<HeldoutBlocks> blocks;
   std::vector<long> heldout_episode_ids;
   std::vector<int> heldout_episode_index;
   Transitions data;
@@ -214,8 +218,11 @@ struct DiagnosisReport {
   std::vector<FreeRunEpisode> free_run;
 };
 
-/// Runs the diagnosis. Throws std::invalid_argument for bad options or data that do not fit the model
-/// (too few episodes, dt varying between episodes, a value beyond 1e12: check_measurement_range).
+/// Runs the diagnosis. Data of several episodes hold whole episodes out (heldout_episodes); a single
+/// episode is cut into blocks with gaps (heldout_blocks.hpp: split_heldout_blocks with the gap
+/// heldout_block_gap(horizons)) and each block is an episode from then on. Throws std::invalid_argument
+/// for bad options or data that do not fit the model (no episode, a single record too short for its
+/// blocks, dt varying between episodes, a value beyond 1e12: check_measurement_range).
 DiagnosisReport diagnose(const MeasurementSet& data, const DiagnosisOptions& options);
 
 }  // namespace gpilqg::diagnosis

@@ -29,6 +29,12 @@
 ///                  predicted/<model> ((steps + 1) x n: x_0 and the predictions before any divergence)}
 ///         attrs: id (the episode's id), index (in the file); j = 0, 1, ... the held-out episodes in order
 ///   /free_run attrs: models (M strings: "sim", ["sim+effect",] "sim+GP"; the rows of fit_percent)
+///   /heldout_blocks/{first, last, used_first, used_last (B, int: samples of the record, inclusive),
+///                    heldout (B, int), t_start, t_end (B: times of first and last)}
+///         attrs: episode (the record's id), samples, gap (samples), gap_time (s). Present for a
+///         single-episode record only (heldout_blocks.hpp); every episode above is then a block:
+///         episode index and id b are block b, times are the record's, and a k-step window's start
+///         counts from its block's used_first.
 ///
 /// Integer-valued datasets (marked int) hold whole numbers stored as float64, like every dataset here.
 

@@ -5,7 +5,8 @@
 /// windows restarted from measured states.
 ///
 /// Held-out data are whole episodes, never single samples: consecutive samples of one episode are
-/// strongly correlated, so a sample split would leak the held-out data into the fit.
+/// strongly correlated, so a sample split would leak the held-out data into the fit. A file of a single
+/// episode is cut into blocks first (heldout_blocks.hpp), and the blocks are the episodes here.
 
 #include <vector>
 
@@ -29,8 +30,8 @@ struct Transitions {
 
 /// The held-out episodes (indices into MeasurementSet::episodes): every episode whose position i
 /// satisfies (i + 1) * fraction crossing an integer, i.e. round(E * fraction) episodes spread evenly
-/// over the file, at least one and at least one left for training. Throws std::invalid_argument when
-/// the set has fewer than 2 episodes or fraction is outside (0, 1).
+/// over the file, at least one and at least one left for training (heldout_indices, heldout_blocks.hpp).
+/// Throws std::invalid_argument when the set has fewer than 2 episodes or fraction is outside (0, 1).
 std::vector<int> heldout_episodes(const MeasurementSet& set, double fraction);
 
 /// The transitions of `set`, with held-out rows marked. Throws std::invalid_argument when an episode's
