@@ -78,7 +78,8 @@ std::vector<Tag> tags(const std::string& text, const std::string& path) {
       while (p < text.size() && !is_space(text[p]) && text[p] != '=' && text[p] != '>' && text[p] != '/') ++p;
       const std::string key = text.substr(key_start, p - key_start);
       while (p < text.size() && is_space(text[p])) ++p;
-      if (key.empty() || p >= text.size() || text[p] != '=') fail(p, fmt::format("a malformed attribute in <{}>", tag.name));
+      if (key.empty() || p >= text.size() || text[p] != '=')
+        fail(p, fmt::format("a malformed attribute in <{}>", tag.name));
       ++p;
       while (p < text.size() && is_space(text[p])) ++p;
       if (p >= text.size() || (text[p] != '"' && text[p] != '\''))
@@ -95,12 +96,6 @@ std::vector<Tag> tags(const std::string& text, const std::string& path) {
   return out;
 }
 
-std::string root_name(const std::vector<Tag>& tags) {
-  for (const Tag& t : tags)
-    if (!t.closing) return t.name;
-  return "";
-}
-
 bool actuated_type(const std::string& type) {
   return type == "revolute" || type == "continuous" || type == "prismatic";
 }
@@ -108,11 +103,20 @@ bool actuated_type(const std::string& type) {
 }  // namespace
 
 bool is_urdf(const std::string& text) {
-  try {
-    return root_name(tags(text, "")) == "robot";
-  } catch (const std::invalid_argument&) {
-    return false;  // MuJoCo's own parser reports malformed XML
+  // The first element after the prolog (declaration, comments, processing instructions, DOCTYPE).
+  std::size_t i = 0;
+  while ((i = text.find('<', i)) != std::string::npos) {
+    const char* end = text.compare(i, 4, "<!--") == 0 ? "-->" : text.compare(i, 2, "<?") == 0 ? "?>"
+                      : text.compare(i, 2, "<!") == 0 ? ">" : nullptr;
+    if (end == nullptr) break;
+    const std::size_t e = text.find(end, i);
+    if (e == std::string::npos) return false;  // MuJoCo's own parser reports malformed XML
+    i = e + std::char_traits<char>::length(end);
   }
+  if (i == std::string::npos) return false;
+  std::size_t p = i + 1;
+  while (p < text.size() && !is_space(text[p]) && text[p] != '>' && text[p] != '/') ++p;
+  return text.compare(i + 1, p - i - 1, "robot") == 0 && p - i - 1 == 5;
 }
 
 std::vector<Joint> read_joints(const std::string& text, const std::string& path) {
@@ -171,8 +175,9 @@ std::string actuator_section(const std::vector<Joint>& joints, const std::vector
     const std::string motor = name + "_motor";
     for (const std::string& other : model_joints)
       if (other == motor)
-        throw std::invalid_argument(fmt::format(
-            "{}: joint '{}' would get the motor '{}', the name of another joint; rename one of them", path, name, motor));
+        throw std::invalid_argument(
+            fmt::format("{}: joint '{}' would get the motor '{}', the name of another joint; rename one of them", path,
+                        name, motor));
     std::string escaped;
     for (const char c : name) {
       if (c == '"') escaped += "&quot;";
@@ -185,7 +190,8 @@ std::string actuator_section(const std::vector<Joint>& joints, const std::vector
                             "ctrlrange=\"{1:.17g} {2:.17g}\"/>\n",
                             escaped, -*joint->effort, *joint->effort);
     else
-      motors += fmt::format("    <motor name=\"{0}_motor\" joint=\"{0}\" gear=\"1\" ctrllimited=\"false\"/>\n", escaped);
+      motors +=
+          fmt::format("    <motor name=\"{0}_motor\" joint=\"{0}\" gear=\"1\" ctrllimited=\"false\"/>\n", escaped);
   }
   return motors.empty() ? "" : "  <actuator>\n" + motors + "  </actuator>\n";
 }
