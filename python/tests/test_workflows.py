@@ -219,3 +219,27 @@ def test_diagnose_reports_progress_and_ctrl_c_stops_it_between_effects():
         gpilqg.diagnose("cartpole", data, progress=progress)
     assert lines[0] == "residual GP of the model fitted"
     assert lines[-1].startswith("effect 3/"), lines
+
+
+def test_diagnose_a_passive_pendulum_equals_the_command_line(tmp_path):
+    # Free swings of the pendulum without actuators with a hidden joint damping: Python's diagnose gives the
+    # command line's verdict, and it names the damping; solve refuses the passive system.
+    pendulum = SOURCE_DIR / "data" / "pendulum_passive.xml"
+    data = tmp_path / "swing.csv"
+    status, _, err = cli("simulate", "--system", pendulum, "--param", "swing.damping=0.3", "--episodes", "6",
+                         "--steps", "150", "--seed", "2", "--out", data)
+    assert status == 0, err
+    status, out, err = cli("diagnose", "--system", pendulum, "--data", data, "--gp-points", "100", "--json")
+    assert status == 0, err
+    expected = json.loads(out)
+    report = gpilqg.diagnose(str(pendulum), data, gp_points=100)
+    assert report["verdict"] == expected["verdict"]
+    assert report["verdict"]["status"] == "explained"
+    assert {report["verdict"]["effect"], *report["verdict"]["aliases"]} & {"param:swing.damping",
+                                                                          "joint_viscous_damping:swing"}
+    assert all(not e["effect"].startswith(("input_delay", "actuator_gain")) for e in report["ranking"])
+    config = tmp_path / "solve.toml"
+    config.write_text('[system]\nname = "%s"\ndt = 0.02\n[problem]\nhorizon = 10\nx0 = [0, 0]\ngoal = [0, 0]\n'
+                      'Q = [1, 1]\nR = []\nQf = [1, 1]\n' % pendulum)
+    with pytest.raises(gpilqg.InputError, match="no controls to optimise"):
+        gpilqg.solve(config)
