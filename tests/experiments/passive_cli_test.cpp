@@ -130,6 +130,38 @@ TEST(PassiveCli, SolvePlanRolloutAndRunRefuseAPassiveSystem) {
   EXPECT_FALSE(fs::exists(dir / "run.h5"));
 }
 
+TEST(PassiveCli, APluginSystemWithoutControlsIsSimulatedDiagnosedAndRefusedBySolve) {
+  // tests/plugins/passive_plugin.cpp: a pendulum without controls, damping 0 (sim) and 0.2 (real); its
+  // entry lists actuator_gain and input_delay, which the registry drops.
+  const fs::path dir = test::temporary_dir("passive_plugin");
+  const std::string plugin = " --plugin " + quote(fs::path(GPILQG_TEST_PLUGIN_DIR) / "libpassive_plugin.so");
+  const fs::path data = dir / "swing.csv";
+  const auto sim = test::run_cli("simulate --system passive_pendulum --preset real --episodes 6 --steps 150 --out " +
+                                 quote(data) + plugin);
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  std::ifstream in(data);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "episode,t,theta,theta_dot");
+  const auto r = test::run_cli("diagnose --system passive_pendulum --data " + quote(data) + " --json --gp-points 100" +
+                               plugin);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  ASSERT_EQ(j["verdict"]["status"], "explained") << j["verdict"].dump();
+  const std::string effect = j["verdict"]["effect"].get<std::string>();
+  EXPECT_TRUE(effect == "param:damping" || effect == "joint_viscous_damping:theta") << j["verdict"].dump();
+  EXPECT_NEAR(j["verdict"]["parameters"].begin()->get<double>(), 0.2, 0.02) << j["verdict"].dump();
+  for (const auto& entry : j["ranking"]) {
+    const std::string name = entry["effect"].get<std::string>();
+    EXPECT_TRUE(name != "input_delay" && name != "actuator_gain") << name;
+  }
+  std::ofstream(dir / "solve.toml") << "[system]\nname = \"passive_pendulum\"\ndt = 0.02\n[problem]\nhorizon = 10\n"
+                                       "x0 = [0, 0]\ngoal = [0, 0]\nQ = [1, 1]\nR = []\nQf = [1, 1]\n";
+  const auto solve = test::run_cli("solve " + quote(dir / "solve.toml") + plugin);
+  EXPECT_EQ(solve.status, 2) << solve.err;
+  EXPECT_NE(solve.err.find("system passive_pendulum has no controls to optimise"), std::string::npos) << solve.err;
+}
+
 TEST(UrdfCli, TheArmsJointsAreControlsAndSimulateAndDiagnoseRun) {
   const fs::path dir = test::temporary_dir("urdf_cli");
   const fs::path data = dir / "arm.csv";
