@@ -5,6 +5,9 @@
 ///   /episodes/<k>/x   (T x n)  float64, the measured states in the order of state_names
 ///   /episodes/<k>/u   (T x m)  float64, the applied controls in the order of control_names
 ///
+/// A system without controls (m = 0, a passive system): control_names may be absent or empty and each
+/// u absent or of shape (T x 0); the writer writes an empty control_names and u of shape (T x 0).
+///
 /// The reader accepts variable-length and fixed-length strings (null- or space-padded) and any
 /// floating-point storage type; episodes come back ordered by k. Other objects (extra attributes,
 /// groups or datasets) are ignored. Every failure, including one inside the HDF5 library, is a
@@ -131,6 +134,7 @@ class Hdf5Reader {
         throw DataError(file_, location, "holds no value (an empty dataspace), not a single string", expected);
       const H5::StrType type = attribute.getStrType();
       std::vector<std::string> strings;
+      if (count == 0) return strings;  // an empty array (the control names of a passive system)
       if (type.isVariableStr()) {
         std::vector<char*> buffer(count, nullptr);
         attribute.read(type, buffer.data());
@@ -161,7 +165,9 @@ class Hdf5Reader {
       throw DataError(file_, attribute_location("system"), "the file holds data of system '" + found + "'",
                       "'" + system_.name + "' (the --system given)");
     check_names(root, "state_names", names_of(system_.states), "state");
-    check_names(root, "control_names", names_of(system_.controls), "control");
+    // A system without controls (a passive system): control_names may be absent, or an empty array.
+    if (!system_.controls.empty() || root.attrExists("control_names"))
+      check_names(root, "control_names", names_of(system_.controls), "control");
   }
 
   void check_names(const H5::Group& root, const std::string& attribute,
@@ -265,10 +271,13 @@ class Hdf5Reader {
     const RowMajor x = read_dataset(group, prefix, "x", T, n,
                                     fmt::format("shape ({} x {}): T = {} samples as in {}/t, n = {} states {}",
                                                 T, n, T, prefix, n, quoted_list(names_of(system_.states))));
+    // A system without controls (a passive system): u may be absent, or of shape (T x 0).
     const RowMajor u =
-        read_dataset(group, prefix, "u", T, m,
-                     fmt::format("shape ({} x {}): T = {} samples as in {}/t, m = {} controls {}", T, m, T,
-                                 prefix, m, quoted_list(names_of(system_.controls))));
+        m == 0 && !group.nameExists("u")
+            ? RowMajor(T, 0)
+            : read_dataset(group, prefix, "u", T, m,
+                           fmt::format("shape ({} x {}): T = {} samples as in {}/t, m = {} controls {}", T, m, T,
+                                       prefix, m, quoted_list(names_of(system_.controls))));
     check_finite(t, prefix + "/t", nullptr, "");
     check_finite(x, prefix + "/x", &system_.states, "state");
     check_finite(u, prefix + "/u", &system_.controls, "control");
@@ -308,7 +317,8 @@ void write_strings(H5::Group& root, const std::string& name, const std::vector<s
   std::vector<const char*> data;
   for (const auto& value : values) data.push_back(value.c_str());
   const hsize_t dims[1] = {values.size()};
-  root.createAttribute(name, type, H5::DataSpace(1, dims)).write(type, data.data());
+  const H5::Attribute attribute = root.createAttribute(name, type, H5::DataSpace(1, dims));
+  if (!values.empty()) attribute.write(type, data.data());  // an empty array: nothing to write
 }
 
 void write_array(H5::Group& group, const std::string& name, const RowMajor& values, bool one_dimensional) {

@@ -3,14 +3,20 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <atomic>
 #include <filesystem>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <mutex>
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include "gpilqg/core/input_file.hpp"
+#include "urdf_actuators.hpp"
 
 namespace gpilqg {
 namespace {
@@ -45,6 +51,71 @@ std::string one_line(const std::string& text) {
   return out;
 }
 
+/// MuJoCo's "last loaded model" (mj_saveLastXML) is process-wide: loads take turns.
+std::mutex& load_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in && !in.eof()) throw std::invalid_argument(fmt::format("{}: cannot read the model file", path));
+  return text.str();
+}
+
+/// A URDF with the motors of urdf_actuators.hpp: MuJoCo loads the URDF, writes it back as MJCF, and
+/// loads that with an <actuator> section added, from memory (named after the URDF, in its folder, so
+/// that mesh files resolve as they do for the URDF).
+mjModel* load_urdf(const std::string& path, const std::string& text, char* error, int error_size) {
+  const std::vector<urdf::Joint> joints = urdf::read_joints(text, path);
+  mjModel* plain = mj_loadXML(path.c_str(), nullptr, error, error_size);
+  if (plain == nullptr) return nullptr;
+  std::vector<std::string> model_joints;
+  for (int j = 0; j < plain->njnt; ++j) model_joints.push_back(object_name(plain, mjOBJ_JOINT, j));
+  std::string actuators;
+  try {
+    actuators = urdf::actuator_section(joints, model_joints, path);
+  } catch (...) {
+    mj_deleteModel(plain);
+    throw;
+  }
+  if (actuators.empty()) return plain;  // every joint passive (effort = 0) or fixed
+
+  static std::atomic<int> counter{0};
+  std::error_code ec;
+  const std::filesystem::path saved =
+      std::filesystem::temp_directory_path(ec) / fmt::format("gpilqg_urdf_{}_{}.xml", ::getpid(), counter++);
+  const int ok = mj_saveLastXML(saved.string().c_str(), plain, error, error_size);
+  mj_deleteModel(plain);
+  if (!ok) {
+    std::filesystem::remove(saved, ec);
+    throw std::runtime_error(fmt::format("{}: MuJoCo could not convert the URDF to MJCF: {}", path, one_line(error)));
+  }
+  std::string mjcf = file_text(saved.string());
+  std::filesystem::remove(saved, ec);
+  const std::size_t end = mjcf.rfind("</mujoco>");
+  if (end == std::string::npos)
+    throw std::runtime_error(fmt::format("{}: MuJoCo's MJCF of the URDF has no </mujoco>", path));
+  mjcf.insert(end, actuators);
+
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  const std::string name = path + ".gpilqg.xml";
+  if (mj_makeEmptyFileVFS(&vfs, name.c_str(), static_cast<int>(mjcf.size())) != 0)
+    throw std::runtime_error(fmt::format("{}: MuJoCo could not hold the converted model in memory", path));
+  std::memcpy(vfs.filedata[vfs.nfile - 1], mjcf.data(), mjcf.size());
+  mjModel* m = mj_loadXML(name.c_str(), &vfs, error, error_size);
+  mj_deleteVFS(&vfs);
+  if (m == nullptr) {
+    const std::string reason = one_line(error);
+    std::snprintf(error, static_cast<std::size_t>(error_size), "with the motors gpilqg adds to its joints: %s",
+                  reason.c_str());
+  }
+  return m;
+}
+
 }  // namespace
 
 MujocoModel::MujocoModel(mjModel* m, std::string path) : m_(m), path_(std::move(path)) {}
@@ -55,7 +126,13 @@ std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
   route_warnings_to_stderr();
   check_input_file_as<std::invalid_argument>(path, kMaxConfigFileBytes, "a MuJoCo model (MJCF .xml or URDF)");
   char error[1024] = "";
-  mjModel* m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
+  const std::string text = file_text(path);
+  mjModel* m = nullptr;
+  {
+    std::lock_guard lock(load_mutex());
+    m = urdf::is_urdf(text) ? load_urdf(path, text, error, sizeof error)
+                            : mj_loadXML(path.c_str(), nullptr, error, sizeof error);
+  }
   if (m == nullptr)
     throw std::invalid_argument(fmt::format("{}: MuJoCo cannot load the model: {}", path, one_line(error)));
   // One extra userdata slot per mjData holds the passive-force context of the step (mujoco_system.cpp).
@@ -81,7 +158,7 @@ std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
         "{}: the model has {} actuator activation state(s); gpilqg supports actuators without activation dynamics",
         path, m->na));
   if (m->njnt == 0) throw std::invalid_argument(fmt::format("{}: the model has no joints; expected hinge or slide joints", path));
-  if (m->nu == 0) throw std::invalid_argument(fmt::format("{}: the model has no actuators; expected at least one", path));
+  // No actuators: a passive system (no controls), for free-swing and decay data.
   model->read_names();
   return model;
 }

@@ -33,6 +33,12 @@ void complete_system_entry(SystemEntry& entry) {
   }
   if (!probe) throw std::invalid_argument(fmt::format("system '{}' ({}): its builder returned nothing", entry.name, entry.origin));
   if (entry.parameters.empty()) entry.parameters = probe->parameters();
+  if (probe->control_dim() == 0) {
+    // A passive system (no controls): effects of the input (actuator_gain, input_delay) cannot apply.
+    std::erase_if(entry.effects, [](const LibraryEffect& e) {
+      return e.kind == EffectKind::ActuatorGain || e.kind == EffectKind::InputDelay;
+    });
+  }
   const auto* forces = dynamic_cast<const GeneralisedForceInput*>(probe.get());
   entry.generalised_forces = forces != nullptr;
   if (forces == nullptr) return;

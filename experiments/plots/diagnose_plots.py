@@ -243,7 +243,8 @@ def free_run(f, out, states, shown, episodes=3):
             if r == len(shown) - 1:
                 ax.set_xlabel("t [s]")
     fig.legend(handles[:1], labels[:1], loc="upper right", fontsize=8)
-    fig.suptitle("Free-run simulation (k = inf) from the measured initial state with the measured controls; "
+    controls = "with the measured controls" if len(names(f.attrs["control_names"])) else "(no controls: a passive system)"
+    fig.suptitle(f"Free-run simulation (k = inf) from the measured initial state {controls}; "
                  "fit = 100 (1 - |y - y^| / |y - mean y|)", fontsize=10, x=0.02, ha="left")
     fig.tight_layout(rect=(0, 0, 1, 0.97))
     fig.savefig(os.path.join(out, "free_run.png"), dpi=110)

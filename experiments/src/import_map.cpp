@@ -48,7 +48,9 @@ LogMap read_import_map(const std::filesystem::path& file) {
   const toml::table root = TomlFields::parse(file);
   const TomlFields fields(root, file);
   fields.only_keys("", {"time", "episode", "resample", "states", "controls", "velocities"});
-  for (const char* section : {"time", "states", "controls"}) fields.require_section(section);
+  // [controls] may be left out for a system without controls (a passive system); for any other
+  // system each control's missing column is then an error naming it (log_import.cpp).
+  for (const char* section : {"time", "states"}) fields.require_section(section);
 
   LogMap map;
   map.file = file;
@@ -81,6 +83,9 @@ LogMap read_import_map(const std::filesystem::path& file) {
   }
 
   for (const char* section : {"states", "controls"}) {
+    if (root.get(section) == nullptr) continue;  // no [controls]
+    if (!root.get(section)->is_table())
+      fields.fail(section, fmt::format("expected a table [{}] of NAME = \"column\" entries", section));
     const toml::table* table = root.get(section)->as_table();
     std::vector<ColumnMapping>& list = std::string(section) == "states" ? map.states : map.controls;
     for (const auto& [key, node] : *table) {

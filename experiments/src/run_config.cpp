@@ -109,6 +109,7 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
   if (!same_system(c.system, system))
     f.fail("system.name", fmt::format("is '{}' but the command runs '{}'", c.system, system));
   const SystemSignature signature = f.system("system.name");
+  if (signature.controls.empty()) f.fail("system.name", passive_system_refusal(c.system));
   const int n = static_cast<int>(signature.states.size());
   const int m = static_cast<int>(signature.controls.size());
 

@@ -33,6 +33,7 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   SolveConfig c;
   c.system = f.system_name("system.name");
   const SystemSignature signature = f.system("system.name");
+  if (signature.controls.empty()) f.fail("system.name", passive_system_refusal(c.system));
   const int n = static_cast<int>(signature.states.size());
   const int m = static_cast<int>(signature.controls.size());
 

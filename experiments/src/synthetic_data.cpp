@@ -93,6 +93,15 @@ ExcitationSettings default_excitation(const Dynamics& system) {
     s.control_amplitude = Vector::Constant(m, 5.0);
     s.observation_std = Vector::Constant(n, 1e-3);
   }
+  if (m == 0) {
+    // A passive system (no controls): free swings from spread initial states, the only excitation.
+    // Angles +-1 rad and rates +-0.5 rad/s; lengths +-0.1 m and speeds +-0.05 m/s; other units +-0.5.
+    const auto& states = system.states();
+    for (int i = 0; i < n; ++i) {
+      const std::string& unit = states[static_cast<std::size_t>(i)].unit;
+      s.initial_spread(i) = unit == "rad" ? 1.0 : unit == "m" ? 0.1 : unit == "m/s" ? 0.05 : 0.5;
+    }
+  }
   return s;
 }
 

@@ -17,15 +17,18 @@
 namespace gpilqg::python {
 namespace {
 
-/// (t, x, u) -> an Episode; shapes are checked with the whole set (check_measurement_set).
-Episode episode_of(const py::handle& item, long id) {
+/// (t, x, u) -> an Episode, or (t, x) for a system without controls (m = 0); shapes are checked with
+/// the whole set (check_measurement_set).
+Episode episode_of(const py::handle& item, long id, bool passive) {
   const py::tuple parts = py::reinterpret_borrow<py::object>(item).cast<py::tuple>();
-  if (parts.size() != 3) throw InputError(fmt::format("episode {}: expected a tuple (t, x, u)", id));
+  if (parts.size() != 3 && !(passive && parts.size() == 2))
+    throw InputError(fmt::format("episode {}: expected a tuple (t, x, u){}", id,
+                                 passive ? " or (t, x) (the system has no controls)" : ""));
   Episode e;
   e.id = id;
   e.t = parts[0].cast<Vector>();
   e.x = parts[1].cast<Matrix>();
-  e.u = parts[2].cast<Matrix>();
+  e.u = parts.size() == 3 ? parts[2].cast<Matrix>() : Matrix(e.t.size(), 0);
   return e;
 }
 
@@ -35,7 +38,8 @@ MeasurementSet make_set(const py::object& system, const py::list& episodes, cons
   if (!ids.empty() && ids.size() != episodes.size())
     throw InputError(fmt::format("ids: {} ids for {} episodes", ids.size(), episodes.size()));
   for (std::size_t i = 0; i < episodes.size(); ++i)
-    set.episodes.push_back(episode_of(episodes[i], ids.empty() ? static_cast<long>(i) : ids[i]));
+    set.episodes.push_back(
+        episode_of(episodes[i], ids.empty() ? static_cast<long>(i) : ids[i], set.system.controls.empty()));
   try {
     check_measurement_set(set);
   } catch (const std::invalid_argument& e) {
@@ -64,8 +68,8 @@ void bind_data(py::module_& m) {
 Measured episodes of one system (DESIGN.md section 4): per episode the measured state at each time
 and the control applied from then until the next sample, at a constant step.)")
       .def(py::init(&make_set), py::arg("system"), py::arg("episodes"), py::arg("ids") = std::vector<long>{},
-           R"(system: a registry name or gpilqg.Dynamics; episodes: a list of (t (T,), x (T, n), u (T, m));
-ids: the episode ids (default 0, 1, ...). Raises InputError naming the episode and sample for wrong
+           R"(system: a registry name or gpilqg.Dynamics; episodes: a list of (t (T,), x (T, n), u (T, m)), or of
+(t, x) for a system without controls (m = 0, u then has shape (T, 0)); ids: the episode ids (default 0, 1, ...). Raises InputError naming the episode and sample for wrong
 shapes, non-finite values, or times that do not increase at a constant step.)")
       .def_property_readonly("system", [](const MeasurementSet& s) { return s.system.name; })
       .def_property_readonly("state_names", [](const MeasurementSet& s) { return names_of(s.system.states); })

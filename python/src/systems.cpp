@@ -38,7 +38,8 @@ class PythonDynamics : public Dynamics {
   PythonDynamics(std::string name, std::vector<Quantity> states, std::vector<Quantity> controls)
       : name_(std::move(name)), states_(std::move(states)), controls_(std::move(controls)) {
     if (name_.empty()) throw py::value_error("Dynamics: the name is empty");
-    if (states_.empty() || controls_.empty()) throw py::value_error("Dynamics: needs at least one state and one control");
+    // No controls (m = 0) is a passive system: simulate, data and diagnose take it; solve and plan refuse it.
+    if (states_.empty()) throw py::value_error("Dynamics: needs at least one state");
   }
   const std::string& name() const override { return name_; }
   const std::vector<Quantity>& states() const override { return states_; }

@@ -129,6 +129,7 @@ Policy plan(const ConfigSource& source, const std::vector<std::filesystem::path>
 std::string run(const std::string& system, const ConfigSource& source, int seeds, std::uint64_t first_seed,
                 std::optional<int> iterations, const std::vector<std::string>& backends, const std::filesystem::path& out,
                 const py::object& progress) {
+  if (system_signature(system).controls.empty()) throw InputError(passive_system_refusal(system));
   RunConfig config = source.file ? load_run_config(system, *source.file)
                                  : (source.text.empty() ? load_run_config(system, std::nullopt)
                                                         : parse_run_config(system, source.text, "<config>"));

@@ -72,3 +72,26 @@ def test_dataframe_round_trip_and_the_shipped_csv():
                                   s.episodes[0].x)
     with pytest.raises(gpilqg.InputError, match="expected"):
         gpilqg.MeasurementSet.from_dataframe(df.drop(columns=["theta"]), "cartpole")
+
+
+def test_a_passive_system_has_no_control_columns(tmp_path):
+    # The passive pendulum (no actuators): episodes are (t, x), u has shape (T, 0), files have no control columns.
+    pendulum = str(SOURCE_DIR / "data" / "pendulum_passive.xml")
+    t = np.arange(10) * 0.02
+    x = np.random.default_rng(0).normal(size=(10, 2))
+    s = gpilqg.MeasurementSet(pendulum, [(t, x), (t, x, np.zeros((10, 0)))])
+    assert s.control_names == [] and s.state_names == ["swing", "swing_dot"]
+    assert s.episodes[0].u.shape == (10, 0)
+    for name in ("swing.csv", "swing.h5"):
+        s.write(tmp_path / name)
+        back = gpilqg.read_measurements(tmp_path / name, pendulum)
+        np.testing.assert_array_equal(back.episodes[1].x, x)
+        assert back.episodes[1].u.shape == (10, 0)
+    assert (tmp_path / "swing.csv").read_text().splitlines()[0] == "episode,t,swing,swing_dot"
+    df = s.to_dataframe()
+    assert list(df.columns) == ["episode", "t", "swing", "swing_dot"]
+    again = gpilqg.MeasurementSet.from_dataframe(df, pendulum)
+    np.testing.assert_array_equal(again.episodes[0].x, x)
+    # A system with controls still needs them.
+    with pytest.raises(gpilqg.InputError, match=r"expected a tuple \(t, x, u\)"):
+        gpilqg.MeasurementSet("cartpole", [(t, np.zeros((10, 4)))])

@@ -137,3 +137,28 @@ def test_a_mujoco_model_file_is_a_system():
     step = gpilqg.StepModel(arm, dt=0.05)
     x_next, A, B = step.jacobians(np.zeros(4), np.ones(2))
     assert x_next.shape == (4,) and A.shape == (4, 4) and B.shape == (4, 2)
+
+
+def test_a_passive_system_has_no_controls():
+    from conftest import SOURCE_DIR
+    pendulum = gpilqg.system(str(SOURCE_DIR / "data" / "pendulum_passive.xml"))
+    assert pendulum.control_dim == 0 and pendulum.control_names == []
+    x_next, A, B = gpilqg.StepModel(pendulum, dt=0.02).jacobians(np.array([0.5, 0.0]), np.zeros(0))
+    assert x_next[1] < 0.0 and B.shape == (2, 0)
+
+    class Decay(gpilqg.Dynamics):  # a Python system without controls
+        def __init__(self):
+            super().__init__("python_decay", states=[("v", "m/s")], controls=[])
+
+        def f(self, x, u):
+            return -0.5 * x
+
+    decay = Decay()
+    assert decay.control_dim == 0
+    np.testing.assert_allclose(decay.xdot(np.array([2.0]), np.zeros(0)), [-1.0])
+
+
+def test_a_urdf_robot_gets_one_motor_per_joint():
+    from conftest import SOURCE_DIR
+    arm = gpilqg.system(str(SOURCE_DIR / "data" / "two_link_arm.urdf"))
+    assert arm.control_names == ["shoulder_motor", "elbow_motor"]

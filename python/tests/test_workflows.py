@@ -250,3 +250,60 @@ def test_diagnose_reports_progress_and_ctrl_c_stops_it_between_effects():
         gpilqg.diagnose("cartpole", data, progress=progress)
     assert lines[0] == "residual GP of the model fitted"
     assert lines[-1].startswith("effect 3/"), lines
+
+
+def test_diagnose_a_passive_pendulum_equals_the_command_line(tmp_path):
+    # Free swings of the pendulum without actuators with a hidden joint damping: Python's diagnose gives the
+    # command line's verdict, and it names the damping; solve refuses the passive system.
+    pendulum = SOURCE_DIR / "data" / "pendulum_passive.xml"
+    data = tmp_path / "swing.csv"
+    status, _, err = cli("simulate", "--system", pendulum, "--param", "swing.damping=0.3", "--episodes", "6",
+                         "--steps", "150", "--seed", "2", "--out", data)
+    assert status == 0, err
+    status, out, err = cli("diagnose", "--system", pendulum, "--data", data, "--gp-points", "100", "--json")
+    assert status == 0, err
+    expected = json.loads(out)
+    report = gpilqg.diagnose(str(pendulum), data, gp_points=100)
+    assert report["verdict"] == expected["verdict"]
+    assert report["verdict"]["status"] == "explained"
+    assert {report["verdict"]["effect"], *report["verdict"]["aliases"]} & {"param:swing.damping",
+                                                                          "joint_viscous_damping:swing"}
+    assert all(not e["effect"].startswith(("input_delay", "actuator_gain")) for e in report["ranking"])
+    config = tmp_path / "solve.toml"
+    config.write_text('[system]\nname = "%s"\ndt = 0.02\n[problem]\nhorizon = 10\nx0 = [0, 0]\ngoal = [0, 0]\n'
+                      'Q = [1, 1]\nR = []\nQf = [1, 1]\n' % pendulum)
+    with pytest.raises(gpilqg.InputError, match="no controls to optimise"):
+        gpilqg.solve(config)
+
+
+class PassivePendulum(gpilqg.Dynamics):
+    """A pendulum without controls, q_ddot = -g sin q - b q_dot (no MuJoCo: the generic path of a plugin's system)."""
+
+    def __init__(self, b):
+        super().__init__("python_passive_pendulum", states=[("q", "rad"), ("q_dot", "rad/s")], controls=[])
+        self.b = b
+
+    def parameters(self):
+        return {"b": self.b}
+
+    def f(self, x, u):
+        return np.array([x[1], -9.81 * np.sin(x[0]) - self.b * x[1]])
+
+
+def test_diagnose_a_registered_passive_python_system():
+    if "python_passive_pendulum" not in gpilqg.systems():
+        gpilqg.register_system("python_passive_pendulum",
+                               lambda preset, p: PassivePendulum(p.get("b", 0.0 if preset == "sim" else 0.5)))
+    step = gpilqg.StepModel(PassivePendulum(0.5), dt=0.02)
+    rng = np.random.default_rng(0)
+    episodes = []
+    for _ in range(5):
+        xs = [np.array([rng.uniform(-1, 1), rng.uniform(-0.5, 0.5)])]
+        for _ in range(99):
+            xs.append(step.jacobians(xs[-1], np.zeros(0))[0])
+        episodes.append((np.arange(100) * 0.02, np.array(xs) + 1e-3 * rng.normal(size=(100, 2))))
+    report = gpilqg.diagnose("python_passive_pendulum", gpilqg.MeasurementSet("python_passive_pendulum", episodes),
+                             gp_points=100)
+    assert report["verdict"]["effect"] == "param:b"
+    assert report["verdict"]["parameters"]["b"] == pytest.approx(0.5, rel=0.05)
+    assert [e["effect"] for e in report["ranking"]] == ["param:b"]  # no input_delay without controls

@@ -420,7 +420,9 @@ TEST_F(BadInput, BadLogsAndOtherMapMistakes) {
                {"map.toml:line 12: unknown field 'velocity'; expected one of: time, episode"});
   expect_error(run(map_text("x = \"x\"") + "[resample]\ncontrols = \"linear\"\n", log),
                {"map.toml:line 13: field 'resample.controls': unknown rule 'linear'; expected \"hold\" or \"average\""});
-  expect_error(run("[time]\ncolumn = \"time\"\n[states]\nx = \"x\"\n", log), {"map.toml: missing section [controls]"});
+  // Without [controls] (the map of a passive system), each control of the cart-pole is missing.
+  expect_error(run("[time]\ncolumn = \"time\"\n[states]\nx = \"x\"\nx_dot = \"xd\"\ntheta = \"th\"\ntheta_dot = \"thd\"\n", log),
+               {"map.toml: field 'controls': control 'force' has no column"});
 }
 
 }  // namespace

@@ -63,8 +63,9 @@ Episode episode_of(const RealRollout& r, int id, double dt) {
 
 int run_rollout(const RolloutOptions& o) {
   check_output_file_option("--out", o.out);
-  const PolicyFile policy = read_policy_file(o.policy);
   const SystemSignature signature = system_signature(o.world.system);
+  if (signature.controls.empty()) throw InputError("--system " + o.world.system + ": " + passive_system_refusal(o.world.system));
+  const PolicyFile policy = read_policy_file(o.policy);
   if (policy.state_names != names_of(signature.states) || policy.control_names != names_of(signature.controls))
     throw InputError(fmt::format("--policy {}: its states [{}] and controls [{}] are not those of --system {} ([{}] and [{}])",
                                  o.policy, fmt::join(policy.state_names, ", "), fmt::join(policy.control_names, ", "),

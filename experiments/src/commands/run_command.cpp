@@ -18,6 +18,7 @@
 #include "parallel/run_session.hpp"
 #include "stop_signal.hpp"
 #include "gpilqg/core/limits.hpp"
+#include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/plot_script.hpp"
 #include "gpilqg/experiments/run_checkpoint.hpp"
@@ -78,6 +79,7 @@ int run_command(const RunArguments& a) {
     if (a.first_seed + static_cast<std::uint64_t>(a.seeds) - 1 > limits::kMaxSeed)
       throw InputError(fmt::format("--first-seed {} --seeds {}: the last seed exceeds {} (the largest seed)", a.first_seed,
                                    a.seeds, limits::kMaxSeed));
+    if (system_signature(a.system).controls.empty()) throw InputError(passive_system_refusal(a.system));
     config = load_run_config(a.system, a.config.empty() ? std::nullopt : std::optional<std::filesystem::path>(a.config));
     if (a.iterations > 0) config.iterations = a.iterations;  // validated by its option check
     options.seeds.clear();

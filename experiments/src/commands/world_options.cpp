@@ -69,6 +69,13 @@ DynamicsPtr build_world(const WorldOptions& o, double* input_delay, const std::s
   if (!preset) throw InputError("--preset '" + o.preset + "': expected 'sim' or 'real'");
   const SystemSignature signature = system_signature(o.system);
   const int m = static_cast<int>(signature.controls.size());
+  if (m == 0)
+    for (const auto& [option, values] : {std::pair{"--actuator-noise", &o.actuator_noise},
+                                         std::pair{"--multiplicative-noise", &o.multiplicative_noise}})
+      if (!values->empty())
+        throw InputError(fmt::format("{}: system {} has no controls (a passive system), so it has no actuator noise; "
+                                     "leave the option out",
+                                     option, o.system));
   ActuatorNoise noise;
   noise.additive_std = per_quantity(o.actuator_noise, m, "--actuator-noise", Vector());
   noise.multiplicative_std = per_quantity(o.multiplicative_noise, m, "--multiplicative-noise", Vector());

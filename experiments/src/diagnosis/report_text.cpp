@@ -138,8 +138,8 @@ void whiteness_section(const DiagnosisReport& r, std::string& out) {
 
 void free_run_section(const DiagnosisReport& r, std::string& out) {
   if (r.free_run.empty()) return;
-  out += fmt::format("\nFree-run fit (k = inf) per held-out {}: simulated from the measured x[0] with the measured controls, "
-                     "fit % per state\n", unit_name(r));
+  out += fmt::format("\nFree-run fit (k = inf) per held-out {}: simulated from the measured x[0] {}, fit % per state\n",
+                     unit_name(r), r.control_names.empty() ? "(a passive system: no controls)" : "with the measured controls");
   out += fmt::format("   {:<8} {:<11}{}\n", unit_name(r), "model", state_header(r));
   for (const FreeRunEpisode& e : r.free_run) {
     bool first = true;

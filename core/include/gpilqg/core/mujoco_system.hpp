@@ -3,8 +3,11 @@
 /// A MuJoCo model (MJCF, or URDF as MuJoCo loads it) as a gpilqg system (DESIGN.md section 10).
 ///
 /// States: the joint positions in model order, named by joint name, then their velocities named
-/// `<joint>_dot`. Controls: the actuators in model order, named by actuator name. Hinge and slide
-/// joints only (then nq = nv and x = [qpos; qvel]); actuators without activation states (na = 0).
+/// `<joint>_dot`. Controls: the actuators in model order, named by actuator name; a model without
+/// actuators is a passive system (no controls, m = 0). A URDF's revolute, continuous and prismatic
+/// joints get one motor each, "<joint>_motor" with gear 1, bounded by the joint's <limit effort> (effort
+/// 0: no motor; no effort: unbounded). Hinge and slide joints only (then nq = nv and x = [qpos; qvel]);
+/// actuators without activation states (na = 0).
 ///
 /// Continuous time (Dynamics): xdot = [qvel; qacc(qpos, qvel, k .* u)] from mj_forward, with the
 /// generalised-force map W = [0; M(q)^-1] (nv forces, one per degree of freedom), so the
@@ -46,7 +49,8 @@ class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public
  public:
   /// Loads `path` and applies `overrides` by parameter name. Throws std::invalid_argument with the
   /// file (and MuJoCo's line) for a model MuJoCo rejects, naming the joint for a free or ball joint,
-  /// the index for an unnamed joint or actuator, and listing the valid names for an unknown parameter.
+  /// the index for an unnamed joint or actuator, the joint for a URDF's bad effort limit, and listing
+  /// the valid names for an unknown parameter.
   static std::shared_ptr<MujocoSystem> load(const std::string& path, const std::map<std::string, double>& overrides = {});
 
   /// The same model with other parameter values (overrides apply on top of this system's values).

@@ -28,6 +28,14 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Why solve, plan, rollout and run (the commands that optimise or apply controls) refuse `system`,
+/// a system without controls (a passive system: a MuJoCo model without actuators, a URDF whose
+/// joints all have effort 0, a plugin with m = 0).
+inline std::string passive_system_refusal(const std::string& system) {
+  return "system " + system + " has no controls to optimise (a passive system, without actuators); solve, plan, "
+         "rollout and run need at least one control. Passive systems work with simulate, data and diagnose";
+}
+
 /// An error that another process reports: a rank of an MPI job whose failure rank 0 prints ends
 /// with the same exit status and prints nothing, so the message appears once.
 class ReportedElsewhere : public std::exception {

@@ -1,0 +1,203 @@
+// Systems without controls (m = 0, passive systems) and URDF robots (mujoco_system.hpp): a MuJoCo
+// model without actuators loads as a passive system and steps; a URDF's revolute, continuous and
+// prismatic joints get one motor each bounded by the joint's effort limit (effort 0: no motor); bad
+// efforts are errors naming the file and the joint; measurement files without control columns.
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <H5Cpp.h>
+
+#include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/measurements.hpp"
+#include "gpilqg/core/mujoco_system.hpp"
+#include "gpilqg/core/system_registry.hpp"
+#include "test_support.hpp"
+
+namespace gpilqg {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string pendulum_path() { return (test::source_dir() / "data" / "pendulum_passive.xml").string(); }
+std::string urdf_arm_path() { return (test::source_dir() / "data" / "two_link_arm.urdf").string(); }
+
+std::vector<std::string> effect_names_of(const std::string& system) {
+  std::vector<std::string> out;
+  for (const LibraryEffect& e : find_system(system)->effects) out.push_back(e.name);
+  return out;
+}
+
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+TEST(PassiveSystem, AModelWithoutActuatorsLoadsAndSwings) {
+  const auto pendulum = MujocoSystem::load(pendulum_path());
+  EXPECT_EQ(pendulum->name(), "pendulum_passive");
+  EXPECT_EQ(pendulum->control_dim(), 0);
+  EXPECT_EQ(names_of(pendulum->states()), (std::vector<std::string>{"swing", "swing_dot"}));
+  const Vector x = (Vector(2) << 0.5, 0.0).finished();
+  const Vector u(0);
+  Vector xdot(2);
+  DynamicsJacobians J;
+  pendulum->evaluate(x, u, xdot, &J);
+  EXPECT_NEAR(xdot(1), -9.81 * std::sin(0.5) * 0.5 / (0.25 + 0.001), 1e-6);  // m g l sin / (m l^2 + I)
+  EXPECT_EQ(J.fu.rows(), 2);
+  EXPECT_EQ(J.fu.cols(), 0);
+  const auto step = pendulum->own_step_model(pendulum, 0.02);
+  Vector next(2);
+  StepJacobians SJ;
+  step->step(x, u, next, &SJ);
+  EXPECT_LT(next(1), 0.0);  // it swings back
+  EXPECT_EQ(SJ.B.cols(), 0);
+  const auto [lower, upper] = pendulum->control_limits();
+  EXPECT_EQ(lower.size(), 0);
+}
+
+TEST(PassiveSystem, NoEffectOfTheInputIsACandidate) {
+  const std::vector<std::string> names = effect_names_of(pendulum_path());
+  EXPECT_TRUE(contains(names, "joint_viscous_damping:swing"));
+  EXPECT_TRUE(contains(names, "param:swing.damping"));
+  EXPECT_FALSE(contains(names, "input_delay"));
+  for (const std::string& name : names) EXPECT_EQ(name.rfind("actuator_gain", 0), std::string::npos) << name;
+}
+
+TEST(UrdfRobot, EachJointGetsAMotorBoundedByItsEffortLimit) {
+  const auto arm = MujocoSystem::load(urdf_arm_path());
+  EXPECT_EQ(arm->name(), "two_link_arm_urdf");
+  EXPECT_EQ(names_of(arm->states()), (std::vector<std::string>{"shoulder", "elbow", "shoulder_dot", "elbow_dot"}));
+  EXPECT_EQ(names_of(arm->controls()), (std::vector<std::string>{"shoulder_motor", "elbow_motor"}));
+  const auto [lower, upper] = arm->control_limits();
+  EXPECT_MATRIX_NEAR(lower, (Vector(2) << -8.0, -3.0).finished(), 0.0);
+  EXPECT_MATRIX_NEAR(upper, (Vector(2) << 8.0, 3.0).finished(), 0.0);
+  // The motor applies u as the joint torque (gear 1): at rest, hanging, u = (1, 0) accelerates the shoulder.
+  Vector xdot(4);
+  arm->evaluate(Vector::Zero(4), (Vector(2) << 1.0, 0.0).finished(), xdot, nullptr);
+  EXPECT_GT(xdot(2), 0.0);
+  // The URDF's joint damping came along.
+  for (const Parameter& p : arm->parameters()) {
+    if (p.name == "elbow.damping") {
+      EXPECT_DOUBLE_EQ(p.value, 0.05);
+    }
+  }
+}
+
+/// A URDF of a slider and a wheel with the given <limit> elements ("" for none).
+fs::path write_urdf(const fs::path& dir, const std::string& slider_limit, const std::string& wheel_limit) {
+  const fs::path file = dir / "robot.urdf";
+  std::ofstream(file) << R"(<?xml version="1.0"?>
+<robot name="slider_wheel">
+  <link name="base"/>
+  <link name="cart"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="wheel"><inertial><mass value="0.2"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <!-- a comment with <joint name="fake" type="revolute"> inside -->
+  <joint name="slide" type="prismatic"><parent link="base"/><child link="cart"/><axis xyz="1 0 0"/>)"
+                      << slider_limit << R"(</joint>
+  <joint name="spin" type="continuous"><parent link="cart"/><child link="wheel"/><axis xyz="0 1 0"/>)"
+                      << wheel_limit << R"(</joint>
+</robot>
+)";
+  return file;
+}
+
+TEST(UrdfRobot, EffortZeroLeavesAJointPassiveAndNoEffortLeavesTheMotorUnbounded) {
+  const fs::path dir = test::temporary_dir("urdf_effort");
+  const auto one = MujocoSystem::load(
+      write_urdf(dir, R"(<limit lower="-1" upper="1" effort="0" velocity="1"/>)", "").string());
+  EXPECT_EQ(names_of(one->controls()), (std::vector<std::string>{"spin_motor"}));
+  const auto [lower, upper] = one->control_limits();
+  EXPECT_TRUE(std::isinf(lower(0)) && std::isinf(upper(0)));
+
+  const auto passive = MujocoSystem::load(write_urdf(dir, R"(<limit lower="-1" upper="1" effort="0" velocity="1"/>)",
+                                                     R"(<limit effort="0.0" velocity="1"/>)")
+                                              .string());
+  EXPECT_EQ(passive->control_dim(), 0);
+  EXPECT_EQ(names_of(passive->states()), (std::vector<std::string>{"slide", "spin", "slide_dot", "spin_dot"}));
+}
+
+TEST(UrdfRobot, ABadEffortNamesTheFileAndTheJoint) {
+  const fs::path dir = test::temporary_dir("urdf_bad_effort");
+  for (const std::string effort : {"-2", "abc", "nan", ""}) {
+    const fs::path file =
+        write_urdf(dir, R"(<limit lower="-1" upper="1" effort=")" + effort + R"(" velocity="1"/>)", "");
+    try {
+      (void)MujocoSystem::load(file.string());
+      ADD_FAILURE() << "effort '" << effort << "' was accepted";
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(file.string()), std::string::npos) << what;
+      EXPECT_NE(what.find("joint 'slide'"), std::string::npos) << what;
+      EXPECT_NE(what.find("effort"), std::string::npos) << what;
+    }
+  }
+}
+
+TEST(UrdfRobot, AMalformedUrdfNamesTheFileAndTheLine) {
+  const fs::path file = test::temporary_dir("urdf_malformed") / "broken.urdf";
+  std::ofstream(file) << "<robot name=\"r\">\n  <link name=\"base\"/>\n  <joint name=\"j type=\"revolute\">\n</robot>\n";
+  try {
+    (void)MujocoSystem::load(file.string());
+    ADD_FAILURE() << "a malformed URDF was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string() + ": line 3"), std::string::npos) << e.what();
+  }
+}
+
+MeasurementSet passive_set() {
+  MeasurementSet set;
+  set.system = MujocoSystem::load(pendulum_path())->signature();
+  for (long id = 0; id < 2; ++id) {
+    Episode e;
+    e.id = id;
+    e.t = Vector::LinSpaced(5, 0.0, 0.08);
+    e.x = Matrix::Random(5, 2);
+    e.u = Matrix(5, 0);
+    set.episodes.push_back(e);
+  }
+  return set;
+}
+
+TEST(PassiveSystem, MeasurementFilesWithoutControlColumnsRoundTrip) {
+  const fs::path dir = test::temporary_dir("passive_files");
+  const MeasurementSet set = passive_set();
+  for (const char* name : {"swing.csv", "swing.h5"}) {
+    write_measurements(dir / name, set);
+    const MeasurementSet back = read_measurements(dir / name, set.system);
+    ASSERT_EQ(back.episodes.size(), 2u);
+    EXPECT_EQ(back.episodes[1].u.rows(), 5);
+    EXPECT_EQ(back.episodes[1].u.cols(), 0);
+    EXPECT_MATRIX_NEAR(back.episodes[1].x, set.episodes[1].x, 1e-12);
+  }
+  std::ifstream csv(dir / "swing.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "episode,t,swing,swing_dot");
+}
+
+TEST(PassiveSystem, AnHdf5FileWithoutControlNamesOrUIsRead) {
+  const fs::path file = test::temporary_dir("passive_h5_minimal") / "swing.h5";
+  {
+    H5::H5File h5(file.string(), H5F_ACC_TRUNC);
+    const H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+    const char* system[] = {"pendulum_passive"};
+    h5.openGroup("/").createAttribute("system", type, H5::DataSpace(H5S_SCALAR)).write(type, system);
+    const char* states[] = {"swing", "swing_dot"};
+    const hsize_t two[1] = {2};
+    h5.openGroup("/").createAttribute("state_names", type, H5::DataSpace(1, two)).write(type, states);
+    H5::Group episode = h5.createGroup("episodes").createGroup("0");
+    const double t[3] = {0.0, 0.02, 0.04}, x[6] = {0.1, 0.0, 0.09, -0.1, 0.08, -0.2};
+    const hsize_t tdims[1] = {3}, xdims[2] = {3, 2};
+    episode.createDataSet("t", H5::PredType::IEEE_F64LE, H5::DataSpace(1, tdims)).write(t, H5::PredType::NATIVE_DOUBLE);
+    episode.createDataSet("x", H5::PredType::IEEE_F64LE, H5::DataSpace(2, xdims)).write(x, H5::PredType::NATIVE_DOUBLE);
+  }
+  const MeasurementSet set = read_measurements(file, MujocoSystem::load(pendulum_path())->signature());
+  ASSERT_EQ(set.episodes.size(), 1u);
+  EXPECT_EQ(set.episodes[0].u.rows(), 3);
+  EXPECT_EQ(set.episodes[0].u.cols(), 0);
+}
+
+}  // namespace
+}  // namespace gpilqg
