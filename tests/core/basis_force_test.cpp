@@ -258,7 +258,7 @@ TEST(UserEffects, AreCandidatesThatModelsAddBuildAndDescribe) {
   const std::string unknown = message_of([&] { find_candidate(declared, "spring"); });
   EXPECT_NE(unknown.find("unknown effect 'spring' for system 'cartpole'; expected one of: cart_viscous_friction"),
             std::string::npos) << unknown;
-  EXPECT_NE(unknown.find("param:pole_length, cart_spring"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("constant_force:theta, cart_spring"), std::string::npos) << unknown;
   EXPECT_TRUE(declared.describe().empty());
   EXPECT_TRUE(declared.current_values(spring).isZero());
 

@@ -103,13 +103,15 @@ TEST(Effects, CartPoleEnergyBalanceWithFrictionGainAndForce) {
   const double tau = spec.current_values(find_effect("cartpole", "pole_coulomb_friction"))(0);
   const double F = spec.current_values(find_effect("cartpole", "external_force_x"))(0);
   const double cd = spec.current_values(find_effect("cartpole", "quadratic_drag"))(0);
+  const double Fx = spec.current_values(find_effect("cartpole", "constant_force:x"))(0);
+  const double Ft = spec.current_values(find_effect("cartpole", "constant_force:theta"))(0);
   for (unsigned seed = 1; seed <= 10; ++seed) {
     const Vector x = test::random_vector(4, -2.0, 2.0, seed);
     const Vector u = test::random_vector(1, -5.0, 5.0, 50 + seed);
     const Matrix grad_e = test::numeric_jacobian([&](const Vector& xs) { return Vector::Constant(1, cp.energy(xs)); }, x, kStep);
     const double dE_dt = (grad_e * model->f(x, u))(0);
-    const double Qx = -b * x(1) - mu * std::tanh(x(1) / 0.05) + F - cd * std::abs(x(1)) * x(1);
-    const double Qt = -c * x(3) - tau * std::tanh(x(3) / 0.05);
+    const double Qx = -b * x(1) - mu * std::tanh(x(1) / 0.05) + F - cd * std::abs(x(1)) * x(1) + Fx;
+    const double Qt = -c * x(3) - tau * std::tanh(x(3) / 0.05) + Ft;
     const double power = (1.2 * u(0) + Qx) * x(1) + Qt * x(3);
     EXPECT_NEAR(dE_dt, power, 1e-6 * (1.0 + std::abs(power))) << "seed " << seed;
   }
@@ -161,10 +163,13 @@ TEST(Effects, LibraryHoldsTheFixedNames) {
                                                          "pole_viscous_damping", "pole_coulomb_friction",
                                                          "external_force_x", "quadratic_drag", "actuator_gain",
                                                          "input_delay", "param:cart_mass", "param:pole_mass",
-                                                         "param:pole_length"}));
+                                                         "param:pole_length", "constant_force:x",
+                                                         "constant_force:theta"}));
   EXPECT_EQ(names("quadrotor"), (std::vector<std::string>{"external_force_x", "external_force_y", "external_force_z",
                                                           "quadratic_drag", "actuator_gain", "input_delay", "param:mass",
-                                                          "param:kv", "param:km", "param:inertia", "param:rho"}));
+                                                          "param:kv", "param:km", "param:inertia", "param:rho",
+                                                          "constant_force:px", "constant_force:py", "constant_force:pz",
+                                                          "constant_force:rx", "constant_force:ry", "constant_force:rz"}));
 }
 
 TEST(Effects, BadInputNamesTheProblemAndTheChoices) {

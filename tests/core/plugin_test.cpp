@@ -66,9 +66,10 @@ TEST(Plugin, AcrobotJoinsTheRegistryWithItsEffects) {
 
   for (const char* name : {"joint_viscous_damping:theta1", "joint_viscous_damping:theta2",
                            "joint_coulomb_friction:theta1", "joint_coulomb_friction:theta2", "actuator_gain",
-                           "input_delay", "param:link1_mass", "param:link2_mass", "param:link1_length", "param:link2_length"})
+                           "input_delay", "param:link1_mass", "param:link2_mass", "param:link1_length", "param:link2_length",
+                           "constant_force:theta1", "constant_force:theta2"})
     EXPECT_NO_THROW(find_effect("acrobot", name)) << name;
-  EXPECT_EQ(effect_library("acrobot").size(), 10u);
+  EXPECT_EQ(effect_library("acrobot").size(), 12u);
 
   // The library works on the plugin's system like on a built-in one.
   ModelSpec world;

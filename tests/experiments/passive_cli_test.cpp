@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <H5Cpp.h>
 
 #include <cstdlib>
@@ -86,10 +88,17 @@ TEST(PassiveCli, DiagnoseFindsAHiddenJointDamping) {
   const bool damping = std::find(group.begin(), group.end(), "param:swing.damping") != group.end() ||
                        std::find(group.begin(), group.end(), "joint_viscous_damping:swing") != group.end();
   EXPECT_TRUE(damping) << verdict.dump();
-  // The added damping b on top of the file's 0.02 N m s/rad, or the field itself.
-  const double b = verdict["effect"] == "param:swing.damping" ? verdict["parameters"]["swing.damping"].get<double>()
-                                                              : 0.02 + verdict["parameters"].begin()->get<double>();
-  EXPECT_NEAR(b, 0.3, 0.05) << verdict.dump();
+  // The damping's own fit in the verdict's group (a much lighter bob with the file's damping is an
+  // alias on free-swing data): the field itself, or the added damping b on top of the file's 0.02.
+  double b = std::nan("");
+  const json& best = j["ranking"][0];
+  std::vector<json> fits{best};
+  for (const auto& a : best["alias_fits"]) fits.push_back(a);
+  for (const json& f : fits) {
+    if (f["effect"] == "param:swing.damping") b = f["parameters"]["swing.damping"].get<double>();
+    if (f["effect"] == "joint_viscous_damping:swing") b = 0.02 + f["parameters"]["b"].get<double>();
+  }
+  EXPECT_NEAR(b, 0.3, 0.05) << best.dump();
   for (const auto& entry : j["ranking"]) {
     const std::string name = entry["effect"].get<std::string>();
     EXPECT_NE(name, "input_delay");

@@ -15,6 +15,7 @@
 
 #include "gpilqg/core/integrator.hpp"
 
+#include "ball_drive.hpp"
 #include "diagnosis_support.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
@@ -75,68 +76,6 @@ TEST(RealMachine, SlowSlideCoulombFrictionOnTheDataScale) {
   EXPECT_GT(std::abs(ranked_value(at_default, "joint_coulomb_friction:slide") - friction), 0.3 * friction);
 }
 
-// A position-controlled drive at 1 kHz, as real drives are logged: a PD loop on an encoder of 1 um,
-// positions and the motor force only, one continuous record. The world has viscous friction (MuJoCo's
-// joint damping), Coulomb friction (frictionloss) and a constant force (gravity along a tilted axis)
-// together; the model has none of them.
-struct DriveTruth {
-  double damping = 30.0;      ///< N s/m
-  double friction = 5.0;      ///< N
-  double constant = 3.0;      ///< N: mass 2 kg times a gravity of 1.5 m/s^2 along the slide
-};
-
-std::filesystem::path drive_model() { return test::source_dir() / "tests" / "experiments" / "models" / "ball_drive.xml"; }
-
-/// The world: ball_drive.xml with the three effects written into the file.
-std::filesystem::path drive_world(const std::filesystem::path& dir, const DriveTruth& truth) {
-  std::ifstream in(drive_model());
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto replace = [&](const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-  };
-  replace(R"(<option timestep="0.001"/>)",
-          fmt::format(R"(<option timestep="0.001" gravity="{} 0 -9.81"/>)", truth.constant / 2.0));
-  replace(R"(<joint name="slide" type="slide" axis="1 0 0"/>)",
-          fmt::format(R"(<joint name="slide" type="slide" axis="1 0 0" damping="{}" frictionloss="{}"/>)", truth.damping,
-                      truth.friction));
-  const auto file = dir / "ball_drive_world.xml";
-  std::ofstream(file) << text;
-  return file;
-}
-
-/// `seconds` of the PD loop at 1 kHz tracking a sum of three sines (5, 3 and 2 cm at 0.5, 1.3 and
-/// 2.9 Hz), with force noise of 0.3 N on the motor; the log holds the encoder's count in um and the
-/// commanded force, as a CSV with the columns t, encoder_mm (to the count), force_N.
-std::filesystem::path drive_log(const std::filesystem::path& world_file, const std::filesystem::path& dir, double seconds,
-                                std::uint64_t seed) {
-  const DynamicsPtr world = find_system(world_file.string())->build(Preset::Simulator, {}, {});
-  const double dt = 1e-3, kp = 3000.0, kd = 60.0, count = 1e-6;
-  const auto step = make_step_model(world, Integrator::RK4, dt, 4);
-  std::mt19937_64 random(seed);
-  std::normal_distribution<double> force_noise(0.0, 0.3);
-  Vector x = Vector::Zero(2), next(2);
-  double previous = 0.0;
-  const auto file = dir / "drive_log.csv";
-  std::ofstream out(file);
-  out << "t,encoder_mm,force_N\n";
-  const long samples = std::lround(seconds / dt);
-  for (long k = 0; k <= samples; ++k) {
-    const double t = static_cast<double>(k) * dt;
-    const double reference = 0.05 * std::sin(2 * M_PI * 0.5 * t) + 0.03 * std::sin(2 * M_PI * 1.3 * t + 1.0) +
-                             0.02 * std::sin(2 * M_PI * 2.9 * t + 2.0);
-    const double encoder = std::round(x(0) / count) * count;
-    const double speed = k == 0 ? 0.0 : (encoder - previous) / dt;
-    previous = encoder;
-    const double force = kp * (reference - encoder) - kd * speed;
-    out << fmt::format("{:.3f},{:.3f},{:.6f}\n", t, encoder * 1e3, force);
-    step->step(x, Vector::Constant(1, force + force_noise(random)), next);
-    x = next;
-  }
-  return file;
-}
-
 /// The last --auto step's joint values: effect -> its first parameter.
 std::map<std::string, double> chosen_values(const nlohmann::json& report) {
   std::map<std::string, double> out;
@@ -155,15 +94,19 @@ double chosen(const std::map<std::string, double>& values, std::initializer_list
   return std::nan("");
 }
 
+// A position-controlled drive at 1 kHz, as real drives are logged (ball_drive.hpp): a PD loop on an
+// encoder of 1 um, positions and the motor force only, one continuous record of 12 s. The world has
+// viscous friction, Coulomb friction (MuJoCo's frictionloss) and a constant force together; the model
+// has none of them. --auto must find all three, and no proxy (a gain, a mass).
 TEST(RealMachine, ClosedLoopDriveAtOneKilohertzFindsItsThreeFrictionTerms) {
-  const DriveTruth truth;
+  const test::DriveTruth truth;
   const auto dir = test::temporary_dir("ball_drive");
-  const auto log = drive_log(drive_world(dir, truth), dir, 12.0, 3);
-  std::ofstream(dir / "map.toml") << "[time]\ncolumn = \"t\"\n\n[states]\nslide = { column = \"encoder_mm\", unit = \"mm\" }\n\n"
-                                     "[controls]\ndrive = \"force_N\"\n\n[velocities]\nmethod = \"savitzky_golay\"\nwindow = 21\norder = 2\n";
-  const std::string model = "'" + drive_model().string() + "'";
-  const auto imported = test::run_cli("data import '" + log.string() + "' --system " + model + " --map '" +
-                                      (dir / "map.toml").string() + "' --out '" + (dir / "drive.h5").string() + "'");
+  const auto model_file = test::drive_model(test::source_dir());
+  const auto log = test::drive_log(test::drive_world(model_file, dir, truth), dir, 12.0, 3);
+  const auto map = test::drive_map(dir);
+  const std::string model = "'" + model_file.string() + "'";
+  const auto imported = test::run_cli("data import '" + log.string() + "' --system " + model + " --map '" + map.string() +
+                                      "' --out '" + (dir / "drive.h5").string() + "'");
   ASSERT_EQ(imported.status, 0) << imported.err;
   const auto r = test::run_cli("diagnose --system " + model + " --data '" + (dir / "drive.h5").string() + "' --auto --json");
   ASSERT_EQ(r.status, 0) << r.err;

@@ -12,7 +12,6 @@
 #include <stdexcept>
 
 #include <Eigen/Dense>
-#include <nlopt.hpp>
 
 #include "gpilqg/core/fork_join.hpp"
 #include "gpilqg/core/system_registry.hpp"
@@ -138,28 +137,6 @@ Vector weighted_model_residual(const FitContext& c, const std::vector<int>& rows
 
 Vector clamp_to(const Vector& theta, const Vector& lo, const Vector& hi) { return theta.cwiseMax(lo).cwiseMin(hi); }
 
-struct Objective {
-  const EffectSet* set;
-  const FitContext* context;
-  const std::vector<int>* rows;
-  double penalty;
-  int evaluations = 0;
-};
-
-double nlopt_objective(unsigned p, const double* x, double* gradient, void* data) {
-  static_cast<void>(gradient);  // derivative-free
-  auto* o = static_cast<Objective*>(data);
-  ++o->evaluations;
-  const Eigen::Map<const Vector> theta(x, static_cast<Eigen::Index>(p));
-  try {
-    bool finite = true;
-    const Vector r = weighted_residual_at(*o->set, theta, *o->context, *o->rows, &finite);
-    return finite ? r.squaredNorm() : o->penalty;
-  } catch (const std::invalid_argument&) {
-    return o->penalty;  // outside what the model accepts (e.g. a mass of 0): a wall for the optimiser
-  }
-}
-
 /// The batch length of the significance test: context.batch when set, else ceil(sqrt(N)) of the N
 /// held-out rows (at least 10), the classical batch-means rule: batches grow with the record, so the
 /// serial correlation of a long record sampled fast (1 kHz) stays inside a batch. Rounded up to whole
@@ -278,42 +255,64 @@ namespace {
 EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& theta_ls, const Vector& theta_hat,
                      const Vector& ci_low, const Vector& ci_high, EffectFit fit);
 
-/// One Gauss-Newton step from `theta` (updated in place when it lowers S) for a set of linear effects;
-/// returns S at the final theta.
-double refine_linear(const EffectSet& set, Vector& theta, const Vector& lower, const Vector& upper, const FitContext& c,
-                     const std::vector<int>& rows) {
-  bool finite = true;
-  const Vector r = weighted_residual_at(set, theta, c, rows, &finite);
-  const double at_theta = finite ? r.squaredNorm() : std::numeric_limits<double>::infinity();
-  const Matrix J = regressor(set, theta, c, rows);
-  if (!J.allFinite()) return at_theta;
-  const Vector next = clamp_to(theta + J.colPivHouseholderQr().solve(r), lower, upper);
-  if (!next.allFinite()) return at_theta;
-  bool next_finite = true;
-  double at_next = std::numeric_limits<double>::infinity();
+/// S(theta), or +inf where the model diverges or does not accept theta (a mass of 0, say).
+double objective_at(const EffectSet& set, const VectorCRef& theta, const FitContext& c, const std::vector<int>& rows) {
   try {
-    const Vector rn = weighted_residual_at(set, next, c, rows, &next_finite);
-    if (next_finite) at_next = rn.squaredNorm();
+    bool finite = true;
+    const Vector r = weighted_residual_at(set, theta, c, rows, &finite);
+    return finite ? r.squaredNorm() : std::numeric_limits<double>::infinity();
   } catch (const std::invalid_argument&) {
-    // outside what the model accepts: keep theta
+    return std::numeric_limits<double>::infinity();
   }
-  if (at_next < at_theta) {
-    theta = next;
-    return at_next;
+}
+
+/// Gauss-Newton from `theta` (updated in place), at most `iterations` steps, each clamped to the
+/// physical range and halved (up to 6 times) until S falls; stops when a step lowers S by less than
+/// 1e-9 of it. Returns S at the final theta; `evaluations` counts the residual evaluations.
+double refine_gauss_newton(const EffectSet& set, Vector& theta, const Vector& lower, const Vector& upper,
+                           const FitContext& c, const std::vector<int>& rows, int iterations, int& evaluations) {
+  double at_theta = objective_at(set, theta, c, rows);
+  ++evaluations;
+  for (int k = 0; k < iterations && std::isfinite(at_theta); ++k) {
+    const Vector r = weighted_residual_at(set, theta, c, rows);
+    const Matrix J = regressor(set, theta, c, rows);
+    evaluations += 1 + 2 * static_cast<int>(theta.size());
+    if (!J.allFinite() || !r.allFinite()) break;
+    const Vector step = J.colPivHouseholderQr().solve(r);
+    if (!step.allFinite()) break;
+    bool lowered = false;
+    for (double scale = 1.0; scale > 1.0 / 64.0 && !lowered; scale *= 0.5) {
+      const Vector next = clamp_to(theta + scale * step, lower, upper);
+      const double at_next = objective_at(set, next, c, rows);
+      ++evaluations;
+      if (at_next < at_theta) {
+        const bool converged = at_theta - at_next <= 1e-9 * at_theta;
+        theta = next;
+        at_theta = at_next;
+        lowered = true;
+        if (converged) return at_theta;
+      }
+    }
+    if (!lowered) break;
   }
   return at_theta;
 }
+
+/// Gauss-Newton steps from theta_0: effects linear in their parameters need two (the least-squares
+/// step, then what the integrator leaves of the nonlinearity); the others (a mass, a length, a delay)
+/// up to this many.
+constexpr int kLinearRefinements = 2;
+constexpr int kNonlinearRefinements = 12;
 
 /// Steps 1-4 on the stacked parameters of `set`, from `initial`.
 EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext& c) {
   if (c.data == nullptr) throw std::invalid_argument("fit_effect: no data");
   const auto p = set.size();
   const std::vector<int> training = c.data->rows(false);
-  Vector lower(p), upper(p), scale(p);
+  Vector lower(p), upper(p);
   for (Eigen::Index j = 0; j < p; ++j) {
     lower(j) = set.parameter(j).lower;
     upper(j) = set.parameter(j).upper;
-    scale(j) = set.parameter(j).scale;
   }
   Vector theta_ls = initial, theta_hat = initial, ci_low = initial, ci_high = initial;
   EffectFit fit;
@@ -329,47 +328,12 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
     const Vector r_initial = weighted_residual_at(set, initial, c, training);
     const Vector delta = J.colPivHouseholderQr().solve(r_initial);
     theta_ls = clamp_to(initial + delta, lower, upper);
-    if (set.linear()) {
-      // 2'. Effects linear in their parameters: S is quadratic in theta up to the integrator, so one
-      // more Gauss-Newton step from theta_LS reaches the minimum; no derivative-free search is needed.
-      theta_hat = theta_ls;
-      fit.training_objective_after = refine_linear(set, theta_hat, lower, upper, c, training);
-      std::tie(ci_low, ci_high) = confidence_interval(set, theta_hat, c, training);
-      score_heldout(set, theta_hat, c, fit);
-      return finish_fit(set, initial, theta_ls, theta_hat, ci_low, ci_high, std::move(fit));
-    }
-
-    // 2. Nonlinear refit of S(theta) with NLopt, in a box around theta_LS inside the physical range.
-    const Vector radius = 2.0 * delta.cwiseAbs() + 0.05 * scale;
-    const Vector lo = (theta_ls - radius).cwiseMax(lower);
-    const Vector hi = (theta_ls + radius).cwiseMin(upper);
-    Objective objective{&set, &c, &training, 1e30 * (1.0 + fit.training_objective_before)};
-    std::vector<double> x(theta_ls.data(), theta_ls.data() + p);
-    double best = std::numeric_limits<double>::infinity();
-    try {
-      nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(p));
-      opt.set_lower_bounds(std::vector<double>(lo.data(), lo.data() + p));
-      opt.set_upper_bounds(std::vector<double>(hi.data(), hi.data() + p));
-      opt.set_min_objective(nlopt_objective, &objective);
-      opt.set_xtol_abs(std::vector<double>(static_cast<std::size_t>(p), 0.0));
-      opt.set_xtol_rel(1e-7);
-      opt.set_ftol_rel(1e-12);
-      opt.set_maxeval(static_cast<int>(200 * p));
-      std::vector<double> step(static_cast<std::size_t>(p));
-      for (Eigen::Index j = 0; j < p; ++j) step[static_cast<std::size_t>(j)] = std::max(0.25 * (hi(j) - lo(j)), 1e-8 * scale(j));
-      opt.set_initial_step(step);
-      opt.optimize(x, best);
-    } catch (const std::exception&) {
-      // NLopt gave up (roundoff, invalid step): keep the best point it reported, checked below.
-    }
-    fit.evaluations = objective.evaluations;
-    theta_hat = Eigen::Map<const Vector>(x.data(), p);
-    const double at_linear = nlopt_objective(static_cast<unsigned>(p), theta_ls.data(), nullptr, &objective);
-    const double at_refit = theta_hat.allFinite()
-                                ? nlopt_objective(static_cast<unsigned>(p), theta_hat.data(), nullptr, &objective)
-                                : std::numeric_limits<double>::infinity();
-    if (!(at_refit <= at_linear)) theta_hat = theta_ls;
-    fit.training_objective_after = std::min(at_refit, at_linear);
+    // 2. Gauss-Newton on S(theta) inside the physical range, from theta_0: its first step is the
+    // least-squares step above, halved when it does not lower S (a nonlinear effect far from theta_0).
+    theta_hat = initial;
+    fit.training_objective_after =
+        refine_gauss_newton(set, theta_hat, lower, upper, c, training,
+                            set.linear() ? kLinearRefinements : kNonlinearRefinements, fit.evaluations);
 
     // 3. Interval.
     std::tie(ci_low, ci_high) = confidence_interval(set, theta_hat, c, training);

@@ -106,6 +106,7 @@ LinearisedFits::LinearisedFits(const FitContext& c, const std::vector<EffectFit>
   cross_train_ = JT.transpose() * r0.train;
   cross_heldout_ = JH.transpose() * r0.heldout;
   base_heldout_ = r0.heldout.squaredNorm();
+  base_train_ = r0.train.squaredNorm();
 }
 
 int LinearisedFits::index(const std::string& name) const {
@@ -114,27 +115,35 @@ int LinearisedFits::index(const std::string& name) const {
 }
 
 double LinearisedFits::heldout_left(const std::vector<int>& subset) const {
+  return left(subset, gram_heldout_, cross_heldout_, base_heldout_);
+}
+
+double LinearisedFits::training_left(const std::vector<int>& subset) const {
+  return left(subset, gram_train_, cross_train_, base_train_);
+}
+
+double LinearisedFits::left(const std::vector<int>& subset, const Matrix& gram, const Vector& cross, double base) const {
   std::vector<Eigen::Index> cols;
   for (int e : subset)
     for (Eigen::Index j = offset_[static_cast<std::size_t>(e)]; j < offset_[static_cast<std::size_t>(e) + 1]; ++j)
       cols.push_back(j);
   for (Eigen::Index j = 0; j < refit_columns_; ++j) cols.push_back(offset_.back() + j);
-  if (cols.empty()) return base_heldout_;
+  if (cols.empty()) return base;
   const auto k = static_cast<Eigen::Index>(cols.size());
-  Matrix GT(k, k), GH(k, k);
-  Vector bT(k), bH(k);
+  Matrix GT(k, k), G(k, k);
+  Vector bT(k), b(k);
   for (Eigen::Index a = 0; a < k; ++a) {
     bT(a) = cross_train_(cols[static_cast<std::size_t>(a)]);
-    bH(a) = cross_heldout_(cols[static_cast<std::size_t>(a)]);
-    for (Eigen::Index b = 0; b < k; ++b) {
-      GT(a, b) = gram_train_(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
-      GH(a, b) = gram_heldout_(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
+    b(a) = cross(cols[static_cast<std::size_t>(a)]);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      GT(a, c) = gram_train_(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(c)]);
+      G(a, c) = gram(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(c)]);
     }
   }
   // The minimum-norm solution: collinear columns (aliases) share the fit instead of blowing up.
   const Vector theta = GT.completeOrthogonalDecomposition().solve(bT);
-  if (!theta.allFinite()) return base_heldout_;
-  return std::max(0.0, base_heldout_ - 2.0 * theta.dot(bH) + theta.dot(GH * theta));
+  if (!theta.allFinite()) return base;
+  return std::max(0.0, base - 2.0 * theta.dot(b) + theta.dot(G * theta));
 }
 
 double LinearisedFits::gain(const std::vector<int>& subset, const std::vector<int>& reference) const {

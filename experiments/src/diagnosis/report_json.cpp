@@ -72,7 +72,7 @@ json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
           {"explained_ci95", {f.explained - f.explained_ci, f.explained + f.explained_ci}},
           {"z_score", f.z_score},
           {"identifiable", f.identifiable},
-          {"nlopt_evaluations", f.evaluations},
+          {"evaluations", f.evaluations},
           {"heldout_state", r.state_names[static_cast<std::size_t>(state)]},
           {"heldout_rmse_before", f.heldout_rmse_before(state)},
           {"heldout_rmse_after", f.heldout_rmse_after(state)},

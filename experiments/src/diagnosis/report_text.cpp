@@ -303,7 +303,9 @@ std::string report_text(const DiagnosisReport& r) {
   add_section(r, out);
   free_run_section(r, out);
   out += "\nverdict: " + r.verdict.status;
-  if (r.verdict.effect) {
+  if (!r.verdict.effects.empty()) {
+    out += fmt::format(": {} (the set of 3b)", fmt::join(r.verdict.effects, ", "));
+  } else if (r.verdict.effect) {
     out += fmt::format(": {} ({})", r.verdict.effect->effect, parameter_text(*r.verdict.effect, true));
     if (!r.verdict.aliases.empty()) out += fmt::format(", or its aliases {}", fmt::join(r.verdict.aliases, ", "));
   }

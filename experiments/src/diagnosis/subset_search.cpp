@@ -8,6 +8,7 @@
 
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
+#include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -61,7 +62,9 @@ std::vector<std::vector<int>> best_subsets(const LinearisedFits& fits, int k, in
 Selection select_subsets(const FitContext& context, const SelectionOptions& o, std::vector<RankedEffect> first) {
   if (context.data == nullptr) throw std::invalid_argument("select_subsets: no data");
   const SystemEntryPtr system = find_system(context.model.system);
-  const std::vector<LibraryEffect> candidates = candidate_effects(context.model);
+  // Candidates; a Coulomb entry is replaced (in place: `present` points into it) when its smoothing
+  // velocity is fitted again inside a set.
+  std::vector<LibraryEffect> candidates = candidate_effects(context.model);
   const std::vector<RefitEffect> present = model_effects(context.model, candidates);
   std::vector<RankedEffect> ranking =
       first.empty() ? rank_effects(context, o.alias_gain, o.progress, present, o.threads) : std::move(first);
@@ -118,6 +121,33 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     }
     std::vector<std::string> removed;
     best = without_redundant(best, context, accepted_context, candidates, removed);
+    // The Coulomb members' smoothing velocities, fitted inside the set; the set refitted at them.
+    bool rescaled = false;
+    for (const auto& [name, v0] : joint_smoothing(context, best)) {
+      for (LibraryEffect& e : candidates)
+        if (e.name == name && e.smoothing && e.smoothing->width != v0) {
+          e = with_smoothing(e, v0);
+          rescaled = true;
+        }
+    }
+    if (rescaled) {
+      std::vector<RefitEffect> rest;
+      for (const EffectValues& v : best.refitted) rest.push_back({&named(candidates, v.effect), v.estimate});
+      best = fit_jointly(named(candidates, best.effect), rest, accepted_context, best.estimate);
+    }
+    // The backward check may leave the accepted set itself, or a set no better than it.
+    std::vector<std::string> kept{best.effect};
+    for (const EffectValues& v : best.refitted) kept.push_back(v.effect);
+    std::sort(kept.begin(), kept.end());
+    std::vector<std::string> before = accepted;
+    std::sort(before.begin(), before.end());
+    if (kept == before || best.explained < o.min_explained || best.z_score < o.min_z) {
+      last_rejection = fmt::format(
+          "the best set of {} ({}) comes to {} after dropping members whose intervals contain their values without "
+          "them, which removes {:.1f}% of the held-out residual left (z = {:.1f})",
+          k, names, fmt::join(kept, ", "), 100.0 * best.explained, best.z_score);
+      continue;
+    }
     // Present in the previous set, absent from this one (and not dropped by the backward check).
     std::vector<std::string> now{best.effect};
     for (const EffectValues& v : best.refitted) now.push_back(v.effect);

@@ -1,5 +1,7 @@
 #include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
+#include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -34,31 +36,30 @@ double profiled_objective(const FitContext& c, const LibraryEffect& coulomb, dou
   return r0.squaredNorm() - jr * jr / jj;
 }
 
-/// The fitted v0 of one Coulomb candidate (the file comment), or `fallback` when its velocity is 0.
-double fitted_smoothing(const FitContext& c, const LibraryEffect& coulomb, const Vector& r0, const std::vector<int>& rows) {
-  const double rms = training_rms(*c.data, coulomb.smoothing->velocity);
-  if (!(rms > 0.0) || !std::isfinite(rms)) return coulomb.smoothing->width;
+/// The v0 = f s minimising `objective(v0)` over the grid f of kSmoothingGrid, refined by the vertex of
+/// the parabola through the best grid point and its neighbours in log v0; `fallback` when s is 0.
+template <class Objective>
+double minimising_smoothing(double rms, double fallback, Objective&& objective) {
+  if (!(rms > 0.0) || !std::isfinite(rms)) return fallback;
   const auto points = static_cast<int>(std::size(kSmoothingGrid));
-  std::vector<double> objective(static_cast<std::size_t>(points));
+  std::vector<double> values(static_cast<std::size_t>(points));
   int best = 0;
   for (int i = 0; i < points; ++i) {
-    objective[static_cast<std::size_t>(i)] = profiled_objective(c, coulomb, kSmoothingGrid[i] * rms, r0, rows);
-    if (objective[static_cast<std::size_t>(i)] < objective[static_cast<std::size_t>(best)]) best = i;
+    values[static_cast<std::size_t>(i)] = objective(kSmoothingGrid[i] * rms);
+    if (values[static_cast<std::size_t>(i)] < values[static_cast<std::size_t>(best)]) best = i;
   }
-  double v0 = kSmoothingGrid[best] * rms;
+  const double v0 = kSmoothingGrid[best] * rms;
   if (best == 0 || best == points - 1) return v0;
-  // The vertex of the parabola through the best point and its neighbours, in x = log v0.
   const double x0 = std::log(kSmoothingGrid[best - 1]), x1 = std::log(kSmoothingGrid[best]),
                x2 = std::log(kSmoothingGrid[best + 1]);
-  const double y0 = objective[static_cast<std::size_t>(best - 1)], y1 = objective[static_cast<std::size_t>(best)],
-               y2 = objective[static_cast<std::size_t>(best + 1)];
+  const double y0 = values[static_cast<std::size_t>(best - 1)], y1 = values[static_cast<std::size_t>(best)],
+               y2 = values[static_cast<std::size_t>(best + 1)];
   const double d01 = (y1 - y0) / (x1 - x0), d12 = (y2 - y1) / (x2 - x1), curvature = (d12 - d01) / (x2 - x0);
   if (!(curvature > 0.0)) return v0;
   // p(x) = y0 + d01 (x - x0) + curvature (x - x0)(x - x1), p'(x) = 0 at:
   const double x = std::clamp(0.5 * (x0 + x1) - d01 / (2.0 * curvature), x0, x2);
   const double candidate = std::exp(x) * rms;
-  if (profiled_objective(c, coulomb, candidate, r0, rows) < y1) v0 = candidate;
-  return v0;
+  return objective(candidate) < y1 ? candidate : v0;
 }
 
 }  // namespace
@@ -73,7 +74,42 @@ ModelSpec with_fitted_smoothing(const FitContext& c) {
                                      [&](const auto& force) { return force.first == effect.name; });
     if (present) continue;
     if (r0.size() == 0) r0 = weighted_residual_of(c.model, c, rows);
-    out.smoothing[effect.name] = fitted_smoothing(c, effect, r0, rows);
+    out.smoothing[effect.name] =
+        minimising_smoothing(training_rms(*c.data, effect.smoothing->velocity), effect.smoothing->width,
+                             [&](double v0) { return profiled_objective(c, effect, v0, r0, rows); });
+  }
+  return out;
+}
+
+}  // namespace gpilqg::diagnosis
+
+namespace gpilqg::diagnosis {
+
+std::map<std::string, double> joint_smoothing(const FitContext& c, const EffectFit& fit) {
+  // The set as effect fits (LinearisedFits takes each one's name, value and size).
+  std::vector<EffectFit> members{fit};
+  for (const EffectValues& v : fit.refitted) {
+    EffectFit member;
+    member.effect = v.effect;
+    member.parameters = v.parameters;
+    member.initial = v.initial;
+    member.estimate = v.estimate;
+    members.push_back(std::move(member));
+  }
+  std::vector<int> all(members.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  FitContext trial = c;
+  std::map<std::string, double> out;
+  for (const EffectFit& member : members) {
+    const LibraryEffect effect = find_candidate(c.model, member.effect);
+    if (!effect.smoothing) continue;
+    const double v0 = minimising_smoothing(training_rms(*c.data, effect.smoothing->velocity), effect.smoothing->width,
+                                           [&](double width) {
+                                             trial.model.smoothing[effect.name] = width;
+                                             return LinearisedFits(trial, members, {}).training_left(all);
+                                           });
+    trial.model.smoothing[effect.name] = v0;
+    out[effect.name] = v0;
   }
   return out;
 }

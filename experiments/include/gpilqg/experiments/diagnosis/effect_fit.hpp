@@ -16,8 +16,10 @@
 ///    model's residual. For an effect linear in theta (friction, drag, external forces, the gain, kv,
 ///    km, rho) this is the estimate up to the RK4 discretisation; for the others it is a Gauss-Newton
 ///    step.
-/// 2. A nonlinear refit of S with NLopt (BOBYQA, derivative-free, bounded to the parameter's physical
-///    range and a box around theta_LS) gives the final estimate theta_hat.
+/// 2. Gauss-Newton on S from theta_0, each step clamped to the parameters' physical range and halved
+///    until S falls: two steps for effects linear in theta (the first is step 1's), up to twelve for
+///    the others; this gives the final estimate theta_hat. (A derivative-free search took 30 to 200
+///    evaluations of S per parameter; on 25,000 samples of a MuJoCo model that was most of the time.)
 /// 3. A 95% interval from the Gauss-Newton covariance at theta_hat, s^2 (J'WJ)^-1 with
 ///    s^2 = S / (N n - p), widened to the delete-one-episode jackknife when that is larger: one-step
 ///    residuals of one episode are correlated, so the iid interval alone is too narrow.
@@ -95,7 +97,7 @@ struct EffectFit {
   Vector estimate;           ///< theta_hat (NLopt)
   Vector ci_low, ci_high;    ///< 95% interval of theta_hat
   double smoothing = 0.0;    ///< Coulomb friction: its smoothing velocity v0 (LibraryEffect::smoothing); else 0
-  int evaluations = 0;       ///< NLopt objective evaluations
+  int evaluations = 0;       ///< evaluations of the residual in step 2
   double training_objective_before = 0.0;  ///< S(theta_0)
   double training_objective_after = 0.0;   ///< S(theta_hat)
   Vector heldout_rmse_before;  ///< n

@@ -46,6 +46,9 @@ class LinearisedFits {
   /// `subset` (indices) with the refitted effects, fitted on the training rows (never below 0).
   double heldout_left(const std::vector<int>& subset) const;
 
+  /// The same on the training rows: what the fit leaves of the weighted training objective.
+  double training_left(const std::vector<int>& subset) const;
+
   /// The share of what `reference` leaves on the held-out rows that `subset` removes:
   /// 1 - left(subset) / left(reference) (0 when the reference leaves nothing).
   double gain(const std::vector<int>& subset, const std::vector<int>& reference) const;
@@ -56,7 +59,10 @@ class LinearisedFits {
   Eigen::Index refit_columns_ = 0;
   Matrix gram_train_, gram_heldout_;
   Vector cross_train_, cross_heldout_;
-  double base_heldout_ = 0.0;
+  double base_heldout_ = 0.0, base_train_ = 0.0;
+  /// What the least-squares fit of `subset` (with the refitted effects) leaves of r'r, with the fit on
+  /// the training rows, evaluated with (gram, cross, base).
+  double left(const std::vector<int>& subset, const Matrix& gram, const Vector& cross, double base) const;
 };
 
 }  // namespace gpilqg::diagnosis

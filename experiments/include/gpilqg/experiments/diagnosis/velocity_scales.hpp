@@ -20,6 +20,9 @@
 /// keeps the library's default (kDefaultCoulombWidth). The value is reported with the effect
 /// (`v0 = ...`) and written into model files, so a model keeps the smoothing it was fitted with.
 
+#include <map>
+#include <string>
+
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
 
 namespace gpilqg::diagnosis {
@@ -34,5 +37,13 @@ double training_rms(const Transitions& data, int velocity);
 /// that the model neither has as a force nor gives a v0 already. Needs the context's data, weights
 /// and residual (that of context.model).
 ModelSpec with_fitted_smoothing(const FitContext& context);
+
+/// The smoothing velocities of the Coulomb effects of the joint fit `fit` (its effect and those it
+/// refitted), fitted again inside the set: for each in turn, the same grid and parabola, the objective
+/// being the training objective of the linearised joint fit of the whole set (linearised_fits.hpp)
+/// around context.model. A v0 fitted alone is biased by what the other effects do (on a cart with
+/// Coulomb friction and a constant force, v0 alone came out at 0.6 times its value); the set's
+/// v0 is not. Effect name -> v0.
+std::map<std::string, double> joint_smoothing(const FitContext& context, const EffectFit& fit);
 
 }  // namespace gpilqg::diagnosis
