@@ -93,7 +93,7 @@ const char* unit_name(const DiagnosisReport& r) { return r.blocks ? "block" : "e
 /// A single record's blocks (heldout_blocks.hpp): which are held out, and the gap.
 void blocks_section(const DiagnosisReport& r, std::string& out) {
   const HeldoutBlocks& b = *r.blocks;
-  out += fmt::format("data: one record (episode {}, {} samples, dt = {} s) cut into {} blocks, held-out blocks {}; "
+  out += fmt::format("data: one record (episode {}, {} samples, dt = {:.6g} s) cut into {} blocks, held-out blocks {}; "
                      "{} transitions used\n",
                      b.episode_id, b.samples, r.dt, b.blocks.size(), fmt::join(r.heldout_episode_ids, ", "), r.samples);
   out += fmt::format("   gap: the {} training samples ({:.4g} s) on either side of every held-out block are dropped, the "
