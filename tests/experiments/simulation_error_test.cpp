@@ -2,8 +2,8 @@
 // measured states, and the acceptance case it exists for: a MuJoCo pendulum with a damping ratio of
 // 0.005, whose damping is below the noise of one step but shows over a few periods. The one-step
 // criterion misses it; the simulation criterion over windows of 200 samples (2 s, two periods) finds
-// joint_viscous_damping:hinge within 15%. The pendulum has a motor only because a MuJoCo model needs an
-// actuator; every control is 0.
+// joint_viscous_damping:hinge within 15%. The pendulum is passive: a model without actuators, data
+// without control columns, the free-swing decay test of system identification.
 
 #include <gtest/gtest.h>
 
@@ -35,7 +35,6 @@ void write_pendulum(const fs::path& file, double damping) {
       <inertial pos="0 0 -0.25" mass="1" diaginertia="0.0001 0.0001 0.0001"/>
     </body>
   </worldbody>
-  <actuator><motor name="motor" joint="hinge"/></actuator>
 </mujoco>
 )";
 }
@@ -44,7 +43,7 @@ constexpr double kDamping = 0.0039;
 constexpr double kAngleNoise = 1e-3;  // rad
 
 /// Free decay of the damped pendulum: `episodes` records of 4 s (about 4 periods) at 100 Hz from
-/// angles of 0.3 to 0.9 rad, zero controls. The angle carries sensor noise of 1 mrad; the velocity is
+/// angles of 0.3 to 0.9 rad, no controls. The angle carries sensor noise of 1 mrad; the velocity is
 /// not measured but computed from the noisy angles by central differences (first and last sample
 /// dropped), as from an encoder.
 MeasurementSet free_decay(const fs::path& world_file, int episodes, std::uint64_t seed) {
@@ -58,7 +57,6 @@ MeasurementSet free_decay(const fs::path& world_file, int episodes, std::uint64_
   s.nominal_state(0) = 0.6;
   s.initial_spread = Vector::Zero(2);
   s.initial_spread << 0.3, 0.5;
-  s.control_amplitude = Vector::Zero(1);
   s.observation_std = Vector::Zero(2);
   s.observation_std(0) = kAngleNoise;
   s.seed = seed;
