@@ -21,12 +21,23 @@
 namespace gpilqg {
 namespace {
 
+/// MuJoCo's warnings printed so far, and how many are printed at most: a fit that tries parameters at
+/// which the model is unstable makes MuJoCo warn at every step (60,000 lines in one diagnosis), and
+/// the diagnosis already treats those predictions as diverged.
+std::atomic<long> warnings_printed{0};
+constexpr long kMaxWarningsPrinted = 5;
+
 /// MuJoCo prints warnings on stdout by default, which would corrupt `--json` output: route them to
-/// stderr, once per process.
+/// stderr, once per process, the first kMaxWarningsPrinted of them.
 void route_warnings_to_stderr() {
   static std::once_flag once;
   std::call_once(once, [] {
-    mju_user_warning = [](const char* message) { std::fprintf(stderr, "warning: MuJoCo: %s\n", message); };
+    mju_user_warning = [](const char* message) {
+      const long count = ++warnings_printed;
+      if (count <= kMaxWarningsPrinted) std::fprintf(stderr, "warning: MuJoCo: %s\n", message);
+      if (count == kMaxWarningsPrinted)
+        std::fprintf(stderr, "warning: MuJoCo: further warnings of this process are not printed\n");
+    };
   });
 }
 

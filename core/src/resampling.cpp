@@ -6,6 +6,11 @@
 
 namespace gpilqg {
 
+namespace {
+/// A time within this share of a step of a grid point is on the grid point.
+constexpr double kOnGrid = 1e-6;
+}  // namespace
+
 std::vector<SampleRange> split_at_gaps(const VectorCRef& t, double max_gap) {
   std::vector<SampleRange> ranges;
   if (t.size() == 0) return ranges;
@@ -24,7 +29,9 @@ std::vector<SampleRange> split_at_gaps(const VectorCRef& t, double max_gap) {
 
 Vector uniform_grid(const VectorCRef& t, double dt) {
   if (t.size() == 0 || !(dt > 0.0)) throw std::invalid_argument("uniform_grid: needs samples and dt > 0");
-  const long steps = static_cast<long>(std::floor((t(t.size() - 1) - t(0)) / dt + 1e-9));
+  // A sample within a millionth of a step of a grid point is on it: a step computed from logged
+  // times (66.600960 s + k 1.6384 ms) carries their rounding, which must not lose the last sample.
+  const long steps = static_cast<long>(std::floor((t(t.size() - 1) - t(0)) / dt + kOnGrid));
   Vector tau(steps + 1);
   for (long k = 0; k <= steps; ++k) tau(k) = t(0) + static_cast<double>(k) * dt;
   return tau;
@@ -32,11 +39,11 @@ Vector uniform_grid(const VectorCRef& t, double dt) {
 
 namespace {
 
-/// The index i of the last sample with t_i <= tau (0 when tau precedes every sample).
-long last_at_or_before(const VectorCRef& t, double tau) {
+/// The index i of the last sample with t_i <= tau + tolerance (0 when tau precedes every sample).
+long last_at_or_before(const VectorCRef& t, double tau, double tolerance = 0.0) {
   const auto* begin = t.data();
   const auto* end = t.data() + t.size();
-  const auto* after = std::upper_bound(begin, end, tau);
+  const auto* after = std::upper_bound(begin, end, tau + tolerance);
   return after == begin ? 0 : static_cast<long>(after - begin) - 1;
 }
 
@@ -59,7 +66,10 @@ Matrix interpolate_linear(const VectorCRef& t, const MatrixCRef& y, const Vector
 
 Matrix hold_zero_order(const VectorCRef& t, const MatrixCRef& y, const VectorCRef& tau) {
   Matrix out(tau.size(), y.cols());
-  for (long k = 0; k < tau.size(); ++k) out.row(k) = y.row(last_at_or_before(t, tau(k)));
+  // A sample within a millionth of the grid's step of tau_k is at tau_k (the rounding of a grid built
+  // from logged times would otherwise hold the previous sample's control at every point).
+  const double tolerance = tau.size() >= 2 ? kOnGrid * (tau(1) - tau(0)) : 0.0;
+  for (long k = 0; k < tau.size(); ++k) out.row(k) = y.row(last_at_or_before(t, tau(k), tolerance));
   return out;
 }
 

@@ -74,6 +74,25 @@ TEST(Resampling, HeldControlsAreTheLastSampleAtOrBefore) {
   EXPECT_EQ(hold_zero_order(t, u, Vector::Constant(1, 0.11))(0, 0), 2);
 }
 
+// A log whose times start far from 0 (a benchmark's 66.600960 s + k 1.6384 ms): the median step and
+// the grid carry the times' rounding, which must neither move a held control to the previous sample
+// nor drop the last one.
+TEST(Resampling, RoundingOfLoggedTimesNeitherDelaysControlsNorDropsSamples) {
+  const long n = 20000;
+  Vector t(n), u(n);
+  for (long i = 0; i < n; ++i) {
+    t(i) = 66.600960 + static_cast<double>(i) * 0.0016384;
+    u(i) = static_cast<double>(i % 7);
+  }
+  for (const double dt : {0.0016383999999902699, 0.0016384, 0.0016384000000097})
+  {
+    const Vector tau = uniform_grid(t, dt);
+    ASSERT_EQ(tau.size(), n) << dt;
+    const Matrix held = hold_zero_order(t, u, tau);
+    for (long i = 0; i < n; ++i) ASSERT_EQ(held(i, 0), u(i)) << "sample " << i << ", dt " << dt;
+  }
+}
+
 TEST(Resampling, AveragedControlsHaveTheImpulseOfTheHeldSignal) {
   const Vector t = (Vector(5) << 0.0, 0.11, 0.19, 0.305, 0.4).finished();
   const Matrix u = (Matrix(5, 1) << 1, 2, 3, 4, 5).finished();

@@ -267,17 +267,7 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
     EffectFit first = joint;
     first.refitted.clear();
     R.added.push_back(first);
-    for (std::size_t i = 1; i < to_fit.size(); ++i) {
-      EffectFit f = first;
-      const EffectValues& v = joint.refitted[i - 1];
-      f.effect = v.effect;
-      f.parameters = v.parameters;
-      f.initial = f.linear_estimate = v.initial;
-      f.estimate = v.estimate;
-      f.ci_low = v.ci_low;
-      f.ci_high = v.ci_high;
-      R.added.push_back(std::move(f));
-    }
+    for (std::size_t i = 1; i < to_fit.size(); ++i) R.added.push_back(led_by(first, joint.refitted[i - 1]));
     R.refitted.assign(joint.refitted.begin() + static_cast<std::ptrdiff_t>(to_fit.size() - 1), joint.refitted.end());
   }
   const auto step = make_step_model(R.model, o.integrator, R.dt, o.substeps);

@@ -110,18 +110,9 @@ Matrix regressor(const EffectSet& set, const VectorCRef& theta, const FitContext
   const auto p = theta.size();
   Matrix J(static_cast<Eigen::Index>(rows.size()) * c.weights.size(), p);
   for (Eigen::Index j = 0; j < p; ++j) {
-    const EffectParameter& spec = set.parameter(j);
-    const double h = 1e-4 * std::max(std::abs(theta(j)), spec.scale);
-    Vector plus = theta, minus = theta;
-    plus(j) += h;
-    minus(j) -= h;
-    double width = 2.0 * h;
-    if (minus(j) < spec.lower) {
-      minus(j) = theta(j);
-      width = h;
-    }
+    const DifferenceStep d = difference_step(set.parameter(j), theta, j);
     // The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
-    J.col(j) = (weighted_residual_at(set, minus, c, rows) - weighted_residual_at(set, plus, c, rows)) / width;
+    J.col(j) = (weighted_residual_at(set, d.minus, c, rows) - weighted_residual_at(set, d.plus, c, rows)) / d.width;
   }
   return J;
 }
@@ -244,6 +235,33 @@ std::pair<Vector, Vector> confidence_interval(const EffectSet& set, const Vector
 }
 
 }  // namespace
+
+DifferenceStep difference_step(const EffectParameter& spec, const Vector& theta, Eigen::Index j) {
+  const double h = 1e-4 * std::max(std::abs(theta(j)), spec.scale);
+  DifferenceStep d{theta, theta, 2.0 * h};
+  d.plus(j) += h;
+  d.minus(j) -= h;
+  if (d.minus(j) < spec.lower) {
+    d.minus(j) = theta(j);
+    d.width = h;
+  }
+  return d;
+}
+
+EffectFit led_by(EffectFit fit, const EffectValues& values) {
+  fit.effect = values.effect;
+  fit.parameters = values.parameters;
+  fit.initial = fit.linear_estimate = values.initial;
+  fit.estimate = values.estimate;
+  fit.ci_low = values.ci_low;
+  fit.ci_high = values.ci_high;
+  fit.smoothing = values.smoothing;
+  return fit;
+}
+
+EffectValues own_values(const EffectFit& fit) {
+  return {fit.effect, fit.parameters, fit.initial, fit.estimate, fit.ci_low, fit.ci_high, fit.smoothing};
+}
 
 Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows) {
   const auto step = make_step_model(model, settings.integrator, settings.dt, settings.substeps);

@@ -37,20 +37,11 @@ std::pair<Matrix, Matrix> columns(const ModelSpec& base, const Split& r0, const 
     return {JT, JH};
   }
   for (Eigen::Index j = 0; j < p; ++j) {
-    const EffectParameter& spec = effect.parameters[static_cast<std::size_t>(j)];
-    const double h = 1e-4 * std::max(std::abs(theta0(j)), spec.scale);
-    Vector plus = theta0, minus = theta0;
-    plus(j) += h;
-    minus(j) -= h;
-    double width = 2.0 * h;
-    if (minus(j) < spec.lower) {
-      minus(j) = theta0(j);
-      width = h;
-    }
-    const Split a = residual_split(base.with(effect, minus), c, train, heldout);
-    const Split b = residual_split(base.with(effect, plus), c, train, heldout);
-    JT.col(j) = (a.train - b.train) / width;
-    JH.col(j) = (a.heldout - b.heldout) / width;
+    const DifferenceStep d = difference_step(effect.parameters[static_cast<std::size_t>(j)], theta0, j);
+    const Split a = residual_split(base.with(effect, d.minus), c, train, heldout);
+    const Split b = residual_split(base.with(effect, d.plus), c, train, heldout);
+    JT.col(j) = (a.train - b.train) / d.width;
+    JH.col(j) = (a.heldout - b.heldout) / d.width;
   }
   return {JT, JH};
 }

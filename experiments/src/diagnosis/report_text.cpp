@@ -242,10 +242,19 @@ void selection_section(const DiagnosisReport& r, std::string& out) {
              ? "\n3b. Several effects (--auto): the best set of each size on the held-out episodes, every set fitted jointly\n"
              : "\n3b. Several effects (--auto): forward selection, every step refitting the chosen effects jointly\n";
   int k = 1;
+  // The effects of the step before (the model's own at first): a step may bring several new ones.
+  std::vector<std::string> before;
+  const std::vector<LibraryEffect> candidates = candidate_effects(r.model);
+  for (const RefitEffect& e : model_effects(r.model, candidates)) before.push_back(e.effect->name);
   for (const SelectionStep& step : r.selection->steps) {
     const EffectFit& f = step.fit;
     out += fmt::format("   step {}: + {}: {}\n", k++, f.effect, parameter_text(f, true));
-    for (const EffectValues& v : f.refitted) out += fmt::format("           refitted {}: {}\n", v.effect, parameter_text(v));
+    for (const EffectValues& v : f.refitted) {
+      const bool had = std::find(before.begin(), before.end(), v.effect) != before.end();
+      out += fmt::format(had ? "           refitted {}: {}\n" : "         + {}: {}\n", v.effect, parameter_text(v));
+    }
+    before = {f.effect};
+    for (const EffectValues& v : f.refitted) before.push_back(v.effect);
     for (const std::string& name : step.removed)
       out += fmt::format("           removed {}\n", name);
     out += fmt::format("           removes {} +- {} of the held-out residual left (z = {:.1f}); held-out rmse:", percent(f.explained),

@@ -162,16 +162,9 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
         if (std::find(accepted.begin(), accepted.end(), name) != accepted.end()) continue;
         const bool from_m0 = std::any_of(present.begin(), present.end(), [&](const RefitEffect& r) { return r.effect->name == name; });
         if (from_m0) continue;
-        EffectValues lead{best.effect, best.parameters, best.initial, best.estimate, best.ci_low, best.ci_high, best.smoothing};
-        const EffectValues swap = best.refitted[i];
+        const EffectValues lead = own_values(best), swap = best.refitted[i];
         best.refitted[i] = lead;
-        best.effect = swap.effect;
-        best.parameters = swap.parameters;
-        best.initial = best.linear_estimate = swap.initial;
-        best.estimate = swap.estimate;
-        best.ci_low = swap.ci_low;
-        best.ci_high = swap.ci_high;
-        best.smoothing = swap.smoothing;
+        best = led_by(std::move(best), swap);
         break;
       }
     }

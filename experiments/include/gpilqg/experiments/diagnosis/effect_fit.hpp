@@ -112,6 +112,22 @@ struct EffectFit {
   std::vector<EffectValues> refitted;
 };
 
+/// `fit` with the values of `values` (one effect of its joint fit) as its own effect's: its name,
+/// parameters, start, estimate, interval and smoothing; the scores stay those of the joint fit.
+EffectFit led_by(EffectFit fit, const EffectValues& values);
+
+/// The values of `fit`'s own effect, as one entry of a joint fit.
+EffectValues own_values(const EffectFit& fit);
+
+/// The central-difference step of parameter j of theta (spec its parameter): theta -+ h e_j with
+/// h = 1e-4 max(|theta_j|, spec.scale), one-sided (theta itself as `minus`) when the lower point would
+/// leave the physical range. The derivative is (f(plus) - f(minus)) / width.
+struct DifferenceStep {
+  Vector minus, plus;
+  double width = 0.0;
+};
+DifferenceStep difference_step(const EffectParameter& spec, const Vector& theta, Eigen::Index j);
+
 /// Fits one effect (steps 1-4 above). Never returns NaN: an effect without influence on the data
 /// (J = 0) keeps theta_0, identifiable = false and explained = 0.
 EffectFit fit_effect(const LibraryEffect& effect, const FitContext& context);
