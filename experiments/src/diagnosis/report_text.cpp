@@ -251,7 +251,7 @@ void selection_section(const DiagnosisReport& r, std::string& out) {
     out += fmt::format("   step {}: + {}: {}\n", k++, f.effect, parameter_text(f, true));
     for (const EffectValues& v : f.refitted) {
       const bool had = std::find(before.begin(), before.end(), v.effect) != before.end();
-      out += fmt::format(had ? "           refitted {}: {}\n" : "         + {}: {}\n", v.effect, parameter_text(v));
+      out += fmt::format("         {} {}: {}\n", had ? "  refitted" : "+", v.effect, parameter_text(v));
     }
     before = {f.effect};
     for (const EffectValues& v : f.refitted) before.push_back(v.effect);
