@@ -143,17 +143,21 @@ MeasurementSet friction_record(double mu, std::uint64_t seed) {
   return simulate_measurements(system, settings).set;
 }
 
+/// The friction of 1 N is named, fitted within 15%, and explains more than 30% of the held-out residual.
+void expect_friction_found(const diagnosis::DiagnosisReport& r) {
+  ASSERT_EQ(r.verdict.status, "explained") << r.verdict.reason;
+  ASSERT_EQ(r.verdict.effect->effect, "cart_coulomb_friction");
+  EXPECT_NEAR(r.verdict.effect->estimate(0), 1.0, 0.15);
+  const int worst = diagnosis::worst_state(r);
+  EXPECT_LT(r.verdict.effect->heldout_rmse_after(worst), 0.8 * r.verdict.effect->heldout_rmse_before(worst));
+  EXPECT_GT(r.verdict.effect->explained, 0.3);
+}
+
 // The multi-episode tests' seeds and tolerance (diagnosis_test.cpp): named, within 15%, error falls.
 TEST(HeldoutBlocks, OneRecordWithHiddenFrictionIsFoundLikeInEpisodes) {
   for (std::uint64_t seed : {22, 33}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    const diagnosis::DiagnosisReport r = diagnosis::diagnose(friction_record(1.0, seed), test::fast_options("cartpole"));
-    ASSERT_EQ(r.verdict.status, "explained") << r.verdict.reason;
-    ASSERT_EQ(r.verdict.effect->effect, "cart_coulomb_friction");
-    EXPECT_NEAR(r.verdict.effect->estimate(0), 1.0, 0.15);
-    const int worst = diagnosis::worst_state(r);
-    EXPECT_LT(r.verdict.effect->heldout_rmse_after(worst), 0.8 * r.verdict.effect->heldout_rmse_before(worst));
-    EXPECT_GT(r.verdict.effect->explained, 0.3);
+    expect_friction_found(diagnosis::diagnose(friction_record(1.0, seed), test::fast_options("cartpole")));
   }
 }
 
@@ -165,12 +169,7 @@ TEST(HeldoutBlocks, OneRecordWithHiddenFrictionIsDiagnosedPerBlock) {
   EXPECT_EQ(r.blocks->gap, 50);
   EXPECT_EQ(r.heldout_episode_index, (std::vector<int>{3, 6, 9}));
   EXPECT_EQ(r.heldout_episode_ids, (std::vector<long>{3, 6, 9}));
-  ASSERT_EQ(r.verdict.status, "explained") << r.verdict.reason;
-  ASSERT_EQ(r.verdict.effect->effect, "cart_coulomb_friction");
-  EXPECT_NEAR(r.verdict.effect->estimate(0), 1.0, 0.15);
-  const int worst = diagnosis::worst_state(r);
-  EXPECT_LT(r.verdict.effect->heldout_rmse_after(worst), 0.8 * r.verdict.effect->heldout_rmse_before(worst));
-  EXPECT_GT(r.verdict.effect->explained, 0.3);
+  expect_friction_found(r);
   // Blocks of 1200 / 10 = 120 samples, 5 gaps of 50 samples dropped, one transition fewer than samples per block.
   EXPECT_EQ(r.samples, 1200 - 5 * 50 - 10);
   // Every step per block: the free run of each held-out block, residual per block.
