@@ -107,6 +107,10 @@ TEST(HostileLimits, TheCommandLineNamesTheOptionOrReportsTheDivergence) {
       {"data info " + quote(latin1) + " --system cartpole --json", 2,
        "error: FILE '" + (dir / "m\\xe9sures.csv").string() +
            "': is not valid UTF-8; expected UTF-8 names with --json (JSON output holds only UTF-8 text)"},
+      // diagnose --out stores its report as a JSON attribute: the same rule.
+      {"diagnose --system cartpole --data " + quote(latin1) + " --out " + quote(dir / "report.h5"), 2,
+       "error: --data '" + (dir / "m\\xe9sures.csv").string() +
+           "': is not valid UTF-8; expected UTF-8 names with --out (JSON output holds only UTF-8 text)"},
   };
   // A run whose sensor noise puts the measured states where the simulator diverges.
   std::string noisy = test::kTinyRun;
