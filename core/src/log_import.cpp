@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 
+#include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/resampling.hpp"
 #include "gpilqg/core/savitzky_golay.hpp"
 
@@ -219,6 +220,21 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
       }
   }
   if (!std::isfinite(report.step_min)) report.step_min = 0.0;
+
+  // The resampled length, checked against the sample limit before any grid is allocated (a step
+  // of 1e-7 s over a few seconds of log would be gigabytes).
+  double grid_samples = 0.0;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (const SampleRange& r : pieces[g])
+      grid_samples += uniform_grid_size(group_times[g].segment(r.begin, r.size()), report.dt);
+  if (grid_samples > static_cast<double>(limits::kMaxSamples)) {
+    MapOrigin origin = map.resample_section;
+    origin.field = "resample.dt";
+    map_error(origin,
+              fmt::format("{} s{} resamples the log's {} rows to {:.0f} samples", report.dt,
+                          map.dt ? "" : " (the log's median step)", rows, grid_samples),
+              fmt::format("at most {} samples (the sample limit); a larger step", limits::kMaxSamples));
+  }
 
   // 4-6. Resample each piece, estimate velocities, keep or drop.
   std::optional<SavitzkyGolayDerivative> differentiator;

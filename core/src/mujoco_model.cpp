@@ -149,6 +149,12 @@ std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
   // One extra userdata slot per mjData holds the passive-force context of the step (mujoco_system.cpp).
   m->nuserdata += 1;
   std::shared_ptr<MujocoModel> model(new MujocoModel(m, path));
+  // MuJoCo accepts timestep="0"; every step length derived from it would be NaN or infinite.
+  if (!(std::isfinite(m->opt.timestep) && m->opt.timestep > 0.0))
+    throw std::invalid_argument(fmt::format(
+        "{}: <option timestep=\"{}\">: the model's timestep is {} s; expected a finite value > 0 (the length of one "
+        "MuJoCo step)",
+        path, m->opt.timestep, m->opt.timestep));
   for (int j = 0; j < m->njnt; ++j) {
     const std::string name = object_name(m, mjOBJ_JOINT, j);
     const int type = m->jnt_type[j];

@@ -9,6 +9,7 @@
 
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
+#include "gpilqg/core/utf8.hpp"
 #include "name_list.hpp"
 
 namespace gpilqg {
@@ -60,6 +61,12 @@ RawLog read_raw_log(const std::filesystem::path& file) {
   else if (extension == ".h5" || extension == ".hdf5") log = read_raw_log_hdf5(file);
   else
     throw DataError(file, "", fmt::format("unknown extension '{}'", extension), "a log ending in .csv, .mat, .h5 or .hdf5");
+  // Column names reach the import report (and its JSON): names that are not UTF-8 are refused
+  // here, for every format, with their bytes shown escaped.
+  for (const LogColumn& column : log.columns)
+    if (!is_valid_utf8(column.name))
+      throw DataError(file, log.location(escaped_bytes(column.name)), "the column's name is not valid UTF-8",
+                      "column names in UTF-8");
   const bool any_usable =
       std::any_of(log.columns.begin(), log.columns.end(), [](const LogColumn& c) { return c.unusable.empty(); });
   if (!any_usable)

@@ -27,11 +27,16 @@ std::vector<SampleRange> split_at_gaps(const VectorCRef& t, double max_gap) {
   return ranges;
 }
 
+double uniform_grid_size(const VectorCRef& t, double dt) {
+  if (t.size() == 0 || !(dt > 0.0)) throw std::invalid_argument("uniform_grid_size: needs samples and dt > 0");
+  return std::floor((t(t.size() - 1) - t(0)) / dt + kOnGrid) + 1.0;
+}
+
 Vector uniform_grid(const VectorCRef& t, double dt) {
   if (t.size() == 0 || !(dt > 0.0)) throw std::invalid_argument("uniform_grid: needs samples and dt > 0");
   // A sample within a millionth of a step of a grid point is on it: a step computed from logged
   // times (66.600960 s + k 1.6384 ms) carries their rounding, which must not lose the last sample.
-  const long steps = static_cast<long>(std::floor((t(t.size() - 1) - t(0)) / dt + kOnGrid));
+  const long steps = static_cast<long>(uniform_grid_size(t, dt)) - 1;
   Vector tau(steps + 1);
   for (long k = 0; k <= steps; ++k) tau(k) = t(0) + static_cast<double>(k) * dt;
   return tau;

@@ -4,9 +4,41 @@
 #include <chrono>
 #include <stdexcept>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/gp/noise_floor.hpp"
 
 namespace gpilqg {
+
+namespace {
+
+/// The residual targets and the GP's noise floor are the simulator's step at the measured inputs,
+/// states that carry the sensor noise. Where that step is not finite (the noise put a measured state
+/// where the simulator diverges) there is nothing to learn; the culprit is the config's sensor noise,
+/// `noise.observation` (of `gpilqg run` and `gpilqg plan` alike), named with its values.
+void check_finite_at_measurements(const gp::ResidualData& all, const Vector& floor, const Vector& observation_std) {
+  int bad = 0, first = -1;
+  for (int r = 0; r < all.size(); ++r)
+    if (!all.residuals.row(r).allFinite()) {
+      if (first < 0) first = r;
+      ++bad;
+    }
+  if (bad == 0 && floor.allFinite()) return;
+  const std::string where =
+      bad > 0 ? fmt::format("the simulator's step is not finite at {} of {} measured inputs (the first: z = [{:.3g}])",
+                            bad, all.size(), fmt::join(all.inputs.row(first), ", "))
+              : "the simulator's Jacobian is not finite at the measured inputs";
+  const bool noisy = observation_std.size() > 0 && (observation_std.array() > 0.0).any();
+  throw InputError(fmt::format(
+      "{}{}, so the GP's residual targets and noise floor are not finite; expected {}",
+      noisy ? fmt::format("field 'noise.observation' = [{:g}]: ", fmt::join(observation_std, ", ")) : "", where,
+      noisy ? "sensor noise small against the states, so that measured states stay where the simulator is finite"
+            : "measurements where the simulator is finite"));
+}
+
+}  // namespace
 
 GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const StepModel>& simulator,
                            const GpRoundInputs& in) {
@@ -33,6 +65,7 @@ GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const Step
   options.fit = in.fit;
   options.threads = std::max(1, in.threads);
   options.noise_floor = gp::sensor_noise_floor(*simulator, all, in.observation_std);
+  check_finite_at_measurements(all, options.noise_floor, in.observation_std);
   round.noise_floor = options.noise_floor;
   auto model = std::make_shared<const gp::ResidualModel>(gp::ResidualModel::fit(
       simulator, all, *in.backend, options, nullptr, previous != nullptr ? &validation : nullptr, previous));

@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "commands/json_arguments.hpp"
 #include "commands/commands.hpp"
 #include "gpilqg/core/plugin.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -101,6 +102,7 @@ int main(int argc, char** argv) {
   }
   return gpilqg::run_reporting_errors(
       [&] {
+        gpilqg::cli::check_json_arguments(app);
         gpilqg::load_plugins(plugins);
         return action();
       },

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "gpilqg/experiments/profile.hpp"
@@ -76,6 +77,29 @@ double exact_memory_bytes(std::int64_t n, bool fitted) {
   return (fitted ? 16.0 : 8.0) * static_cast<double>(n) * static_cast<double>(n);
 }
 
+std::optional<RowMemory> profile_row_memory(const ProfileCase& c, const ProfileOptions& options) {
+  const double n = static_cast<double>(c.size);
+  const double workers = std::max(1, options.settings.threads);
+  if (c.backend == "exact" || c.backend == "exact_reference") {
+    const bool fitted = c.backend == "exact";
+    return RowMemory{exact_memory_bytes(c.size, fitted),
+                     fmt::format("the dense exact GP at N = {} ({} N x N matrices)", c.size, fitted ? 2 : 1)};
+  }
+  if (c.backend == "fitc") {
+    const double m = std::min<double>(options.settings.inducing, n);
+    return RowMemory{8.0 * (4.0 * n * m + (6.0 + 2.0 * workers) * m * m),
+                     fmt::format("FITC at N = {} with M = {} inducing points (4 M x N and {} M x M matrices)", c.size,
+                                 static_cast<long>(m), 6 + 2 * static_cast<long>(workers))};
+  }
+  if (c.backend == "ssgp") {
+    const double m = 2.0 * options.settings.frequencies;
+    return RowMemory{8.0 * (2.0 * n * m + (4.0 + workers) * m * m),
+                     fmt::format("SSGP at N = {} with {} frequencies (2 N x 2M and {} 2M x 2M matrices)", c.size,
+                                 options.settings.frequencies, 4 + static_cast<long>(workers))};
+  }
+  return std::nullopt;
+}
+
 ProfileRowWork profile_row_work(const ProfileCase& c, const gp::TrainingSet& subset, int test_points,
                                 const ProfileOptions& options, const gp::FitOptions& fit) {
   const double n = c.size, d = subset.input_dim(), t = test_points;
@@ -93,8 +117,8 @@ ProfileRowWork profile_row_work(const ProfileCase& c, const gp::TrainingSet& sub
   } else if (c.backend == "fitc" || c.backend == "ssgp") {
     const bool fitc = c.backend == "fitc";
     const double m = fitc ? std::min<double>(options.settings.inducing, n) : 2.0 * options.settings.frequencies;
-    work.per_evaluation = (fitc ? 12.0 : 3.0) * n * m * m + 2.0 * n * m * (3.0 * d + 20.0);
-    work.final = 4.0 * n * m * m + t * (m * m + m * (3.0 * d + 20.0));
+    work.per_evaluation = (fitc ? 12.0 : 3.0) * n * m * m + 2.0 * n * m * (3.0 * d + 20.0) + 7.0 * m * m * m / 3.0;
+    work.final = 4.0 * n * m * m + m * m * m / 3.0 + t * (m * m + m * (3.0 * d + 20.0));
     work.what = fmt::format("{}: {} flops per evaluation", fitc ? "FITC" : "SSGP", flops_text(work.per_evaluation));
   } else if (c.backend == "compact") {
     compact_work(subset, test_points, options, fit, work);
@@ -104,12 +128,12 @@ ProfileRowWork profile_row_work(const ProfileCase& c, const gp::TrainingSet& sub
 
 std::string profile_skip_reason(const ProfileCase& c, const gp::TrainingSet& subset, int test_points,
                                 const ProfileOptions& options, const gp::FitOptions& fit) {
-  if (c.backend == "exact" || c.backend == "exact_reference") {
-    const bool fitted = c.backend == "exact";
-    const double need = exact_memory_bytes(c.size, fitted);
-    if (need > options.memory_budget_bytes)
-      return fmt::format("the dense exact GP needs {:.2f} GiB at N = {} ({} N x N matrices), over the budget of {:.2f} GiB",
-                         need / (1ull << 30), c.size, fitted ? 2 : 1, options.memory_budget_bytes / (1ull << 30));
+  if (const std::optional<RowMemory> memory = profile_row_memory(c, options);
+      memory && memory->bytes > options.memory_budget_bytes) {
+    const std::string& what = memory->what;
+    const auto at = what.find(" (");  // "<model> needs X GiB (<matrices>)": the size before the matrices
+    return fmt::format("{} needs {:.2f} GiB{}, over the budget of {:.2f} GiB", what.substr(0, at),
+                       memory->bytes / (1ull << 30), what.substr(at), options.memory_budget_bytes / (1ull << 30));
   }
   const double budget = options.time_budget_seconds;
   if (!(budget > 0.0)) return {};

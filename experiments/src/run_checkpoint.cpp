@@ -92,28 +92,44 @@ RunCheckpoint RunCheckpoint::resume(const std::filesystem::path& folder, const R
   if (!std::filesystem::exists(manifest))
     throw std::invalid_argument(fmt::format("{}: no checkpoint to resume from (expected {}); run without --resume to start",
                                          folder.string(), manifest.string()));
-  const Hdf5Reader h5(manifest);
-  const auto version = static_cast<std::int64_t>(h5.number_attribute("/", "format_version"));
-  if (version != kFormatVersion)
-    throw std::runtime_error(fmt::format("{}: checkpoint format_version {}, this program reads {}", manifest.string(), version,
-                                         kFormatVersion));
+  // What the manifest holds; a manifest that cannot be read (truncated, not HDF5, an attribute
+  // missing or of another type) is a damaged checkpoint, reported as bad input with the way out.
+  struct Stored {
+    std::int64_t version = 0, iterations = 0;
+    std::string system, config;
+    std::vector<std::string> seeds, backends;
+  } stored;
+  try {
+    const Hdf5Reader h5(manifest);
+    stored.version = static_cast<std::int64_t>(h5.number_attribute("/", "format_version"));
+    stored.system = h5.string_attribute("/", "system");
+    stored.config = h5.string_attribute("/", "config");
+    stored.iterations = static_cast<std::int64_t>(h5.number_attribute("/", "iterations"));
+    stored.seeds = h5.string_list_attribute("/", "seeds");
+    stored.backends = h5.string_list_attribute("/", "backends");
+  } catch (const std::exception& e) {
+    std::string reason = e.what();
+    if (reason.rfind(manifest.string(), 0) == 0) reason.erase(0, reason.find_first_not_of(": ", manifest.string().size()));
+    throw std::invalid_argument(fmt::format("{}: the checkpoint is damaged, its manifest cannot be read ({}); delete the "
+                                            "folder {} to start the run over",
+                                            manifest.string(), reason, folder.string()));
+  }
+  if (stored.version != kFormatVersion)
+    throw std::runtime_error(fmt::format("{}: checkpoint format_version {}, this program reads {}", manifest.string(),
+                                         stored.version, kFormatVersion));
   const Identity want = identity_of(config, options);
-  std::vector<std::string> stored_backends = h5.string_list_attribute("/", "backends");
-  if (stored_backends == std::vector<std::string>{""}) stored_backends.clear();
-  const auto mismatch = [&](const std::string& field, const std::string& stored, const std::string& requested) {
+  if (stored.backends == std::vector<std::string>{""}) stored.backends.clear();
+  const auto mismatch = [&](const std::string& field, const std::string& stored_value, const std::string& requested) {
     return std::invalid_argument(fmt::format("{}: the checkpoint was made with {} {}, this run asks for {}; resume with the "
                                           "same arguments, or delete the folder to start over",
-                                          manifest.string(), field, stored, requested));
+                                          manifest.string(), field, stored_value, requested));
   };
-  if (h5.string_attribute("/", "system") != want.system) throw mismatch("system", h5.string_attribute("/", "system"), want.system);
-  if (h5.string_attribute("/", "config") != want.config)
-    throw mismatch("a different config", "(stored in its 'config' attribute)", "this one");
-  const auto iterations = static_cast<std::int64_t>(h5.number_attribute("/", "iterations"));
-  if (iterations != want.iterations)
-    throw mismatch("iterations", std::to_string(iterations), std::to_string(want.iterations));
-  const auto seeds = h5.string_list_attribute("/", "seeds");
-  if (seeds != want.seeds) throw mismatch("seeds", list_text(seeds), list_text(want.seeds));
-  if (stored_backends != want.backends) throw mismatch("backends", list_text(stored_backends), list_text(want.backends));
+  if (stored.system != want.system) throw mismatch("system", stored.system, want.system);
+  if (stored.config != want.config) throw mismatch("a different config", "(stored in its 'config' attribute)", "this one");
+  if (stored.iterations != want.iterations)
+    throw mismatch("iterations", std::to_string(stored.iterations), std::to_string(want.iterations));
+  if (stored.seeds != want.seeds) throw mismatch("seeds", list_text(stored.seeds), list_text(want.seeds));
+  if (stored.backends != want.backends) throw mismatch("backends", list_text(stored.backends), list_text(want.backends));
   return RunCheckpoint(folder);
 }
 

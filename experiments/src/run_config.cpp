@@ -1,5 +1,6 @@
 #include "gpilqg/experiments/run_config.hpp"
 
+#include <cctype>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -9,12 +10,31 @@
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/system_registry.hpp"
+#include "gpilqg/core/utf8.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
 #include "gpilqg/gp/fitted_moment_matcher.hpp"
 
 namespace gpilqg {
 namespace {
+
+/// Why `name` cannot name a task, or "": a task is the root group `/<name>` of the result file
+/// (docs/formats.md), so its name must be a valid HDF5 link name of that group: non-empty, UTF-8,
+/// without '/', whitespace or control characters, neither "." nor ".." (HDF5 reads "." as the
+/// group itself) nor a name the root already holds (the dataset `/seeds`).
+std::string task_name_problem(const std::string& name) {
+  constexpr const char* kRule =
+      "expected a non-empty name without '/', whitespace or control characters, not '.', '..' or 'seeds' (it "
+      "names the task's HDF5 group /<name> in the result file)";
+  if (name.empty()) return fmt::format("is empty; {}", kRule);
+  if (name == "." || name == ".." || name == "seeds")
+    return fmt::format("'{}' is reserved by the result file's layout; {}", name, kRule);
+  for (const char c : name)
+    if (c == '/' || std::isspace(static_cast<unsigned char>(c)) || std::iscntrl(static_cast<unsigned char>(c)))
+      return fmt::format("'{}' holds {}; {}", escaped_bytes(name), c == '/' ? "'/'" : "whitespace or a control character", kRule);
+  if (!is_valid_utf8(name)) return fmt::format("'{}' is not valid UTF-8; {}", escaped_bytes(name), kRule);
+  return {};
+}
 
 /// Reads the [[tasks]] array: at least one task, every field present (a replaced array has no
 /// defaults to fall back on), names unique.
@@ -28,8 +48,7 @@ std::vector<RunTask> read_tasks(const TomlFields& f, const toml::table& root, in
     f.only_keys(p, {"name", "x0", "goal", "horizon", "Q", "R", "Qf", "track_line", "transfer"});
     RunTask t;
     t.name = f.string(p + ".name");
-    if (t.name.empty() || t.name.find_first_of("/ ") != std::string::npos)
-      f.fail(p + ".name", "must be non-empty without '/' or spaces (it names an HDF5 group)");
+    if (const std::string problem = task_name_problem(t.name); !problem.empty()) f.fail(p + ".name", problem);
     for (const auto& earlier : out)
       if (earlier.name == t.name) f.fail(p + ".name", fmt::format("'{}' is used by two tasks", t.name));
     t.x0 = f.state_vector(p + ".x0", n);

@@ -152,8 +152,7 @@ SyntheticData simulate_measurements(const DynamicsPtr& system, const ExcitationS
     out.set.episodes.push_back(std::move(episode));
   }
   if (out.set.episodes.empty())
-    throw std::invalid_argument("every simulated episode diverged before its second sample; "
-                                "reduce 'control_amplitude' or 'dt'");
+    throw ExcitationDiverged("every simulated episode diverged before its second sample");
   return out;
 }
 

@@ -338,5 +338,21 @@ TEST(ImportLog, ErrorsNameTheMapLineOrTheLogRow) {
   EXPECT_NE(e6.find("'n/a'"), std::string::npos) << e6;
 }
 
+/// A resampling step that turns a short log into more samples than the sample limit is refused,
+/// naming the field and the count, before the grid is allocated.
+TEST(ImportLog, ResamplingBeyondTheSampleLimitIsRefusedBeforeAllocation) {
+  LogMap map = cartpole_map(true);
+  map.resample_section = {"map.toml", 12, "resample"};
+  map.dt = 1e-7;
+  map.max_gap = 1.0;
+  const std::string e = import_error(cartpole_log(240, 0.01), map);
+  EXPECT_NE(e.find("map.toml:line 12: field 'resample.dt': 1e-07 s resamples the log's 240 rows to 23900001 samples; "
+                   "expected at most 10000000 samples"),
+            std::string::npos)
+      << e;
+  map.dt = 1e-5;  // 239,001 samples: within the limit
+  EXPECT_EQ(import_log(cartpole_log(240, 0.01), map, system_signature("cartpole")).report.samples_written, 239001);
+}
+
 }  // namespace
 }  // namespace gpilqg

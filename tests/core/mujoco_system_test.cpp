@@ -260,6 +260,10 @@ TEST(MujocoSystem, BadModelsAreRefusedWithWhatIsWrong) {
                                                                "</body></worldbody></mujoco>\n"));
   EXPECT_NE(parse.find("model.xml: MuJoCo cannot load the model"), std::string::npos) << parse;
   EXPECT_NE(parse.find("line 4"), std::string::npos) << parse;
+  const std::string hinge = "<joint name=\"j\" type=\"hinge\"/>" + body_close + "</mujoco>";
+  const std::string zero = write_model("mj_timestep", "<mujoco><option timestep=\"0\"/><worldbody><body name=\"b\">" + hinge);
+  EXPECT_EQ(load_error(zero), zero + ": <option timestep=\"0\">: the model's timestep is 0 s; expected a finite value > 0 "
+                                     "(the length of one MuJoCo step)");
   EXPECT_NE(load_error("/nonexistent/model.xml").find("/nonexistent/model.xml: no such file; expected a MuJoCo model"), std::string::npos);
   const auto arm = MujocoSystem::load(arm_path());
   try {

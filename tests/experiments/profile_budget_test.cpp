@@ -81,6 +81,32 @@ TEST(ProfileBudget, ARowPredictedOverTheBudgetIsSkippedWithItsReasonAndNoFit) {
             "condition and predict, at 1e-06 GFLOP/s)");
 }
 
+TEST(ProfileBudget, EveryBackendsOwnSizesCountInTheMemoryAndTimeBudgets) {
+  // Constant targets: a row that comes back skipped was never fitted (the fit would refuse them).
+  const ProfileData data = synthetic(50, 20, 2, true);
+  // SSGP with 4096 frequencies on 50 points: its 8192 x 8192 matrices, not N, set the cost.
+  ProfileOptions ssgp = options_for("ssgp", 5.0, 1e11);
+  ssgp.settings.frequencies = 4096;
+  ssgp.memory_budget_bytes = 1.0 * (1ull << 30);
+  EXPECT_EQ(run_profile_case("synthetic.h5", data, ssgp, {"ssgp", 50}).reason,
+            "SSGP at N = 50 with 4096 frequencies needs 2.51 GiB (2 N x 2M and 5 2M x 2M matrices), over the budget "
+            "of 1.00 GiB");
+  ssgp.memory_budget_bytes = 4.0 * (1ull << 30);
+  const ProfileRow slow = run_profile_case("synthetic.h5", data, ssgp, {"ssgp", 50});
+  EXPECT_EQ(slow.status, "skipped");
+  EXPECT_EQ(slow.reason.rfind("predicted ", 0), 0u) << slow.reason;  // the 8192^3 Cholesky per evaluation
+  EXPECT_NE(slow.reason.find("SSGP: 1.3e12 flops per evaluation"), std::string::npos) << slow.reason;
+  // FITC: 10,000 inducing points are capped at N; at N = 20,000 its M x N and M x M matrices count.
+  ProfileOptions fitc = options_for("fitc", 0.0, 0.0);
+  fitc.settings.inducing = 10000;
+  const ProfileCase big{"fitc", 20000};
+  const std::optional<RowMemory> memory = profile_row_memory(big, fitc);
+  ASSERT_TRUE(memory.has_value());
+  EXPECT_EQ(memory->bytes, 8.0 * (4.0 * 20000 * 10000 + 8.0 * 10000.0 * 10000));
+  EXPECT_EQ(profile_row_memory({"fitc", 50}, fitc)->bytes, 8.0 * (4.0 * 50 * 50 + 8.0 * 50 * 50));
+  EXPECT_FALSE(profile_row_memory({"compact", 50}, fitc).has_value());
+}
+
 TEST(ProfileBudget, TheCompactPredictionComesFromCholmodsSymbolicAnalysis) {
   const ProfileData data = synthetic(400, 30, 17);
   const ProfileOptions options = options_for("compact", 1.0, 1e6);

@@ -30,6 +30,13 @@ extern char** environ;
 namespace gpilqg {
 namespace {
 
+std::string read_file_bytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
 RunConfig tiny_config() { return parse_run_config("cartpole", test::kTinyRun, "tiny.toml"); }
 
 RunOptions two_seeds() {
@@ -108,6 +115,30 @@ TEST(RunResume, ACheckpointServesOnlyTheRunItWasMadeFor) {
   EXPECT_NE(message_of(more_iterations, two_seeds()).find("iterations 2, this run asks for 5"), std::string::npos);
   const RunConfig other_config = parse_run_config("cartpole", std::string(test::kTinyRun) + "[control]\nu_max = [9.0]\n", "t.toml");
   EXPECT_NE(message_of(other_config, two_seeds()).find("a different config"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(RunResume, ADamagedManifestIsReportedAsADamagedCheckpointWithTheWayToStartOver) {
+  const auto dir = test::temporary_dir("run_resume_damaged");
+  const auto folder = dir / "r.h5.checkpoint";
+  const RunConfig config = tiny_config();
+  RunCheckpoint::create(folder, config, two_seeds());
+  const auto manifest = folder / "manifest.h5";
+  const std::string whole = read_file_bytes(manifest);
+  const std::vector<std::pair<std::string, std::string>> damages = {
+      {"truncated", whole.substr(0, whole.size() / 2)}, {"garbage", std::string(4096, '\x5a')}, {"empty", ""}};
+  for (const auto& [name, bytes] : damages) {
+    SCOPED_TRACE(name);
+    std::ofstream(manifest, std::ios::binary | std::ios::trunc) << bytes;
+    try {
+      RunCheckpoint::resume(folder, config, two_seeds());
+      ADD_FAILURE() << "a damaged manifest was accepted";
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(manifest.string() + ": the checkpoint is damaged, its manifest cannot be read (", 0), 0u) << what;
+      EXPECT_NE(what.find("); delete the folder " + folder.string() + " to start the run over"), std::string::npos) << what;
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 

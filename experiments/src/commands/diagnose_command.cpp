@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "json_arguments.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "option_checks.hpp"
 #include "output_options.hpp"
@@ -150,7 +151,7 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--search", r.search, "How --auto searches: subsets (every set of up to 4 effects) or forward")
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the report");
-  cmd->add_option("--out", o->out, "Write the HDF5 report here");
+  writes_json(cmd->add_option("--out", o->out, "Write the HDF5 report here"));  // its report attribute is JSON
   cmd->add_option("--plots", o->plots, "Write PNG plots into this folder (needs matplotlib and h5py)");
   cmd->add_option("--write-model", o->write_model, "Write the improved model (TOML) for the next diagnosis");
   cmd->add_option("--integrator", r.integrator, "rk4 or euler")->capture_default_str();

@@ -201,7 +201,8 @@ void add_profile_command(CLI::App& app, CommandAction& action) {
       ->capture_default_str()
       ->check(integer_in(0, limits::kMaxSamples));
   cmd->add_option("--memory-budget-gb", o->memory_budget_gb,
-                  "Skip exact-GP sizes whose dense N x N matrices (16 N^2 bytes fitted, 8 N^2 conditioned) exceed this")
+                  "Skip rows whose matrices exceed this (exact: 16 N^2 bytes fitted, 8 N^2 conditioned; FITC and SSGP: "
+                  "their N x M and M x M matrices)")
       ->capture_default_str()
       ->check(number_in(0.0, 1e6, true));
   cmd->add_option("--time-budget", o->time_budget,

@@ -130,8 +130,17 @@ int run_rollout(const RolloutOptions& o) {
     }
     log.episodes.push_back(episode_of(rollout, r, policy.dt));
   }
-  if (log.episodes.empty())
-    throw std::runtime_error(fmt::format("every episode diverged at its first step; {} not written", o.out));
+  if (log.episodes.empty()) {
+    // A reported outcome, like a solve that does not converge: every episode's status, the file
+    // left as it was (an episode of one sample holds no transition, the data format needs two), exit 1.
+    std::cout << fmt::format("{} of {} episode(s) diverged at their first step: status diverged (a state not finite "
+                             "or beyond |x| = {:g}); {} not written\n",
+                             dropped, o.episodes, kDivergedStateMagnitude, o.out);
+    std::cerr << fmt::format("warning: not written: every episode of the round-{} policy {} diverged at its first "
+                             "step, so {} would hold no transition (try another --x0, world or policy)\n",
+                             policy.round, o.policy, o.out);
+    return kExitInternalFailure;
+  }
   write_measurements(o.out, log);
   std::cout << fmt::format("wrote {}: {} episode(s) of the round-{} policy {} on {} ({}), {} rows, dt = {} s, seed {}\n",
                            o.out, log.episodes.size(), policy.round, o.policy,

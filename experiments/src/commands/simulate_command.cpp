@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -49,7 +50,13 @@ int run_simulate(const SimulateOptions& o) {
                                  settings.episodes, settings.steps, static_cast<double>(settings.episodes) * settings.steps,
                                  limits::kMaxSamples));
 
-  SyntheticData data = simulate_measurements(system, settings);
+  SyntheticData data;
+  try {
+    data = simulate_measurements(system, settings);
+  } catch (const ExcitationDiverged& e) {
+    // The excitation's amplitude is the system's default; the step is this command's to choose.
+    throw InputError(fmt::format("{} at --dt {} s; expected a shorter --dt", e.what(), settings.dt));
+  }
   data.set.system = signature;
   write_measurements(o.out, data.set);
   std::cout << fmt::format("wrote {}: {} {}, {} episodes, {} samples, dt = {} s, seed {}\n", o.out,
@@ -74,8 +81,8 @@ void add_simulate_command(CLI::App& app, CommandAction& action) {
       ->check(integer_in(2, limits::kMaxSamples));
   cmd->add_option("--dt", options->dt, "Sampling step in seconds (default 0.02)")->check(positive_number());
   cmd->add_option("--observation-noise", options->observation_noise,
-                  "Std of Gaussian noise on each recorded state (default 1e-3)")
-      ->check(non_negative_number());
+                  "Std of Gaussian noise on each recorded state (default 1e-3; at most the divergence bound 1e12)")
+      ->check(number_in(0.0, kDivergedStateMagnitude));
   cmd->add_option("--seed", options->seed, "Random seed; the same seed gives the same file")
       ->capture_default_str()
       ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));

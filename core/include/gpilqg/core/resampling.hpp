@@ -32,6 +32,10 @@ struct SampleRange {
 /// range.
 std::vector<SampleRange> split_at_gaps(const VectorCRef& t, double max_gap);
 
+/// The number of points of uniform_grid(t, dt), as a double so that a tiny dt over a long span
+/// cannot overflow: callers check it against a limit before the grid is allocated.
+double uniform_grid_size(const VectorCRef& t, double dt);
+
 /// The grid tau_k = t(0) + k dt over [t(0), t(last)] as described above; t non-empty, dt > 0.
 Vector uniform_grid(const VectorCRef& t, double dt);
 

@@ -22,8 +22,9 @@
 ///
 /// Budgets (profile_budget.cpp), checked per row before any numeric work; a row over one is skipped
 /// and says why (status "skipped", reason):
-///  - memory: the exact GP (fitted or reference) needs two dense N x N matrices while fitting
-///    (16 N^2 bytes; one when only conditioning);
+///  - memory: the row's arrays (profile_row_memory): the exact GP (fitted or reference) needs two
+///    dense N x N matrices while fitting (16 N^2 bytes; one when only conditioning), FITC and SSGP
+///    their N x M and M x M matrices;
 ///  - time: the row's predicted seconds, its flop count (ProfileRowWork) over a measured machine rate
 ///    (gp::dense_flop_rate), above the time budget. A fit that runs anyway and passes the budget stops
 ///    at its next NLML evaluation with its best point (FitOptions::max_seconds); its row is scored and
@@ -146,6 +147,17 @@ ProfileReport run_profile(const std::filesystem::path& file, const ProfileData& 
 /// The peak memory the exact GP needs at n points: 16 n^2 bytes when fitted, 8 n^2 when conditioned.
 double exact_memory_bytes(std::int64_t n, bool fitted);
 
+/// The peak memory of a row's arrays and what holds them, checked against --memory-budget-gb before
+/// any work: the exact GP's (exact_memory_bytes); FITC's four M x N matrices and 6 + 2 workers M x M
+/// (M = min(inducing, N)); SSGP's Phi and Gamma (N x 2M) and 4 + workers 2M x 2M matrices (M
+/// frequencies), workers = settings.threads. nullopt for compact, whose kernel pattern and factor are
+/// bounded by its own max_factor_nonzeros (an evaluation over it fails before any numerical work).
+struct RowMemory {
+  double bytes = 0.0;
+  std::string what;  ///< "SSGP at N = 50 with 4096 frequencies (2 N x 2M and 5 2M x 2M matrices)"
+};
+std::optional<RowMemory> profile_row_memory(const ProfileCase& c, const ProfileOptions& options);
+
 /// The predicted work of one row in flops (counted as the dense linear algebra's: one multiply or add
 /// each), with N the size, D the input dimension, T the test points, E = 1 + max_evaluations x starts
 /// the most evaluations the fit may make (starts: the data-driven one, the restarts, and the
@@ -160,8 +172,9 @@ double exact_memory_bytes(std::int64_t n, bool fitted);
 ///                     fl + 2 T nnz(L) (a solve through L per test point, the worst case);
 ///   fitc, ssgp        M = min(inducing, N) for fitc (six N x M by M x M products), M = 2 frequencies
 ///                     for ssgp (Phi'Phi and Phi A^-1): per evaluation 12 N M^2 (fitc) or 3 N M^2
-///                     (ssgp) + 2 N M (3 D + 20) (kernel or features, gradient); final
-///                     4 N M^2 + T (M^2 + M (3 D + 20)).
+///                     (ssgp) + 2 N M (3 D + 20) (kernel or features, gradient) + 7 M^3 / 3 (the
+///                     M x M Cholesky and the inverse from it, which dominate when M > N); final
+///                     4 N M^2 + M^3 / 3 + T (M^2 + M (3 D + 20)).
 struct ProfileRowWork {
   double per_evaluation = 0.0;  ///< flops of one NLML evaluation with its gradient
   int evaluations = 0;          ///< E (0 for exact_reference)
@@ -176,8 +189,8 @@ struct ProfileRowWork {
 ProfileRowWork profile_row_work(const ProfileCase& c, const gp::TrainingSet& subset, int test_points,
                                 const ProfileOptions& options, const gp::FitOptions& fit);
 
-/// Why row `c` is skipped before any numeric work, or empty: over the memory budget (the exact GP's
-/// dense matrices, exact_memory_bytes), or, with a time budget, predicted seconds
+/// Why row `c` is skipped before any numeric work, or empty: over the memory budget
+/// (profile_row_memory), or, with a time budget, predicted seconds
 /// profile_row_work(...).total() / rate above it, e.g.
 ///   "predicted 267 s > 120 s time budget (CHOLMOD: 3.8e9 flops per factorisation + 3.6e10 for the
 ///    gradient's inverse subset, x 101 evaluations + 1.3e10 to condition and predict, at 14.9 GFLOP/s)".

@@ -6,6 +6,7 @@
 /// data with a known ground truth.
 
 #include <cstdint>
+#include <stdexcept>
 
 #include "gpilqg/core/dynamics.hpp"
 #include "gpilqg/core/measurements.hpp"
@@ -44,6 +45,13 @@ struct SyntheticData {
   MeasurementSet set;
   int truncated_episodes = 0;
 };
+/// Throws ExcitationDiverged when every episode diverges before its second sample (nothing to
+/// record): the settings (dt, control_amplitude) drive the system out at once. Its message names no
+/// setting, so that each caller names its own way to change them (`simulate`: --dt).
 SyntheticData simulate_measurements(const DynamicsPtr& system, const ExcitationSettings& settings);
+
+struct ExcitationDiverged : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
 
 }  // namespace gpilqg
