@@ -49,7 +49,12 @@ correction and its std.)")
             options.fit.seed = seed;
             LongCall call;
             return call.run<std::shared_ptr<gp::ResidualModel>>([&] {
-              const gp::ResidualData residuals = gp::make_residual_data(*simulator, data);
+              gp::ResidualData residuals;
+              try {
+                residuals = gp::make_residual_data(*simulator, data);
+              } catch (const std::invalid_argument& e) {  // the data's system or step differs from the simulator's
+                throw InputError(fmt::format("ResidualModel.fit: {}", e.what()));
+              }
               if (observation_std) {
                 try {
                   options.noise_floor = gp::sensor_noise_floor(*simulator, residuals, *observation_std);

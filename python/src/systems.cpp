@@ -248,7 +248,15 @@ and gpilqg.register_system(...) to use it by name in configs, solve, diagnose an
 
   m.def("system", [](const std::string& name, const std::string& preset, const std::map<std::string, double>& parameters,
                      const py::object& noise) {
-          return std::const_pointer_cast<Dynamics>(make_system(name, preset_of(preset), parameters, noise_of(name, noise)));
+          for (const auto& [parameter, value] : parameters)
+            if (!std::isfinite(value))
+              raise_input_error(fmt::format("system: parameters['{}'] = {} is not finite", parameter, value));
+          try {
+            const ActuatorNoise noise_model = noise_of(name, noise);
+            return std::const_pointer_cast<Dynamics>(make_system(name, preset_of(preset), parameters, noise_model));
+          } catch (const std::invalid_argument& e) {  // an unknown name or parameter, a value out of range
+            throw InputError(e.what());
+          }
         },
         py::arg("name"), py::arg("preset") = "sim", py::arg("parameters") = std::map<std::string, double>{},
         py::arg("noise") = py::none(), R"(
@@ -261,6 +269,7 @@ noise: dict with actuator_additive (m,), actuator_multiplicative (m,), state (n,
   m.def("register_system", [](const std::string& name, const py::function& builder, const std::string& description) {
           // The registry lives until the process ends, after the interpreter: it keeps the builder
           // with a reference that is never released (a Python object must not be freed then).
+          if (name.empty()) raise_input_error("register_system: the name is empty; expected a system name");
           PyObject* function = builder.inc_ref().ptr();
           SystemEntry entry;
           entry.name = name;
@@ -304,7 +313,12 @@ Euler or RK4 with sub-steps) or, for a MuJoCo model, MuJoCo's own.)")
       .def(py::init([](const py::object& system, double dt, const std::string& integrator, int substeps) {
              const auto parsed = parse_integrator(integrator);
              if (!parsed) throw InputError(fmt::format("integrator '{}': expected 'euler' or 'rk4'", integrator));
-             return std::const_pointer_cast<StepModel>(make_step_model(system_from_python(system, "StepModel"), *parsed, dt, substeps));
+             DynamicsPtr dynamics = system_from_python(system, "StepModel");
+             try {
+               return std::const_pointer_cast<StepModel>(make_step_model(std::move(dynamics), *parsed, dt, substeps));
+             } catch (const std::invalid_argument& e) {  // dt or substeps out of range
+               throw InputError(fmt::format("StepModel: {}", e.what()));
+             }
            }),
            py::arg("system"), py::arg("dt"), py::arg("integrator") = "rk4", py::arg("substeps") = 1,
            "system: a gpilqg.Dynamics or a registry name")
