@@ -9,7 +9,8 @@ The C++ library through pybind11, with NumPy arrays in and out (docs/python.md):
 - workflows: ``diagnose``, ``solve``, ``plan`` (returns a ``Policy``), ``run`` (returns the result file).
 
 Long calls release the GIL, pass progress lines to ``progress(line)`` when given, and stop on Ctrl-C
-(KeyboardInterrupt) within one iteration.
+(KeyboardInterrupt) within one iteration. Arguments are checked where they enter: a wrong type, a
+shape that does not fit the system, or a non-finite value raises ``InputError`` naming the argument.
 """
 
 import os as _os
@@ -23,7 +24,7 @@ from ._dataframes import install as _install_dataframes
 _install_dataframes(_gpilqg.MeasurementSet)
 
 
-def _config_source(config):
+def _config_source(who, config):
     """A config as the extension takes it: a file path, or TOML text (a dict is written as TOML)."""
     if config is None:
         return None
@@ -31,7 +32,24 @@ def _config_source(config):
         return _to_toml(config)
     if isinstance(config, (str, _os.PathLike)):
         return _os.fspath(config)
-    raise TypeError("config: expected a file path or a dict of TOML tables, got %s" % type(config).__name__)
+    raise InputError("%s: config is %s; expected a file path or a dict of TOML tables" % (who, type(config).__name__))
+
+
+def _path(who, name, value, optional=False):
+    """A file path argument (str or os.PathLike) as str; None only when `optional`."""
+    if optional and value is None:
+        return None
+    if isinstance(value, (str, _os.PathLike)):
+        return _os.fspath(value)
+    raise InputError("%s: %s is %s; expected a file path (str or os.PathLike)%s"
+                     % (who, name, type(value).__name__, " or None" if optional else ""))
+
+
+def _paths(who, name, values):
+    """A list of file paths; one path alone is not taken for the list of its characters."""
+    if isinstance(values, (str, bytes, _os.PathLike)) or not hasattr(values, "__iter__"):
+        raise InputError("%s: %s is %s; expected a list of file paths" % (who, name, type(values).__name__))
+    return [_path(who, "%s[%d]" % (name, i), v) for i, v in enumerate(values)]
 
 
 def solve(config, progress=None):
@@ -41,7 +59,7 @@ def solve(config, progress=None):
     Returns a dict: cost, expected_cost, termination, converged, iterations, gradient_norm,
     solve_time_s, x (T+1, n), u (T, m), and policy (a Policy).
     """
-    return _gpilqg._solve(_config_source(config), progress)
+    return _gpilqg._solve(_config_source("solve", config), progress)
 
 
 def plan(config, data=(), previous=None, out=None, seed=1, progress=None):
@@ -51,9 +69,11 @@ def plan(config, data=(), previous=None, out=None, seed=1, progress=None):
     previous round's policy file; out: where to write the policy file (optional); seed: the GP fit's.
     Returns a Policy that can act: ``policy(t, x)``.
     """
-    files = [_os.fspath(f) for f in data]
-    return _gpilqg._plan(_config_source(config), files, None if previous is None else _os.fspath(previous),
-                         None if out is None else _os.fspath(out), seed, progress)
+    if config is None:
+        raise InputError("plan: config is None; expected a file path or a dict of TOML tables")
+    return _gpilqg._plan(_config_source("plan", config), _paths("plan", "data", data),
+                         _path("plan", "previous", previous, optional=True), _path("plan", "out", out, optional=True),
+                         seed, progress)
 
 
 def run(system, config=None, seeds=1, first_seed=1, iterations=None, backends=(), out=None, progress=None):
@@ -62,7 +82,11 @@ def run(system, config=None, seeds=1, first_seed=1, iterations=None, backends=()
     config: overrides of the embedded defaults (file or dict); out: the result file (default
     out/run_<system>.h5). Returns the result file's path (layout: README, results file).
     """
+    if not isinstance(system, str):
+        raise InputError("run: system is %s; expected a system name (str)" % type(system).__name__)
     if out is None:
         out = _os.path.join("out", "run_%s.h5" % _os.path.basename(system))
-    return _gpilqg._run(system, _config_source(config), seeds, first_seed, iterations, list(backends),
-                        _os.fspath(out), progress)
+    if isinstance(backends, str) or not hasattr(backends, "__iter__"):
+        raise InputError("run: backends is %s; expected a list of GP backend names" % type(backends).__name__)
+    return _gpilqg._run(system, _config_source("run", config), seeds, first_seed, iterations, list(backends),
+                        _path("run", "out", out), progress)

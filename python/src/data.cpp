@@ -10,6 +10,7 @@
 
 #include "bindings.hpp"
 #include "conversions.hpp"
+#include "gp_arrays.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -20,21 +21,24 @@ namespace {
 /// (t, x, u) -> an Episode, or (t, x) for a system without controls (m = 0); shapes are checked with
 /// the whole set (check_measurement_set).
 Episode episode_of(const py::handle& item, long id, bool passive) {
-  const py::tuple parts = py::reinterpret_borrow<py::object>(item).cast<py::tuple>();
-  if (parts.size() != 3 && !(passive && parts.size() == 2))
+  const bool sequence = py::isinstance<py::tuple>(item) || py::isinstance<py::list>(item);
+  const std::size_t size = sequence ? py::len(item) : 0;
+  if (size != 3 && !(passive && size == 2))
     throw InputError(fmt::format("episode {}: expected a tuple (t, x, u){}", id,
                                  passive ? " or (t, x) (the system has no controls)" : ""));
+  const py::sequence parts = py::reinterpret_borrow<py::sequence>(item);
+  const std::string who = fmt::format("MeasurementSet: episode {}", id);
   Episode e;
   e.id = id;
-  e.t = parts[0].cast<Vector>();
-  e.x = parts[1].cast<Matrix>();
-  e.u = parts.size() == 3 ? parts[2].cast<Matrix>() : Matrix(e.t.size(), 0);
+  e.t = as_vector(checked_array(parts[0], 1, who, "t", "(T,)"));
+  e.x = as_matrix(checked_array(parts[1], 2, who, "x", "(T, n)"));
+  e.u = size == 3 ? Matrix(as_matrix(checked_array(parts[2], 2, who, "u", "(T, m)"))) : Matrix(e.t.size(), 0);
   return e;
 }
 
 MeasurementSet make_set(const py::object& system, const py::list& episodes, const std::vector<long>& ids) {
   MeasurementSet set;
-  set.system = system_from_python(system)->signature();
+  set.system = system_from_python(system, "MeasurementSet")->signature();
   if (!ids.empty() && ids.size() != episodes.size())
     throw InputError(fmt::format("ids: {} ids for {} episodes", ids.size(), episodes.size()));
   for (std::size_t i = 0; i < episodes.size(); ++i)
@@ -86,7 +90,7 @@ shapes, non-finite values, or times that do not increase at a constant step.)")
 
   m.def("read_measurements",
         [](const std::filesystem::path& file, const py::object& system) {
-          return read_measurements(file, system_from_python(system)->signature());
+          return read_measurements(file, system_from_python(system, "read_measurements")->signature());
         },
         py::arg("file"), py::arg("system"),
         "Reads and validates a CSV or HDF5 measurement file; raises DataError naming the file and line or dataset.");

@@ -28,7 +28,11 @@ correction and its std.)")
           "fit",
           [](const std::shared_ptr<StepModel>& simulator, const MeasurementSet& data, const std::string& backend,
              int exact_points, int inducing, int frequencies, int restarts, int max_evaluations, std::uint64_t seed,
-             const std::optional<Vector>& observation_std) {
+             const py::object& observation_std_in) {
+            if (!simulator) raise_input_error("ResidualModel.fit: simulator is None; expected a gpilqg.StepModel");
+            std::optional<Vector> observation_std;
+            if (!observation_std_in.is_none())
+              observation_std = vector_argument(observation_std_in, states_of(*simulator), "ResidualModel.fit", "observation_std");
             gp::BackendSettings settings;
             settings.exact_points = exact_points;
             settings.inducing = inducing;
@@ -45,7 +49,12 @@ correction and its std.)")
             options.fit.seed = seed;
             LongCall call;
             return call.run<std::shared_ptr<gp::ResidualModel>>([&] {
-              const gp::ResidualData residuals = gp::make_residual_data(*simulator, data);
+              gp::ResidualData residuals;
+              try {
+                residuals = gp::make_residual_data(*simulator, data);
+              } catch (const std::invalid_argument& e) {  // the data's system or step differs from the simulator's
+                throw InputError(fmt::format("ResidualModel.fit: {}", e.what()));
+              }
               if (observation_std) {
                 try {
                   options.noise_floor = gp::sensor_noise_floor(*simulator, residuals, *observation_std);
@@ -65,11 +74,14 @@ state, optional): the sensors' noise; with the simulator's process noise it sets
 noise std (gp/noise_floor.hpp), so that the GP does not explain sensor noise as dynamics. Runs
 without the GIL.)")
       .def("predict",
-           [](const gp::ResidualModel& model, const Matrix& x, const Matrix& u) {
+           [](const gp::ResidualModel& model, const py::object& x_in, const py::object& u_in) {
              const int n = model.state_dim(), mdim = model.control_dim();
-             if (x.cols() != n || u.cols() != mdim || x.rows() != u.rows())
-               throw InputError(fmt::format("predict: x is ({}, {}) and u ({}, {}); expected (N, {}) and (N, {})",
-                                            x.rows(), x.cols(), u.rows(), u.cols(), n, mdim));
+             const std::string who = "ResidualModel.predict";
+             const Matrix x = rows_argument(x_in, states_of(model), who, "x");
+             const Matrix u = rows_argument(u_in, controls_of(model), who, "u");
+             if (x.rows() != u.rows())
+               raise_input_error(fmt::format("{}: x has {} rows and u {}; expected one row of u per row of x", who,
+                                             x.rows(), u.rows()));
              Matrix z(x.rows(), n + mdim);
              z << x, u;
              Matrix mean(x.rows(), n), std(x.rows(), n);
@@ -82,6 +94,10 @@ without the GIL.)")
                  std.col(i) = output_variance.cwiseMax(0.0).cwiseSqrt();
                }
              }
+             const std::string context = fmt::format("these finite x and u (the GP of {} is not finite there)",
+                                                     step_model_label(model));
+             require_finite_result(mean, who, "mean", context);
+             require_finite_result(std, who, "std", context);
              return py::make_tuple(mean, std);
            },
            py::arg("x"), py::arg("u"),

@@ -158,7 +158,7 @@ py::object diagnose(const py::object& system, const py::object& data, const std:
                     double heldout, int gp_points, int gp_restarts, const std::string& backend, std::uint64_t seed,
                     const std::string& criterion, std::optional<long> window, const py::object& progress) {
   diagnosis::DiagnoseRequest request;
-  request.system = py::isinstance<py::str>(system) ? system.cast<std::string>() : system_from_python(system)->name();
+  request.system = py::isinstance<py::str>(system) ? system.cast<std::string>() : system_from_python(system, "diagnose")->name();
   request.model_file = model;
   request.preset = preset;
   request.add = add;
@@ -176,9 +176,11 @@ py::object diagnose(const py::object& system, const py::object& data, const std:
   diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(request);
   LongCall call(progress);
   options.progress = [&call](const std::string& line) { call.throwing_checkpoint(line); };
-  const MeasurementSet set = py::isinstance<MeasurementSet>(data)
-                                 ? data.cast<MeasurementSet>()
-                                 : read_measurements(data.cast<std::filesystem::path>(), system_signature(request.system));
+  const MeasurementSet set =
+      py::isinstance<MeasurementSet>(data)
+          ? data.cast<MeasurementSet>()
+          : read_measurements(path_argument(data, "diagnose", "data", "a gpilqg.MeasurementSet or a measurement file path"),
+                              system_signature(request.system));
   const nlohmann::json report = call.run<nlohmann::json>([&] {
     try {
       return diagnosis::report_json(diagnosis::diagnose(set, options));
@@ -196,7 +198,7 @@ ConfigSource source_of(const py::object& config) {
     s.text = config.cast<std::string>();  // TOML text (what the package makes of a dict)
     return s;
   }
-  s.file = config.cast<std::filesystem::path>();
+  s.file = path_argument(config, "config", "config", "a config file path or TOML text");
   return s;
 }
 
@@ -206,15 +208,19 @@ void bind_workflows(py::module_& m) {
   py::class_<Policy>(m, "Policy", R"(
 An affine feedback policy (DESIGN.md section 11): u_t = clip(u_bar[t] + K[t] (x - x_bar[t]), u_min, u_max).
 Call it as policy(t, x). Arrays have one row per time step: x_bar (T+1, n), u_bar (T, m), K (T, m, n).)")
-      .def("__call__", [](const Policy& p, int t, const Vector& x) {
+      .def("__call__", [](const Policy& p, int t, const py::object& x_in) {
              if (t < 0 || t >= p.file.policy.horizon())
                throw py::index_error(fmt::format("t = {}: the policy has steps 0 to {}", t, p.file.policy.horizon() - 1));
-             if (x.size() != p.file.policy.x_bar.rows())
-               throw py::value_error(fmt::format("x has {} entries; expected {}", x.size(), p.file.policy.x_bar.rows()));
+             const Quantities states{p.file.policy.x_bar.rows(),
+                                     fmt::format("the states of the policy's system '{}'", p.file.system)};
+             const Vector x = vector_argument(x_in, states, "Policy", "x");
              Vector u(p.file.policy.u_bar.rows());
              p.file.policy.control(t, x, u);
+             require_finite_result(u, "Policy", "u", fmt::format("step {} and this finite x (the policy's gains are not finite there)", t));
              return u;
-           }, py::arg("t"), py::arg("x"), "The control (m,) at step t for the measured state x (n,).")
+           }, py::arg("t"), py::arg("x"),
+           "The control (m,) at step t for the measured state x (n,); gpilqg.InputError for a wrong shape or a "
+           "non-finite x.")
       .def_property_readonly("x_bar", [](const Policy& p) { return rows(p.file.policy.x_bar); })
       .def_property_readonly("u_bar", [](const Policy& p) { return rows(p.file.policy.u_bar); })
       .def_property_readonly("K", [](const Policy& p) {

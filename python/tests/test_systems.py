@@ -69,7 +69,7 @@ def test_python_dynamics_errors_are_python_exceptions():
         def f(self, x, u):
             return np.zeros(3)
 
-    with pytest.raises(ValueError, match=r"f\(x, u\) has shape \(3, 1\); expected \(2, 1\)"):
+    with pytest.raises(gpilqg.InputError, match=r"Dynamics 'wrong': f\(x, u\) has 3 entries; expected 2"):
         WrongShape().xdot(np.zeros(2), np.zeros(1))
 
     class Raises(gpilqg.Dynamics):
