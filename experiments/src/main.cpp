@@ -7,6 +7,7 @@
 /// (exit 2, plugin.hpp).
 
 #include <algorithm>
+#include <csignal>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -51,6 +52,14 @@ std::string joined(const std::vector<std::string>& names) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Under a file-size limit (ulimit -f, RLIMIT_FSIZE) a write past the limit raises SIGXFSZ, whose
+  // default action kills the process without a message and leaves the temporary of an atomic write
+  // behind. Ignored, the write(2) fails with EFBIG instead, and the atomic write reports it
+  // ("<file>: not written: writing failed (File too large)"), removes its temporary and keeps the
+  // previous file. The program ignores it here, not the library: a signal's disposition belongs to
+  // the process, and a program embedding the library chooses its own (Python already ignores
+  // SIGXFSZ at start-up, so the Python module gets the same messages).
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"gpilqg: data-driven robust optimal control (GP-corrected simulators, Robust-iLQG)",
                "gpilqg"};
   app.require_subcommand(1);
