@@ -15,6 +15,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands/commands.hpp"
+#include "commands/output_options.hpp"
 #include "gpilqg/core/plugin.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/gp/blas_library.hpp"
@@ -110,6 +111,9 @@ int main(int argc, char** argv) {
   }
   return gpilqg::run_reporting_errors(
       [&] {
+        std::vector<gpilqg::cli::CommandInput> inputs;
+        for (const auto& plugin : plugins) inputs.push_back({"--plugin", plugin});
+        gpilqg::cli::set_program_inputs(std::move(inputs));
         gpilqg::load_plugins(plugins);
         return action();
       },
