@@ -382,6 +382,8 @@ TEST(HostileFiles, AnOutputThatIsAnInputIsExit2AndTheInputIsKept) {
       {"run cartpole --config " + quote(run_config) + " --no-plots --out {out}", run_config, "--config " + run_config.string(),
        run_config},
       {"sweep " + quote(sweep) + " --no-plots --out {out}", sweep, "SWEEP " + sweep.string(), sweep},
+      {"sweep " + quote(sweep) + " --no-plots --out {out}", run_config, "config (in the sweep file) " + run_config.string(),
+       run_config},
       {"profile " + quote(part) + " --backends exact --out {out}", part, "DATA " + part.string(), part},
       {"merge " + quote(policy) + " " + quote(part) + " --no-plots --out {out}", part, "PART " + part.string(), part},
   };
