@@ -124,7 +124,9 @@ class Scan {
   void include(const Named& named, int depth) {
     const std::string file = model_dir_ + named.file;
     if (!check_named_file(file, kMaxConfigFileBytes, description("an MJCF file", named))) return;
-    if (depth >= kMaxIncludeDepth || !included_.insert(fs::weakly_canonical(file).string()).second) return;
+    std::error_code error;
+    const fs::path canonical = fs::weakly_canonical(file, error);
+    if (depth >= kMaxIncludeDepth || !included_.insert(error ? file : canonical.string()).second) return;
     walk_text(read_text(file), file, depth + 1);
   }
 
