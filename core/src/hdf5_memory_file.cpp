@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/core/hdf5_self_contained.hpp"
 
 namespace gpilqg {
 
@@ -31,7 +32,9 @@ H5::H5File create_hdf5_in_memory(const std::filesystem::path& name) {
 
 H5::H5File open_hdf5_in_memory(const std::filesystem::path& file) {
   H5::Exception::dontPrint();
-  return H5::H5File(file.string(), H5F_ACC_RDWR, H5::FileCreatPropList::DEFAULT, in_memory_access());
+  H5::H5File opened(file.string(), H5F_ACC_RDWR, H5::FileCreatPropList::DEFAULT, in_memory_access());
+  check_hdf5_self_contained(file, opened.getId());
+  return opened;
 }
 
 void save_hdf5_image(H5::H5File& file, const std::filesystem::path& destination) {

@@ -8,6 +8,7 @@
 #include <H5Cpp.h>
 
 #include "gpilqg/core/dataset_size.hpp"
+#include "gpilqg/core/hdf5_self_contained.hpp"
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "hdf5_common.hpp"
@@ -63,6 +64,7 @@ Hdf5Reader::Hdf5Reader(const std::filesystem::path& file) : impl_(std::make_uniq
   H5::Exception::dontPrint();
   impl_->file_bytes = check_input_file(file, kMaxDataFileBytes, "an HDF5 file");
   guarded(file, "/", "opening", [&] { impl_->file = H5::H5File(file.string(), H5F_ACC_RDONLY); });
+  check_hdf5_self_contained(file, impl_->file.getId());
 }
 
 Hdf5Reader::~Hdf5Reader() = default;

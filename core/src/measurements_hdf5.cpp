@@ -25,6 +25,7 @@
 
 #include "gpilqg/core/dataset_size.hpp"
 #include "gpilqg/core/hdf5_memory_file.hpp"
+#include "gpilqg/core/hdf5_self_contained.hpp"
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "measurements_internal.hpp"
@@ -97,6 +98,7 @@ class Hdf5Reader {
     if (!is_hdf5) throw DataError(file_, "", "not an HDF5 file", "an HDF5 file (a CSV file must end in .csv)");
     h5_ = guarded(file_, "", "opening the file", "a readable HDF5 file",
                   [&] { return H5::H5File(file_.c_str(), H5F_ACC_RDONLY); });
+    check_hdf5_self_contained(file_, h5_.getId());
   }
 
   /// Refuses a dataset or attribute that declares more values than the file can hold or than

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "gpilqg/core/input_file.hpp"
+#include "mujoco_model_files.hpp"
 #include "urdf_actuators.hpp"
 
 namespace gpilqg {
@@ -138,6 +139,7 @@ std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
   check_input_file_as<std::invalid_argument>(path, kMaxConfigFileBytes, "a MuJoCo model (MJCF .xml or URDF)");
   char error[1024] = "";
   const std::string text = file_text(path);
+  check_mujoco_model_files(path, text);  // included and asset files: MuJoCo opens them unchecked
   mjModel* m = nullptr;
   {
     std::lock_guard lock(load_mutex());

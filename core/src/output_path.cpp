@@ -2,6 +2,7 @@
 
 #include "gpilqg/core/output_path.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -48,6 +49,13 @@ std::optional<std::string> output_file_problem(const fs::path& file) {
   if (fs::exists(own) && own.type() != fs::file_type::regular && own.type() != fs::file_type::symlink)
     return std::string("is ") + file_kind(own.type()) + "; expected a regular file or a new file name";
   return folder_problem(file.parent_path());
+}
+
+bool same_file(const fs::path& output, const fs::path& input) {
+  struct stat a {}, b {};
+  if (output.empty() || input.empty()) return false;
+  if (::stat(output.c_str(), &a) != 0 || ::stat(input.c_str(), &b) != 0) return false;
+  return a.st_dev == b.st_dev && a.st_ino == b.st_ino;
 }
 
 std::optional<std::string> output_folder_problem(const fs::path& folder) {

@@ -8,8 +8,10 @@
 #include <cstdint>
 #include <memory>
 
+#include <hdf5.h>
 #include <matio.h>
 
+#include "gpilqg/core/hdf5_self_contained.hpp"
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/raw_log.hpp"
@@ -76,10 +78,27 @@ LogColumn column_of(const matvar_t& var, const std::string& name) {
   return column;
 }
 
+/// A MAT v7.3 file is an HDF5 file, which matio reads with the HDF5 library: like every HDF5 input it
+/// must hold its data itself (hdf5_self_contained.hpp), checked before matio opens any object of it.
+void check_mat_v73_self_contained(const std::filesystem::path& file) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  if (H5Fis_hdf5(file.c_str()) <= 0) return;  // v4 or v5: one file, no links
+  const hid_t id = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (id < 0) return;  // matio reports what it cannot open
+  try {
+    check_hdf5_self_contained(file, id);
+  } catch (...) {
+    H5Fclose(id);
+    throw;
+  }
+  H5Fclose(id);
+}
+
 }  // namespace
 
 RawLog read_raw_log_mat(const std::filesystem::path& file) {
   check_input_file(file, kMaxDataFileBytes, "a log file");
+  check_mat_v73_self_contained(file);
   const MatFile mat(Mat_Open(file.string().c_str(), MAT_ACC_RDONLY));
   if (!mat) throw DataError(file, "", "matio cannot open it as a MAT file", "a MATLAB .mat file (v4, v5 or v7.3)");
   RawLog log;

@@ -7,6 +7,7 @@
 /// (exit 2, plugin.hpp).
 
 #include <algorithm>
+#include <csignal>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 
 #include "commands/json_arguments.hpp"
 #include "commands/commands.hpp"
+#include "commands/output_options.hpp"
 #include "gpilqg/core/plugin.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/gp/blas_library.hpp"
@@ -52,6 +54,14 @@ std::string joined(const std::vector<std::string>& names) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Under a file-size limit (ulimit -f, RLIMIT_FSIZE) a write past the limit raises SIGXFSZ, whose
+  // default action kills the process without a message and leaves the temporary of an atomic write
+  // behind. Ignored, the write(2) fails with EFBIG instead, and the atomic write reports it
+  // ("<file>: not written: writing failed (File too large)"), removes its temporary and keeps the
+  // previous file. The program ignores it here, not the library: a signal's disposition belongs to
+  // the process, and a program embedding the library chooses its own (Python already ignores
+  // SIGXFSZ at start-up, so the Python module gets the same messages).
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"gpilqg: data-driven robust optimal control (GP-corrected simulators, Robust-iLQG)",
                "gpilqg"};
   app.require_subcommand(1);
@@ -103,6 +113,9 @@ int main(int argc, char** argv) {
   return gpilqg::run_reporting_errors(
       [&] {
         gpilqg::cli::check_json_arguments(app);
+        std::vector<gpilqg::cli::CommandInput> inputs;
+        for (const auto& plugin : plugins) inputs.push_back({"--plugin", plugin});
+        gpilqg::cli::set_program_inputs(std::move(inputs));
         gpilqg::load_plugins(plugins);
         return action();
       },

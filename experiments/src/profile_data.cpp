@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "gpilqg/core/dataset_size.hpp"
+#include "gpilqg/core/hdf5_self_contained.hpp"
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/measurements.hpp"
@@ -215,6 +216,7 @@ ProfileData read_profile_data(const std::filesystem::path& file, const ProfileDa
   bool benchmark = false;
   try {
     const H5::H5File h5(file.c_str(), H5F_ACC_RDONLY);
+    check_hdf5_self_contained(file, h5.getId());
     benchmark = h5.nameExists("X_train");
     if (benchmark) return read_benchmark(BenchmarkFile{h5, file, bytes});
     if (!h5.nameExists("episodes"))

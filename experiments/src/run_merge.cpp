@@ -12,6 +12,7 @@
 #include "run_result_part.hpp"
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
+#include "gpilqg/core/output_path.hpp"
 #include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
@@ -61,16 +62,12 @@ struct AxisBlocks {
 void require_distinct_files(const std::vector<std::filesystem::path>& files, const std::filesystem::path& out) {
   if (files.size() < 2)
     throw InputError(fmt::format("merge: {} file given; expected two or more result files of `gpilqg run` to join", files.size()));
-  const auto same = [](const std::filesystem::path& a, const std::filesystem::path& b) {
-    std::error_code error;
-    return std::filesystem::equivalent(a, b, error) && !error;
-  };
   for (std::size_t i = 0; i < files.size(); ++i) {
-    if (same(files[i], out))
+    if (same_file(out, files[i]))
       throw InputError(fmt::format("merge: the output {} is one of the files to merge; write the merged result to another file",
                                    out.string()));
     for (std::size_t j = 0; j < i; ++j)
-      if (same(files[i], files[j]))
+      if (same_file(files[i], files[j]))
         throw InputError(fmt::format("merge: {} and {} are the same file; give each part once", files[j].string(), files[i].string()));
   }
 }

@@ -121,6 +121,7 @@ SweepConfig load_sweep_config(const std::filesystem::path& file) {
 
   std::optional<std::filesystem::path> base_file;
   if (f.has("config")) base_file = folder / f.string("config");
+  if (base_file) s.config = *base_file;
   const RunConfig base = load_run_config(s.system, base_file);
   toml::table effective = TomlFields::parse_text(base.text, "<the effective run config>");
 

@@ -3,6 +3,7 @@
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/dataset_size.hpp"
 #include "gpilqg/core/hdf5_memory_file.hpp"
+#include "gpilqg/core/hdf5_self_contained.hpp"
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
 
@@ -178,6 +179,7 @@ std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, cons
     return std::runtime_error(where(file, object) + ": " + problem);
   };
   H5::H5File h5 = guarded(file, "/", "opening", [&] { return H5::H5File(file.c_str(), H5F_ACC_RDONLY); });
+  check_hdf5_self_contained(file, h5.getId());
   if (!guarded(file, group_path, "looking up", [&] { return path_exists(h5, group_path); }))
     throw fail(group_path, "no such group; expected a saved GP");
   const H5::Group group = guarded(file, group_path, "opening", [&] { return h5.openGroup(group_path); });
@@ -258,6 +260,7 @@ ResidualModel load_residual_model(const std::filesystem::path& file, const std::
   };
   const Stored stored = guarded(file, group_path, "reading the residual model's attributes", [&] {
     const H5::H5File h5(file.c_str(), H5F_ACC_RDONLY);
+    check_hdf5_self_contained(file, h5.getId());
     if (!path_exists(h5, group_path)) throw std::runtime_error(where(file, group_path) + ": no such group");
     const H5::Group group = h5.openGroup(group_path);
     Stored s;

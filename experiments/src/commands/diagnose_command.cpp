@@ -75,11 +75,12 @@ std::string criterion_options(const diagnosis::DiagnoseRequest& r) {
 int run_diagnose(const DiagnoseOptions& options_given) {
   const DiagnoseOptions& o = options_given;
   const diagnosis::DiagnoseRequest& r = o.request;
+  const std::vector<CommandInput> inputs = {{"--data", o.data}, {"--model", r.model_file}, system_input(r.system)};
+  check_output_file_option("--out", o.out, inputs);
+  check_output_folder_option("--plots", o.plots);
+  check_output_file_option("--write-model", o.write_model, inputs);
   const SystemSignature signature = system_signature(r.system);
   const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(r);
-  check_output_file_option("--out", o.out);
-  check_output_folder_option("--plots", o.plots);
-  check_output_file_option("--write-model", o.write_model);
   if (!o.plots.empty()) check_plotting();
   const MeasurementSet data = read_measurements(o.data, signature);
   diagnosis::DiagnosisReport report;

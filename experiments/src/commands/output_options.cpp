@@ -9,6 +9,7 @@
 
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/output_path.hpp"
+#include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/plot_script.hpp"
 
@@ -27,12 +28,35 @@ void remove_and_name(const std::vector<std::filesystem::path>& stale) {
   }
 }
 
+std::vector<CommandInput>& program_inputs() {
+  static std::vector<CommandInput> inputs;
+  return inputs;
+}
+
+/// Throws when `file` is one of `inputs`.
+void refuse_input(const std::string& option, const std::filesystem::path& file, const std::vector<CommandInput>& inputs) {
+  for (const CommandInput& input : inputs)
+    if (same_file(file, input.file))
+      throw InputError(fmt::format("{} {}: is the same file as {} {}, an input of the command; expected a file that is "
+                                   "not one of its inputs",
+                                   option, file.string(), input.name, input.file.string()));
+}
+
 }  // namespace
 
-void check_output_file_option(const std::string& option, const std::filesystem::path& file) {
+CommandInput system_input(const std::string& system, const std::string& name) {
+  return {name, is_model_file_name(system) ? std::filesystem::path(system) : std::filesystem::path()};
+}
+
+void set_program_inputs(std::vector<CommandInput> inputs) { program_inputs() = std::move(inputs); }
+
+void check_output_file_option(const std::string& option, const std::filesystem::path& file,
+                              const std::vector<CommandInput>& inputs) {
   if (file.empty()) return;
   if (const auto problem = output_file_problem(file))
     throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
+  refuse_input(option, file, inputs);
+  refuse_input(option, file, program_inputs());
   remove_and_name(stale_temporaries(file));
 }
 

@@ -7,11 +7,30 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace gpilqg::cli {
 
+/// A file a command reads, as messages name it: the option or argument that gave it ("--data",
+/// "LOG") and its path; an empty path (option not given) is skipped.
+struct CommandInput {
+  std::string name;
+  std::filesystem::path file;
+};
+
 /// Checks `file` with output_file_problem (output_path.hpp); an empty path (option not given) passes.
-void check_output_file_option(const std::string& option, const std::filesystem::path& file);
+/// An output that is the same file as one of `inputs` or of the program's inputs (same_file, e.g.
+/// `data import log.csv --out log.csv`) is refused too: writing it would replace the input. Throws
+/// InputError "<option> <file>: is the same file as <name> <input>, an input of the command; expected a
+/// file that is not one of its inputs".
+void check_output_file_option(const std::string& option, const std::filesystem::path& file,
+                              const std::vector<CommandInput>& inputs = {});
+
+/// {"--system", system} when `system` is a model file (is_model_file_name), else an empty input.
+CommandInput system_input(const std::string& system, const std::string& name = "--system");
+
+/// The inputs of the program itself, checked by every check_output_file_option: the --plugin libraries.
+void set_program_inputs(std::vector<CommandInput> inputs);
 
 /// Checks `folder` with output_folder_problem; an empty path passes.
 void check_output_folder_option(const std::string& option, const std::filesystem::path& folder);

@@ -29,7 +29,9 @@ struct PlanOptions {
 };
 
 int run_plan(const PlanOptions& o) {
-  check_output_file_option("--out", o.out);
+  std::vector<CommandInput> inputs = {{"CONFIG", o.config}, {"--previous", o.previous}};
+  for (const auto& file : o.data) inputs.push_back({"--data", file});
+  check_output_file_option("--out", o.out, inputs);
   PlanRequest request;
   request.config = read_plan_config(o.config);
   for (const auto& file : o.data) request.data_files.emplace_back(file);

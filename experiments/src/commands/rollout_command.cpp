@@ -62,7 +62,10 @@ Episode episode_of(const RealRollout& r, int id, double dt) {
 }
 
 int run_rollout(const RolloutOptions& o) {
-  check_output_file_option("--out", o.out);
+  std::vector<CommandInput> inputs = world_inputs(o.world);
+  inputs.push_back({"--policy", o.policy});
+  inputs.push_back({"--cost", o.cost_config});
+  check_output_file_option("--out", o.out, inputs);
   const SystemSignature signature = system_signature(o.world.system);
   if (signature.controls.empty()) throw InputError("--system " + o.world.system + ": " + passive_system_refusal(o.world.system));
   const PolicyFile policy = read_policy_file(o.policy);

@@ -74,7 +74,7 @@ int run_command(const RunArguments& a) {
   RunConfig config;
   RunOptions options;
   every_rank_then_agree(mpi, [&] {
-    check_output_file_option("--out", out);
+    check_output_file_option("--out", out, {system_input(a.system, "SYSTEM"), {"--config", a.config}});
     if (!a.no_plots) check_output_folder_option("--plots", a.plots);
     if (a.first_seed + static_cast<std::uint64_t>(a.seeds) - 1 > limits::kMaxSeed)
       throw InputError(fmt::format("--first-seed {} --seeds {}: the last seed exceeds {} (the largest seed)", a.first_seed,

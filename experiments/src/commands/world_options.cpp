@@ -31,6 +31,10 @@ void add_world_options(CLI::App& cmd, WorldOptions& o) {
       ->delimiter(',');
 }
 
+std::vector<CommandInput> world_inputs(const WorldOptions& o) {
+  return {system_input(o.system), {"--world", o.world_file}, {"--world-model", o.world_model}};
+}
+
 std::map<std::string, double> parse_assignments(const std::vector<std::string>& items, const std::string& option) {
   std::map<std::string, double> out;
   for (const auto& item : items) {

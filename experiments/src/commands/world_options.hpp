@@ -14,6 +14,7 @@
 
 #include "gpilqg/core/dynamics.hpp"
 #include "gpilqg/core/quantity.hpp"
+#include "output_options.hpp"
 
 namespace gpilqg::cli {
 
@@ -31,6 +32,9 @@ struct WorldOptions {
 /// Adds --system, --world, --world-model, --preset, --param, --effect, --actuator-noise and
 /// --multiplicative-noise.
 void add_world_options(CLI::App& command, WorldOptions& options);
+
+/// The files the world is read from: --system (a model file), --world and --world-model.
+std::vector<CommandInput> world_inputs(const WorldOptions& options);
 
 /// "name=value" items of option `option` -> {name: value}; an InputError names the option and the text.
 std::map<std::string, double> parse_assignments(const std::vector<std::string>& items, const std::string& option);

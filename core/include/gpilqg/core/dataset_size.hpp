@@ -8,7 +8,7 @@
 ///  (b) kMaxDatasetValues, whatever the file's size,
 /// and a reader refuses the dataset, naming it, instead of failing in the allocation (std::bad_alloc)
 /// or taking all the memory. Data stored outside the file (external storage, virtual datasets) is
-/// refused by (a) as well.
+/// refused before, when the file is opened (hdf5_self_contained.hpp).
 
 #include <cstdint>
 #include <optional>

@@ -22,6 +22,7 @@ namespace gpilqg {
 H5::H5File create_hdf5_in_memory(const std::filesystem::path& name);
 
 /// An editable in-memory copy of the existing HDF5 file `file` (the file itself is not modified).
+/// Throws DataError when the file refers to data outside it (check_hdf5_self_contained).
 H5::H5File open_hdf5_in_memory(const std::filesystem::path& file);
 
 /// Flushes the in-memory `file`, writes its image to the new file `destination` (write_new_file) and

@@ -7,7 +7,9 @@
 /// the HDF5 C++ API stays inside core. Bad input files throw DataError (measurements.hpp, a
 /// std::runtime_error): a path that is not a readable regular file of at most kMaxDataFileBytes
 /// (input_file.hpp), and a dataset or attribute declaring more values than the file can hold or than
-/// kMaxDatasetValues (dataset_size.hpp), refused before anything is allocated for it.
+/// kMaxDatasetValues (dataset_size.hpp), refused before anything is allocated for it, and a file with
+/// an object stored in another file (an external link, external raw storage, a virtual dataset),
+/// refused when it is opened (hdf5_self_contained.hpp).
 
 #include <cstdint>
 #include <filesystem>

@@ -16,6 +16,13 @@ namespace gpilqg {
 /// will be created, must be a folder this process can write into.
 std::optional<std::string> output_file_problem(const std::filesystem::path& file);
 
+/// Whether writing `output` would replace the existing file `input`: both name one file, by device
+/// and inode, with symbolic links followed on both sides (a hard link, or a symbolic link to the
+/// input, counts as the input). An output that is a symbolic link to an input is refused by the
+/// commands although the atomic rename would replace the link, not the file: the user meant that
+/// file. False when either does not exist or cannot be inspected.
+bool same_file(const std::filesystem::path& output, const std::filesystem::path& input);
+
 /// Why `folder` cannot receive output files (e.g. figures), or nullopt when it can: it must be a
 /// folder or absent, and it or its nearest existing ancestor must be writable.
 std::optional<std::string> output_folder_problem(const std::filesystem::path& folder);

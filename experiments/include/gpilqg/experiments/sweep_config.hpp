@@ -42,6 +42,7 @@ struct SweepConfig {
   std::string system;
   std::vector<std::uint64_t> seeds;
   std::filesystem::path out;
+  std::filesystem::path config;     ///< the base run config named by `config` (empty when absent)
   std::vector<std::string> fields;  ///< the grid's fields in file order
   std::vector<SweepPoint> points;
 };
