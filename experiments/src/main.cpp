@@ -14,8 +14,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "commands/json_arguments.hpp"
 #include "commands/commands.hpp"
+#include "commands/json_arguments.hpp"
 #include "commands/output_options.hpp"
 #include "gpilqg/core/plugin.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
