@@ -76,9 +76,9 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   const diagnosis::DiagnoseRequest& r = o.request;
   const SystemSignature signature = system_signature(r.system);
   const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(r);
-  check_output_file_option("--out", o.out);
+  check_output_file_option("--out", o.out, {"diagnose writes an HDF5 report", kHdf5Extensions});
   check_output_folder_option("--plots", o.plots);
-  check_output_file_option("--write-model", o.write_model);
+  check_output_file_option("--write-model", o.write_model, {"diagnose writes a TOML model file", kTomlExtensions});
   if (!o.plots.empty()) check_plotting();
   const MeasurementSet data = read_measurements(o.data, signature);
   diagnosis::DiagnosisReport report;

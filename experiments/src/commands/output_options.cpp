@@ -29,9 +29,11 @@ void remove_and_name(const std::vector<std::filesystem::path>& stale) {
 
 }  // namespace
 
-void check_output_file_option(const std::string& option, const std::filesystem::path& file) {
+void check_output_file_option(const std::string& option, const std::filesystem::path& file, const OutputFormat& format) {
   if (file.empty()) return;
   if (const auto problem = output_file_problem(file))
+    throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
+  if (const auto problem = output_extension_problem(file, format))
     throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
   remove_and_name(stale_temporaries(file));
 }

@@ -8,10 +8,15 @@
 #include <filesystem>
 #include <string>
 
+#include "gpilqg/core/output_path.hpp"
+
 namespace gpilqg::cli {
 
-/// Checks `file` with output_file_problem (output_path.hpp); an empty path (option not given) passes.
-void check_output_file_option(const std::string& option, const std::filesystem::path& file);
+/// Checks `file` with output_file_problem (output_path.hpp), then with output_extension_problem
+/// against `format` (what the command writes there and the names that format takes); an empty path
+/// (option not given) passes. Every output option of a fixed format goes through here:
+/// "--out p.csv: plan writes an HDF5 policy file; expected a name ending in .h5 or .hdf5".
+void check_output_file_option(const std::string& option, const std::filesystem::path& file, const OutputFormat& format);
 
 /// Checks `folder` with output_folder_problem; an empty path passes.
 void check_output_folder_option(const std::string& option, const std::filesystem::path& folder);

@@ -31,7 +31,7 @@ struct SimulateOptions {
 };
 
 int run_simulate(const SimulateOptions& o) {
-  check_output_file_option("--out", o.out);
+  check_output_file_option("--out", o.out, {"simulate writes a measurement file (CSV or HDF5)", kMeasurementExtensions});
   const auto signature = system_signature(o.world.system);
   const int n = static_cast<int>(signature.states.size());
   double input_delay = 0.0;

@@ -63,7 +63,8 @@ int sweep_command(const SweepArguments& a) {
   every_rank_then_agree(mpi, [&] {
     sweep = load_sweep_config(a.file);
     out = a.out.empty() ? sweep.out : std::filesystem::path(a.out);
-    check_output_file_option(a.out.empty() ? "out (in the sweep file)" : "--out", out);
+    check_output_file_option(a.out.empty() ? "out (in the sweep file)" : "--out", out,
+                             {"sweep writes an HDF5 result file", kHdf5Extensions});
     if (!a.no_plots) check_output_folder_option("--plots", a.plots);
   });
   const std::string rank_prefix = mpi.distributed() ? fmt::format("[rank {}] ", mpi.rank()) : "";
