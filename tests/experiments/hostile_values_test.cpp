@@ -77,36 +77,42 @@ TEST(HostileValues, EveryCommandRefusesAnOutputNameOfAnotherFormat) {
   struct Case {
     std::string arguments, message;
   };
+  // Absolute names in the test's folder and tiny configs: were a name accepted, the work stays small.
+  const auto in = [&](const std::string& name) { return quote(dir / name); };
+  const std::string run = "run cartpole --config " + in("run.toml") + " --no-plots";
   const std::vector<Case> cases = {
-      {"plan " + plan + " --out p.csv", "--out p.csv: plan writes an HDF5 policy file; expected a name ending in .h5 or .hdf5"},
-      {"run cartpole --no-plots --out r.csv", "--out r.csv: run writes an HDF5 result file; expected a name ending in .h5"},
-      {"merge a.h5 b.h5 --no-plots --out m.json", "--out m.json: merge writes an HDF5 result file"},
-      {"sweep " + sweep + " --no-plots --out s.toml", "--out s.toml: sweep writes an HDF5 result file"},
-      {"simulate --system cartpole --out d.txt", "--out d.txt: simulate writes a measurement file (CSV or HDF5); expected a "
-                                                 "name ending in .csv, .h5 or .hdf5"},
-      {"rollout --system cartpole --policy p.h5 --out log", "--out log: rollout writes a log (CSV or HDF5)"},
-      {"diagnose --system cartpole --data d.csv --out r.csv", "--out r.csv: diagnose writes an HDF5 report"},
-      {"diagnose --system cartpole --data d.csv --write-model m.h5",
-       "--write-model m.h5: diagnose writes a TOML model file; expected a name ending in .toml"},
-      {"profile d.h5 --backends exact --out p.json", "--out p.json: profile writes an HDF5 result file"},
-      {"data import log.csv --system cartpole --map m.toml --out set.txt", "--out set.txt: data import writes a measurement file"},
+      {"plan " + plan + " --out " + in("p.csv"), "p.csv: plan writes an HDF5 policy file; expected a name ending in .h5 or .hdf5"},
+      {run + " --out " + in("r.csv"), "r.csv: run writes an HDF5 result file; expected a name ending in .h5"},
+      {"merge a.h5 b.h5 --no-plots --out " + in("m.json"), "m.json: merge writes an HDF5 result file"},
+      {"sweep " + sweep + " --no-plots --out " + in("s.toml"), "s.toml: sweep writes an HDF5 result file"},
+      {"simulate --system cartpole --episodes 1 --steps 5 --out " + in("d.txt"),
+       "d.txt: simulate writes a measurement file (CSV or HDF5); expected a name ending in .csv, .h5 or .hdf5"},
+      {"rollout --system cartpole --policy p.h5 --out " + in("log"), "log: rollout writes a log (CSV or HDF5)"},
+      {"diagnose --system cartpole --data d.csv --out " + in("r.csv"), "r.csv: diagnose writes an HDF5 report"},
+      {"diagnose --system cartpole --data d.csv --write-model " + in("m.h5"),
+       "m.h5: diagnose writes a TOML model file; expected a name ending in .toml"},
+      {"profile d.h5 --backends exact --out " + in("p.json"), "p.json: profile writes an HDF5 result file"},
+      {"data import log.csv --system cartpole --map m.toml --out " + in("set.txt"), "set.txt: data import writes a measurement file"},
   };
   for (const Case& c : cases) {
     const auto r = test::run_cli(c.arguments);
     EXPECT_EQ(r.status, 2) << c.arguments << "\n" << r.err;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.arguments << "\n" << r.err;
   }
-  EXPECT_FALSE(fs::exists("p.csv"));
+  for (const char* name : {"p.csv", "r.csv", "m.json", "s.toml", "d.txt", "log", "m.h5", "p.json", "set.txt"})
+    EXPECT_FALSE(fs::exists(dir / name)) << name;
 }
 
 TEST(HostileValues, AnEmptyBackendListIsRefusedNamingTheOption) {
+  const fs::path dir = test::temporary_dir("hostile_backends");
+  const std::string run = "run cartpole --no-plots --config " + quote(write(dir / "run.toml", test::kTinyRun));
   for (const char* list : {"''", "','", "'exact,'"}) {
-    const auto r = test::run_cli(fmt::format("run cartpole --no-plots --backends {} --out never.h5", list));
+    const auto r = test::run_cli(fmt::format("{} --backends {} --out {}", run, list, quote(dir / "never.h5")));
     EXPECT_EQ(r.status, 2) << list << "\n" << r.err;
     EXPECT_NE(r.err.find("--backends: backend list"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("empty entry"), std::string::npos) << r.err;
   }
-  EXPECT_FALSE(fs::exists("never.h5"));
+  EXPECT_FALSE(fs::exists(dir / "never.h5"));
 }
 
 // ---- policy files --------------------------------------------------------------------------------
