@@ -9,6 +9,8 @@
 #include <cctype>
 #include <cmath>
 #include <set>
+#include <tuple>
+#include <utility>
 #include <stdexcept>
 
 #include "gpilqg/core/atomic_file.hpp"
@@ -19,7 +21,19 @@ namespace gpilqg {
 double Episode::dt() const {
   const Eigen::Index T = t.size();
   if (T < 2) return 0.0;
-  return (t(T - 1) - t(0)) / static_cast<double>(T - 1);
+  const double steps = static_cast<double>(T - 1);
+  const double dt = (t(T - 1) - t(0)) / steps;
+  // Times near the largest double (e.g. -1e308 to 1e308) span more than a double holds while their
+  // step does not: divided first, the step is finite whenever it is representable.
+  return std::isfinite(dt) ? dt : t(T - 1) / steps - t(0) / steps;
+}
+
+std::optional<std::string> column_name_problem(std::string_view name) {
+  if (name.empty()) return "is empty";
+  if (name.find(',') != std::string_view::npos) return "contains a comma, which separates CSV fields";
+  if (name.find_first_of("\r\n") != std::string_view::npos) return "contains a line break, which ends a CSV row";
+  if (name == "episode" || name == "t") return fmt::format("is '{}', a fixed column of measurement files", name);
+  return std::nullopt;
 }
 
 long MeasurementSet::sample_count() const {
@@ -171,29 +185,35 @@ void check_writable(const MeasurementSet& set) {
 namespace {
 
 /// Accumulates one column over all samples: min, max, mean, and the population standard deviation
-/// (computed from deviations about the mean in a second pass, for accuracy).
+/// (computed from deviations about the mean in a second pass, for accuracy). Values near the largest
+/// double (1e308) overflow the plain sum or the squared deviations; the statistics are then taken
+/// of the values divided by the largest magnitude s = max(|min|, |max|) and scaled back, which is
+/// exact in range: |mean| <= s and std <= (max - min) / 2 <= s are finite whenever the values are.
 ColumnSummary summarize_column(const Quantity& quantity, const std::vector<Episode>& episodes,
                                Eigen::Index column, bool is_state) {
   ColumnSummary s{quantity.name, quantity.unit};
   long count = 0;
-  double sum = 0.0;
   for (const Episode& e : episodes) {
     const auto values = is_state ? e.x.col(column) : e.u.col(column);
     if (values.size() == 0) continue;
     const double lo = values.minCoeff(), hi = values.maxCoeff();
     s.min = count == 0 ? lo : std::min(s.min, lo);
     s.max = count == 0 ? hi : std::max(s.max, hi);
-    sum += values.sum();
     count += values.size();
   }
   if (count == 0) return s;
-  s.mean = sum / static_cast<double>(count);
-  double squares = 0.0;
-  for (const Episode& e : episodes) {
-    const auto values = is_state ? e.x.col(column) : e.u.col(column);
-    squares += (values.array() - s.mean).square().sum();
-  }
-  s.std = std::sqrt(squares / static_cast<double>(count));
+  const auto moments = [&](double scale) {
+    double sum = 0.0;
+    for (const Episode& e : episodes) sum += ((is_state ? e.x.col(column) : e.u.col(column)).array() / scale).sum();
+    const double mean = sum / static_cast<double>(count);
+    double squares = 0.0;
+    for (const Episode& e : episodes)
+      squares += ((is_state ? e.x.col(column) : e.u.col(column)).array() / scale - mean).square().sum();
+    return std::pair{mean * scale, std::sqrt(squares / static_cast<double>(count)) * scale};
+  };
+  std::tie(s.mean, s.std) = moments(1.0);
+  const double scale = std::max(std::abs(s.min), std::abs(s.max));
+  if (!(std::isfinite(s.mean) && std::isfinite(s.std)) && scale > 0.0) std::tie(s.mean, s.std) = moments(scale);
   return s;
 }
 
@@ -205,14 +225,16 @@ MeasurementSummary summarize(const MeasurementSet& set) {
   summary.episodes = static_cast<int>(set.episodes.size());
   summary.samples = set.sample_count();
   bool first = true;
+  long double duration = 0.0L;  // a span of times near +-1e308 exceeds a double; its sum is kept exact in range
   for (const Episode& e : set.episodes) {
     if (e.length() < 2) continue;
     const double dt = e.dt();
     summary.dt_min = first ? dt : std::min(summary.dt_min, dt);
     summary.dt_max = first ? dt : std::max(summary.dt_max, dt);
-    summary.duration += e.t(e.length() - 1) - e.t(0);
+    duration += static_cast<long double>(e.t(e.length() - 1)) - static_cast<long double>(e.t(0));
     first = false;
   }
+  summary.duration = static_cast<double>(duration);
   for (std::size_t j = 0; j < set.system.states.size(); ++j)
     summary.states.push_back(
         summarize_column(set.system.states[j], set.episodes, static_cast<Eigen::Index>(j), true));

@@ -10,12 +10,14 @@
 #include <limits>
 #include <sstream>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include "gpilqg/core/input_file.hpp"
+#include "gpilqg/core/measurements.hpp"
 #include "mujoco_model_files.hpp"
 #include "urdf_actuators.hpp"
 
@@ -179,6 +181,26 @@ std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
   if (m->njnt == 0) throw std::invalid_argument(fmt::format("{}: the model has no joints; expected hinge or slide joints", path));
   // No actuators: a passive system (no controls), for free-swing and decay data.
   model->read_names();
+  // The names become the columns of every measurement file of the system: refused here, before any
+  // work, when a file could not hold them (a CSV written but not read back) or two would coincide.
+  const auto refuse = [&](const std::string& element, int index, const std::string& name, const std::string& problem) {
+    throw std::invalid_argument(fmt::format("{}: {} {} name '{}' {}; it names a column of the data files (docs/formats.md)",
+                                            path, element, index, name, problem));
+  };
+  for (int j = 0; j < m->njnt; ++j)
+    if (const auto problem = column_name_problem(object_name(m, mjOBJ_JOINT, j)))
+      refuse("joint", j, object_name(m, mjOBJ_JOINT, j), *problem);
+  for (int a = 0; a < m->nu; ++a)
+    if (const auto problem = column_name_problem(object_name(m, mjOBJ_ACTUATOR, a)))
+      refuse("actuator", a, object_name(m, mjOBJ_ACTUATOR, a), *problem);
+  std::set<std::string> columns;
+  for (const auto* quantities : {&model->states(), &model->controls()})
+    for (const Quantity& q : *quantities)
+      if (!columns.insert(q.name).second)
+        throw std::invalid_argument(fmt::format(
+            "{}: the state or control name '{}' occurs twice (a joint's velocity is named '<joint>_dot'); every column "
+            "of the data files needs its own name",
+            path, q.name));
   return model;
 }
 

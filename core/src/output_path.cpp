@@ -5,6 +5,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <system_error>
@@ -36,6 +38,18 @@ std::optional<std::string> folder_problem(fs::path folder) {
 }
 
 }  // namespace
+
+std::optional<std::string> output_extension_problem(const fs::path& file, const OutputFormat& format) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (std::find(format.extensions.begin(), format.extensions.end(), extension) != format.extensions.end())
+    return std::nullopt;
+  std::string names;
+  for (std::size_t i = 0; i < format.extensions.size(); ++i)
+    names += (i == 0 ? "" : i + 1 == format.extensions.size() ? " or " : ", ") + format.extensions[i];
+  return format.what + "; expected a name ending in " + names;
+}
 
 std::optional<std::string> output_file_problem(const fs::path& file) {
   if (file.empty() || !file.has_filename()) return std::string("expected a file name, not a folder path");

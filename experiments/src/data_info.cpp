@@ -14,8 +14,23 @@ namespace {
 /// Relative agreement of the episodes' steps, as in the data contract (DESIGN.md section 4).
 constexpr double kDtAgreement = 1e-6;
 
+/// What a statistic beyond the largest double reads as, in the table and in JSON (where a number
+/// would be written as null): only a duration or step of times spanning more than 1.8e308 s.
+constexpr const char* kNotRepresentable = "not representable (beyond 1.8e308)";
+
+/// A statistic as JSON: the number, or kNotRepresentable when it is not finite.
+nlohmann::json statistic(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(kNotRepresentable);
+}
+
+/// A statistic in the table: "{:.6g}" with `suffix`, or kNotRepresentable.
+std::string statistic_text(double value, const char* suffix = "") {
+  return std::isfinite(value) ? fmt::format("{:.6g}{}", value, suffix) : kNotRepresentable;
+}
+
 nlohmann::json column_json(const ColumnSummary& c) {
-  return {{"name", c.name}, {"unit", c.unit}, {"min", c.min}, {"max", c.max}, {"mean", c.mean}, {"std", c.std}};
+  return {{"name", c.name},           {"unit", c.unit},           {"min", statistic(c.min)},
+          {"max", statistic(c.max)}, {"mean", statistic(c.mean)}, {"std", statistic(c.std)}};
 }
 
 nlohmann::json columns_json(const std::vector<ColumnSummary>& columns) {
@@ -27,7 +42,8 @@ nlohmann::json columns_json(const std::vector<ColumnSummary>& columns) {
 }  // namespace
 
 std::optional<double> common_dt(const MeasurementSummary& summary) {
-  if (summary.dt_max - summary.dt_min <= kDtAgreement * std::abs(summary.dt_max)) return summary.dt_min;
+  if (summary.dt_max == summary.dt_min || summary.dt_max - summary.dt_min <= kDtAgreement * std::abs(summary.dt_max))
+    return summary.dt_min;
   return std::nullopt;
 }
 
@@ -41,10 +57,13 @@ std::string format_data_info(const std::filesystem::path& file, const Measuremen
   line("episodes", std::to_string(summary.episodes));
   line("samples", std::to_string(summary.samples));
   if (const auto dt = common_dt(summary))
-    line("dt", fmt::format("{:.6g} s", *dt));
-  else
+    line("dt", statistic_text(*dt, " s"));
+  else if (std::isfinite(summary.dt_max))
     line("dt", fmt::format("{:.6g} to {:.6g} s (differs between episodes)", summary.dt_min, summary.dt_max));
-  line("duration", fmt::format("{:.6g} s", summary.duration));
+  else
+    line("dt", fmt::format("{} to {} (differs between episodes)", statistic_text(summary.dt_min, " s"),
+                           statistic_text(summary.dt_max, " s")));
+  line("duration", statistic_text(summary.duration, " s"));
 
   std::size_t name_width = 4, unit_width = 4;
   for (const auto* columns : {&summary.states, &summary.controls})
@@ -70,10 +89,10 @@ nlohmann::json data_info_json(const std::filesystem::path& file, const Measureme
           {"system", summary.system},
           {"episodes", summary.episodes},
           {"samples", summary.samples},
-          {"dt", dt ? nlohmann::json(*dt) : nlohmann::json(nullptr)},
-          {"dt_min", summary.dt_min},
-          {"dt_max", summary.dt_max},
-          {"duration_s", summary.duration},
+          {"dt", dt ? statistic(*dt) : nlohmann::json(nullptr)},  // null: the episodes' steps differ
+          {"dt_min", statistic(summary.dt_min)},
+          {"dt_max", statistic(summary.dt_max)},
+          {"duration_s", statistic(summary.duration)},
           {"states", columns_json(summary.states)},
           {"controls", columns_json(summary.controls)}};
 }

@@ -45,6 +45,7 @@ void check_previous(const PolicyFile& previous, const std::filesystem::path& fil
   if (previous.state_names != names_of(signature.states) || previous.control_names != names_of(signature.controls))
     fail("state_names", fmt::format("[{}] / [{}]", fmt::join(previous.state_names, ", "), fmt::join(previous.control_names, ", ")),
          fmt::format("the states and controls of {}", c.system));
+  check_policy_system(previous, file, c.system);
   if (!same_relative(previous.dt, c.dt)) fail("dt", fmt::format("{}", previous.dt), fmt::format("{}", c.dt));
   if (previous.policy.horizon() != c.horizon)
     fail("horizon", std::to_string(previous.policy.horizon()), std::to_string(c.horizon));

@@ -9,6 +9,7 @@
 #include "gpilqg/core/hdf5_reader.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
 #include "gpilqg/core/input_file.hpp"
+#include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/gp/gp_io.hpp"
@@ -38,6 +39,70 @@ void check_shapes(const PolicyFile& p) {
   if ((a.u_min.size() && a.u_min.size() != m) || (a.u_max.size() && a.u_max.size() != m)) fail("a limit is not of size m");
   if (!(p.dt > 0.0) || !std::isfinite(p.dt)) fail("dt must be finite and > 0");
   if (!std::isfinite(p.predicted_cost) || !std::isfinite(p.expected_cost)) fail("the costs must be finite");
+}
+
+/// The checks of the values a policy file holds, each failing with an InputError naming the file
+/// and the attribute or dataset: a controller runs these numbers on a robot, so a NaN, an infinite
+/// gain or inverted limits are refused on reading rather than discovered at the first step.
+class PolicyValues {
+ public:
+  explicit PolicyValues(const std::filesystem::path& file) : file_(file) {}
+
+  [[noreturn]] void fail(const std::string& object, const std::string& problem) const {
+    throw InputError(fmt::format("{}: {} '{}': {}", file_.string(), object.find('@') == std::string::npos ? "dataset" : "attribute",
+                                 object, problem));
+  }
+
+  /// Every entry of a list finite; the first that is not is named with its index.
+  void finite(const std::string& object, const Vector& values) const {
+    for (Eigen::Index i = 0; i < values.size(); ++i)
+      if (!std::isfinite(values(i))) fail(object, fmt::format("entry {} is {}; expected finite numbers", i, values(i)));
+  }
+
+  /// Every entry of a dataset stored transposed (x_bar, u_bar: one row per step) finite; the first
+  /// that is not is named by its [row, column] in the file.
+  void finite_rows(const std::string& object, const Matrix& columns) const {
+    for (Eigen::Index t = 0; t < columns.cols(); ++t)
+      for (Eigen::Index i = 0; i < columns.rows(); ++i)
+        if (!std::isfinite(columns(i, t)))
+          fail(object, fmt::format("entry [{}, {}] is {}; expected finite numbers", t, i, columns(i, t)));
+  }
+
+  void check(const PolicyFile& p) const {
+    const AffinePolicy& a = p.policy;
+    if (p.system.empty()) fail("/policy@system", "is empty; expected the name of the planned system");
+    if (p.state_names.empty()) fail("/policy@state_names", "is empty; expected one name per state");
+    if (p.control_names.empty()) fail("/policy@control_names", "is empty; expected one name per control");
+    if (!(std::isfinite(p.dt) && p.dt > 0.0)) fail("/policy@dt", fmt::format("is {}; expected a finite number > 0", p.dt));
+    for (const auto& [name, value] : {std::pair{"predicted_cost", p.predicted_cost}, std::pair{"expected_cost", p.expected_cost}})
+      if (!std::isfinite(value)) fail(fmt::format("/policy@{}", name), fmt::format("is {}; expected a finite number", value));
+    finite_rows("/policy/x_bar", a.x_bar);
+    finite_rows("/policy/u_bar", a.u_bar);
+    for (std::size_t t = 0; t < a.K.size(); ++t)
+      for (Eigen::Index r = 0; r < a.K[t].rows(); ++r)
+        for (Eigen::Index c = 0; c < a.K[t].cols(); ++c)
+          if (!std::isfinite(a.K[t](r, c)))
+            fail("/policy/K", fmt::format("entry [{}, {}, {}] is {}; expected finite numbers", t, r, c, a.K[t](r, c)));
+    finite("/policy@u_min", a.u_min);
+    finite("/policy@u_max", a.u_max);
+    if (a.u_min.size() && a.u_max.size())
+      for (Eigen::Index i = 0; i < a.u_min.size(); ++i)
+        if (!(a.u_min(i) <= a.u_max(i)))
+          fail("/policy@u_min", fmt::format("entry {} is {}, above u_max's {}; expected u_min <= u_max", i, a.u_min(i), a.u_max(i)));
+  }
+
+ private:
+  const std::filesystem::path& file_;
+};
+
+/// Whether the system a policy was planned for is `asked`: the same name, or two model files of the
+/// same file name. A policy names its model file by the path the planner used (relative to the plan
+/// config's folder); the controller may load the same model from another folder or machine, and
+/// the state and control names, checked by each caller, must match as well.
+bool same_planned_system(const std::string& planned, const std::string& asked) {
+  if (planned == asked) return true;
+  return is_model_file_name(planned) && is_model_file_name(asked) &&
+         std::filesystem::path(planned).filename() == std::filesystem::path(asked).filename();
 }
 
 }  // namespace
@@ -102,7 +167,10 @@ PolicyFile read_policy_file(const std::filesystem::path& file) {
     p.control_names = h5.string_list_attribute(g, "control_names");
     p.predicted_cost = h5.number_attribute(g, "predicted_cost");
     p.expected_cost = h5.number_attribute(g, "expected_cost");
-    p.round = static_cast<int>(h5.number_attribute(g, "round"));
+    const double round = h5.number_attribute(g, "round");
+    if (!(round >= 0.0 && round <= 1e6) || std::floor(round) != round)
+      throw InputError(fmt::format("{}: attribute '{}@round' is {}; expected a whole number in [0, 1000000]", file.string(), g, round));
+    p.round = static_cast<int>(round);
     p.data_files = h5.has_attribute(g, "data_files") ? h5.string_list_attribute(g, "data_files") : std::vector<std::string>{};
     p.created = h5.string_attribute(g, "created");
     p.gpilqg_version = h5.string_attribute(g, "gpilqg_version");
@@ -133,6 +201,7 @@ PolicyFile read_policy_file(const std::filesystem::path& file) {
                                      g, limit, values.size(), m));
       (std::string(limit) == "u_min" ? p.policy.u_min : p.policy.u_max) = as_vector(values);
     }
+    PolicyValues(file).check(p);
     if (h5.exists(std::string(kModel) + "/0")) p.model_backend = h5.string_attribute(std::string(kModel) + "/0", "backend");
     try {
       check_shapes(p);
@@ -141,6 +210,12 @@ PolicyFile read_policy_file(const std::filesystem::path& file) {
     }
     return p;
   });
+}
+
+void check_policy_system(const PolicyFile& policy, const std::filesystem::path& file, const std::string& system) {
+  if (!same_planned_system(policy.system, system))
+    throw InputError(fmt::format("{}: attribute '/policy@system' is '{}'; expected '{}', the system it is used for",
+                                 file.string(), policy.system, system));
 }
 
 std::shared_ptr<const gp::ResidualModel> read_policy_model(const std::filesystem::path& file,

@@ -54,11 +54,9 @@ std::vector<RunTask> read_tasks(const TomlFields& f, const toml::table& root, in
     t.x0 = f.state_vector(p + ".x0", n);
     t.goal = f.state_vector(p + ".goal", n);
     t.horizon = f.integer_in(p + ".horizon", 2, limits::kMaxHorizon);
-    t.Q = f.vector(p + ".Q", n);
-    t.R = f.vector(p + ".R", m);
-    t.Qf = f.vector(p + ".Qf", n);
-    for (const char* w : {".Q", ".R", ".Qf"})
-      if ((f.vector(p + w, -1).array() < 0.0).any()) f.fail(p + w, "has negative entries; expected weights >= 0");
+    t.Q = f.weight_vector(p + ".Q", n);
+    t.R = f.weight_vector(p + ".R", m);
+    t.Qf = f.weight_vector(p + ".Qf", n);
     if ((t.R.array() <= 0.0).any()) f.fail(p + ".R", "must be > 0 (the control weight makes each step well posed)");
     const auto flag = [&](const std::string& key) {
       const toml::node* node = root.at_path(p + "." + key).node();

@@ -22,6 +22,16 @@ std::pair<std::string, std::string> split_first(const std::string& path) {
   return {path.substr(0, slash), path.substr(slash + 1)};
 }
 
+/// The index of flat entry `i` of a row-major array of shape `dims`: "[2, 0]" ("[i]" for a scalar).
+std::string entry_index(std::size_t i, const std::vector<std::uint64_t>& dims) {
+  std::vector<std::uint64_t> index(dims.size());
+  for (std::size_t axis = dims.size(); axis-- > 0;) {
+    index[axis] = dims[axis] == 0 ? 0 : i % dims[axis];
+    i = dims[axis] == 0 ? i : i / dims[axis];
+  }
+  return fmt::format("[{}]", index.empty() ? std::to_string(i) : fmt::format("{}", fmt::join(index, ", ")));
+}
+
 bool contains(const std::vector<std::string>& names, const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
 }
@@ -82,6 +92,19 @@ class PartChecker {
         fail(fmt::format("the soft link '/{}/gp_ilqg' points to '{}', which is not one of the task's algorithms", task.name,
                          task.main_algorithm));
       check_data(task);
+    }
+  }
+
+  /// Every value of every dataset is finite: `gpilqg run` writes none other (a diverged rollout is
+  /// counted in `diverged`, its cost stays finite), so a NaN or inf is a damaged or edited file and
+  /// would otherwise be copied into the merged result and every mean over seeds.
+  void check_finite() const {
+    for (const std::string& path : h5_.datasets()) {
+      const std::vector<double> values = h5_.read_array(path);
+      const auto bad = std::find_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); });
+      if (bad != values.end())
+        fail(fmt::format("dataset '{}' entry {} is {}; expected finite numbers", path,
+                         entry_index(static_cast<std::size_t>(bad - values.begin()), h5_.shape(path)), *bad));
     }
   }
 
@@ -182,6 +205,7 @@ RunResultPart read_run_result_part(const std::filesystem::path& file) {
     checker.read_root();
     checker.read_datasets();
     checker.check_tasks();
+    checker.check_finite();
   });
   return part;
 }

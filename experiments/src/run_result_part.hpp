@@ -48,8 +48,10 @@ struct RunResultPart {
 /// Opens `file` and checks it is a result of `gpilqg run` of this layout: schema_version
 /// kRunResultsSchemaVersion; /seeds of distinct whole numbers; every dataset known to the layout
 /// (seed_axis() for the algorithms' datasets) with one slice per seed along its seed axis; data/
-/// datasets of one row per entry of data/seed. Throws InputError naming the file and the dataset or
-/// attribute otherwise (a file that is not HDF5, not a run result, or made by another version).
+/// datasets of one row per entry of data/seed; every value of every dataset finite. Throws
+/// InputError naming the file and the dataset or attribute otherwise (a file that is not HDF5, not
+/// a run result, made by another version, or holding a NaN or inf: "dataset '/swing_up/gp_ilqg/cost'
+/// entry [0, 1] is nan; expected finite numbers").
 RunResultPart read_run_result_part(const std::filesystem::path& file);
 
 }  // namespace gpilqg

@@ -1,8 +1,10 @@
 #include "gpilqg/experiments/solve_config.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
-
+#include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
@@ -57,11 +59,9 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   if (const auto problem = limits::trajectory_memory_problem(c.horizon, n, m, false)) f.fail("problem.horizon", *problem);
   c.x0 = f.state_vector("problem.x0", n);
   c.goal = f.state_vector("problem.goal", n);
-  c.Q = f.vector("problem.Q", n);
-  c.R = f.vector("problem.R", m);
-  c.Qf = f.vector("problem.Qf", n);
-  for (const char* field : {"problem.Q", "problem.R", "problem.Qf"})
-    if ((f.vector(field, -1).array() < 0.0).any()) f.fail(field, "has negative entries; expected weights >= 0");
+  c.Q = f.weight_vector("problem.Q", n);
+  c.R = f.weight_vector("problem.R", m);
+  c.Qf = f.weight_vector("problem.Qf", n);
   c.u_min = f.vector("problem.u_min", m, Vector());
   c.u_max = f.vector("problem.u_max", m, Vector());
   if (c.u_min.size() && c.u_max.size() && (c.u_min.array() > c.u_max.array()).any())
@@ -110,6 +110,16 @@ DdpResult solve_config(const SolveConfig& c) {
   const Matrix u0 = c.u_init.size() ? Matrix(c.u_init.replicate(1, c.horizon)) : Matrix(Matrix::Zero(m, c.horizon));
   DdpSolver solver(c.solver);
   return solver.solve(problem, u0);
+}
+
+std::string initial_rollout_failure(double cost) {
+  if (std::isfinite(cost))
+    return fmt::format("drive the model beyond the divergence bound (a state not finite or beyond |x| = {:g}); "
+                       "try another problem.u_init",
+                       kDivergedStateMagnitude);
+  return fmt::format("keep every state within the divergence bound (|x| <= {:g}), but their cost overflowed (not a "
+                     "finite number); try smaller cost weights Q, R, Qf or a shorter system.dt",
+                     kDivergedStateMagnitude);
 }
 
 }  // namespace gpilqg

@@ -7,6 +7,7 @@
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -209,6 +210,18 @@ Vector TomlFields::state_vector(const std::string& path, int size, std::optional
 Vector TomlFields::control_vector(const std::string& path, int size, std::optional<Vector> fallback) const {
   Vector v = vector(path, size, std::move(fallback));
   check_bound(path, v, "beyond it a control drives every model past the divergence bound");
+  return v;
+}
+
+Vector TomlFields::weight_vector(const std::string& path, int size, std::optional<Vector> fallback) const {
+  Vector v = vector(path, size, std::move(fallback));
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (v(i) < 0.0) fail(path, fmt::format("has negative entries (entry {} is {:g}); expected weights >= 0", i, v(i)));
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (v(i) > limits::kMaxCostWeight)
+      fail(path, fmt::format("entry {} is {:g}; expected a weight in [0, {:g}] (a larger one makes the cost of states "
+                             "within the divergence bound overflow)",
+                             i, v(i), limits::kMaxCostWeight));
   return v;
 }
 

@@ -7,6 +7,8 @@
 #include "gpilqg/experiments/run_merge.hpp"
 
 #include <fstream>
+#include <functional>
+#include <limits>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -224,6 +226,34 @@ TEST_F(RunMerge, FilesThatAreNotDistinctResultPartsAreRefused) {
   std::ofstream(text) << "not HDF5\n";
   EXPECT_EQ(refusal({text, parts_[0]}, dir_ / "merged.h5"), text.string() + ": not an HDF5 file; expected a result file of `gpilqg run`");
   EXPECT_NE(refusal({dir_ / "absent.h5", parts_[0]}, dir_ / "merged.h5").find("absent.h5"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "merged.h5"));
+}
+
+TEST_F(RunMerge, APartHoldingANaNOrAnInfIsRefusedNamingTheDatasetAndTheEntry) {
+  struct Case {
+    const char* name;
+    std::function<void(IterationRecord&)> damage;
+    int iteration;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"nan_cost", [](IterationRecord& r) { r.evaluation.mean_cost = std::numeric_limits<double>::quiet_NaN(); }, 1,
+       "dataset '/first/gp_ilqg/cost' entry [1, 0] is nan; expected finite numbers"},
+      {"inf_state", [](IterationRecord& r) { r.evaluation.example.x(2, 3) = std::numeric_limits<double>::infinity(); }, 0,
+       "dataset '/first/gp_ilqg/iter_0/eval_x' entry [0, 2, 3] is inf; expected finite numbers"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    RunResults damaged = single_[1];
+    TaskResults& task = damaged.tasks[0];
+    c.damage(task.seeds[0][index_of(task, "gp_ilqg")].iterations[static_cast<std::size_t>(c.iteration)]);
+    const fs::path part = written(dir_ / fmt::format("{}.h5", c.name), damaged);
+    EXPECT_EQ(refusal({parts_[0], part}, dir_ / "merged.h5"), part.string() + ": " + c.message);
+    const auto r = test::run_cli(fmt::format("merge '{}' '{}' --no-plots --out '{}'", parts_[0].string(), part.string(),
+                                             (dir_ / "merged.h5").string()));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find(part.string() + ": " + c.message), std::string::npos) << r.err;
+  }
   EXPECT_FALSE(fs::exists(dir_ / "merged.h5"));
 }
 

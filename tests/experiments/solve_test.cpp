@@ -74,6 +74,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadConfig{"wrong_size", "x0 = [0, 0, 0, 0]", "x0 = [0, 0, 0]", "field 'problem.x0': has 3 entries; expected 4"},
         BadConfig{"not_a_number", "R = [0.1]", "R = [\"a\"]", "field 'problem.R': entry 0 is not a number"},
         BadConfig{"negative_weight", "R = [0.1]", "R = [-0.1]", "field 'problem.R': has negative entries"},
+        // A weight of 1e308 makes the cost of a state of 10 overflow, which the solver would take for divergence.
+        BadConfig{"huge_weight", "Qf = [100, 100, 1000, 100]", "Qf = [1e308, 100, 1000, 100]",
+                  "field 'problem.Qf': entry 0 is 1e+308; expected a weight in [0, 1e+150] (a larger one makes the cost "
+                  "of states within the divergence bound overflow)"},
         BadConfig{"bad_algorithm", "algorithm = \"ilqr\"", "algorithm = \"ddp\"", "field 'solver.algorithm'"},
         BadConfig{"bad_integrator", "integrator = \"euler\"", "integrator = \"rk45\"", "field 'system.integrator'"},
         BadConfig{"zero_dt", "dt = 0.05", "dt = 0", "field 'system.dt': must be > 0"},

@@ -33,7 +33,7 @@ struct DataImportOptions {
 /// Reads the map first (its errors need no log), then the log; writes the set (by extension, .h5 /
 /// .hdf5 or .csv) and prints the report.
 int run_data_import(const DataImportOptions& options) {
-  check_output_file_option("--out", options.out,
+  check_output_file_option("--out", options.out, {"data import writes a measurement file (CSV or HDF5)", kMeasurementExtensions},
                            {{"LOG", options.log}, {"--map", options.map}, system_input(options.system)});
   const SystemSignature signature = system_signature(options.system);
   const LogMap map = read_import_map(options.map);

@@ -76,9 +76,10 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   const DiagnoseOptions& o = options_given;
   const diagnosis::DiagnoseRequest& r = o.request;
   const std::vector<CommandInput> inputs = {{"--data", o.data}, {"--model", r.model_file}, system_input(r.system)};
-  check_output_file_option("--out", o.out, inputs);
+  check_output_file_option("--out", o.out, {"diagnose writes an HDF5 report", kHdf5Extensions}, inputs);
   check_output_folder_option("--plots", o.plots);
-  check_output_file_option("--write-model", o.write_model, inputs);
+  check_output_file_option("--write-model", o.write_model, {"diagnose writes a TOML model file", kTomlExtensions},
+                           inputs);
   const SystemSignature signature = system_signature(r.system);
   const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(r);
   if (!o.plots.empty()) check_plotting();

@@ -25,7 +25,7 @@ int merge_command(const MergeArguments& a) {
   const std::filesystem::path out = a.out;
   std::vector<CommandInput> inputs;
   for (const auto& part : a.parts) inputs.push_back({"PART", part});
-  check_output_file_option("--out", out, inputs);
+  check_output_file_option("--out", out, {"merge writes an HDF5 result file", kHdf5Extensions}, inputs);
   if (!a.no_plots) check_output_folder_option("--plots", a.plots);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
   const MergeSummary summary = merge_run_results(std::vector<std::filesystem::path>(a.parts.begin(), a.parts.end()), out);

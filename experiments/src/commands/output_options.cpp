@@ -50,10 +50,12 @@ CommandInput system_input(const std::string& system, const std::string& name) {
 
 void set_program_inputs(std::vector<CommandInput> inputs) { program_inputs() = std::move(inputs); }
 
-void check_output_file_option(const std::string& option, const std::filesystem::path& file,
+void check_output_file_option(const std::string& option, const std::filesystem::path& file, const OutputFormat& format,
                               const std::vector<CommandInput>& inputs) {
   if (file.empty()) return;
   if (const auto problem = output_file_problem(file))
+    throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
+  if (const auto problem = output_extension_problem(file, format))
     throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
   refuse_input(option, file, inputs);
   refuse_input(option, file, program_inputs());

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "gpilqg/core/output_path.hpp"
+
 namespace gpilqg::cli {
 
 /// A file a command reads, as messages name it: the option or argument that gave it ("--data",
@@ -18,12 +20,15 @@ struct CommandInput {
   std::filesystem::path file;
 };
 
-/// Checks `file` with output_file_problem (output_path.hpp); an empty path (option not given) passes.
+/// Checks `file` with output_file_problem (output_path.hpp), then with output_extension_problem
+/// against `format` (what the command writes there and the names that format takes); an empty path
+/// (option not given) passes. Every output option of a fixed format goes through here:
+/// "--out p.csv: plan writes an HDF5 policy file; expected a name ending in .h5 or .hdf5".
 /// An output that is the same file as one of `inputs` or of the program's inputs (same_file, e.g.
 /// `data import log.csv --out log.csv`) is refused too: writing it would replace the input. Throws
 /// InputError "<option> <file>: is the same file as <name> <input>, an input of the command; expected a
 /// file that is not one of its inputs".
-void check_output_file_option(const std::string& option, const std::filesystem::path& file,
+void check_output_file_option(const std::string& option, const std::filesystem::path& file, const OutputFormat& format,
                               const std::vector<CommandInput>& inputs = {});
 
 /// {"--system", system} when `system` is a model file (is_model_file_name), else an empty input.

@@ -14,6 +14,7 @@
 #include "output_options.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/planning.hpp"
+#include "gpilqg/experiments/solve_config.hpp"
 
 namespace gpilqg::cli {
 
@@ -31,7 +32,7 @@ struct PlanOptions {
 int run_plan(const PlanOptions& o) {
   std::vector<CommandInput> inputs = {{"CONFIG", o.config}, {"--previous", o.previous}};
   for (const auto& file : o.data) inputs.push_back({"--data", file});
-  check_output_file_option("--out", o.out, inputs);
+  check_output_file_option("--out", o.out, {"plan writes an HDF5 policy file", kHdf5Extensions}, inputs);
   PlanRequest request;
   request.config = read_plan_config(o.config);
   for (const auto& file : o.data) request.data_files.emplace_back(file);
@@ -40,8 +41,12 @@ int run_plan(const PlanOptions& o) {
   const PlannedPolicy planned = plan_policy(request);
   const DdpSummary& s = planned.summary;
   if (s.termination == DdpTermination::InitialRolloutDiverged) {
-    std::cerr << fmt::format("error: the initial controls drive the model to non-finite states; no policy was "
-                             "written to {} (try other [problem] u_init or a shorter horizon)\n", o.out);
+    Trajectory reached;  // the states before the divergence bound, the initial controls
+    reached.x = planned.file.policy.x_bar;
+    reached.u = planned.file.policy.u_bar;
+    std::cerr << fmt::format("error: the initial controls {}; no policy was written to {}\n",
+                             initial_rollout_failure(trajectory_cost(
+                                 make_solve_cost(request.config.problem), reached)), o.out);
     return kExitInternalFailure;
   }
   write_policy_file(o.out, planned.file, planned.model.get());

@@ -113,7 +113,8 @@ int run_profile_command(ProfileCommandOptions& o) {
   ProfileOptions options;
   ProfileData data;
   every_rank_then_agree(mpi, [&] {
-    check_output_file_option("--out", o.out, {{"DATA", o.file}, system_input(o.data.system)});
+    check_output_file_option("--out", o.out, {"profile writes an HDF5 result file", kHdf5Extensions},
+                             {{"DATA", o.file}, system_input(o.data.system)});
     check_output_folder_option("--plots", o.plots);
     if (o.target == "residual")
       o.data.target = ProfileTarget::Residual;

@@ -2,6 +2,7 @@
 /// simulated world and log what a robot would log (DESIGN.md sections 4 and 11), so that the loop of
 /// plan, run, log, plan again can be tried without hardware.
 
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -65,7 +66,7 @@ int run_rollout(const RolloutOptions& o) {
   std::vector<CommandInput> inputs = world_inputs(o.world);
   inputs.push_back({"--policy", o.policy});
   inputs.push_back({"--cost", o.cost_config});
-  check_output_file_option("--out", o.out, inputs);
+  check_output_file_option("--out", o.out, {"rollout writes a log (CSV or HDF5)", kMeasurementExtensions}, inputs);
   const SystemSignature signature = system_signature(o.world.system);
   if (signature.controls.empty()) throw InputError("--system " + o.world.system + ": " + passive_system_refusal(o.world.system));
   const PolicyFile policy = read_policy_file(o.policy);
@@ -74,6 +75,7 @@ int run_rollout(const RolloutOptions& o) {
                                  o.policy, fmt::join(policy.state_names, ", "), fmt::join(policy.control_names, ", "),
                                  o.world.system, fmt::join(names_of(signature.states), ", "),
                                  fmt::join(names_of(signature.controls), ", ")));
+  check_policy_system(policy, o.policy, o.world.system);
   const int n = static_cast<int>(signature.states.size());
   const int m = static_cast<int>(signature.controls.size());
 
@@ -120,13 +122,17 @@ int run_rollout(const RolloutOptions& o) {
 
   MeasurementSet log;
   log.system = signature;
-  int diverged = 0, dropped = 0;
+  int diverged = 0, dropped = 0, overflowed = 0;
   for (int r = 0; r < o.episodes; ++r) {
     // The stream of data rollout r after the plan of this round: what `gpilqg run` draws (run_setup.hpp).
     auto rng = data_rollout_rng(o.seed, 0, "gp_ilqg", policy.round, r);
     const RealRollout rollout = roll_out(setup, act, rng);
     if (!rollout.finite) ++diverged;
-    if (cost && rollout.finite) costs.push_back(trajectory_cost(*cost, rollout.truth));
+    if (cost && rollout.finite) {
+      const double value = trajectory_cost(*cost, rollout.truth);
+      if (std::isfinite(value)) costs.push_back(value);
+      else ++overflowed;  // states within the divergence bound, the weighted sum beyond a double
+    }
     if (rollout.steps_completed == 0) {
       ++dropped;
       continue;
@@ -155,6 +161,10 @@ int run_rollout(const RolloutOptions& o) {
     std::cout << fmt::format("task cost of the true trajectories ({}): mean {:.6g} over {} finite episode(s): {:.6g}\n",
                              o.cost_config, mean, costs.size(), fmt::join(costs, ", "));
   }
+  if (overflowed > 0)
+    std::cout << fmt::format("note: the task cost ({}) of {} finite episode(s) overflowed (not a finite number: the cost "
+                             "weights are too large for the states reached); {}\n",
+                             o.cost_config, overflowed, costs.empty() ? "no mean" : "the mean is over the others");
   if (diverged > 0)
     std::cout << fmt::format("note: {} episode(s) diverged; each is kept up to its last finite state{}\n", diverged,
                              dropped > 0 ? fmt::format(" ({} with no finite step were left out)", dropped) : "");

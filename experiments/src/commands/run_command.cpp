@@ -5,9 +5,9 @@
 
 #include <cmath>
 #include <csignal>
-#include <optional>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -33,7 +33,7 @@ struct RunArguments {
   int seeds = 1;
   std::uint64_t first_seed = 1;
   int iterations = -1;
-  std::string backends;
+  std::optional<std::string> backends;  ///< nullopt when --backends is not given; given, it may not be empty
   std::string out;
   std::string plots;
   bool no_plots = false;
@@ -74,7 +74,8 @@ int run_command(const RunArguments& a) {
   RunConfig config;
   RunOptions options;
   every_rank_then_agree(mpi, [&] {
-    check_output_file_option("--out", out, {system_input(a.system, "SYSTEM"), {"--config", a.config}});
+    check_output_file_option("--out", out, {"run writes an HDF5 result file", kHdf5Extensions},
+                             {system_input(a.system, "SYSTEM"), {"--config", a.config}});
     if (!a.no_plots) check_output_folder_option("--plots", a.plots);
     if (a.first_seed + static_cast<std::uint64_t>(a.seeds) - 1 > limits::kMaxSeed)
       throw InputError(fmt::format("--first-seed {} --seeds {}: the last seed exceeds {} (the largest seed)", a.first_seed,
@@ -84,9 +85,9 @@ int run_command(const RunArguments& a) {
     if (a.iterations > 0) config.iterations = a.iterations;  // validated by its option check
     options.seeds.clear();
     for (int s = 0; s < a.seeds; ++s) options.seeds.push_back(a.first_seed + static_cast<std::uint64_t>(s));
-    if (!a.backends.empty()) {
+    if (a.backends) {
       try {
-        options.backends = gp::parse_backend_list(a.backends);
+        options.backends = gp::parse_backend_list(*a.backends);
       } catch (const std::invalid_argument& e) {
         throw InputError(fmt::format("--backends: {}", e.what()));
       }

@@ -32,7 +32,8 @@ struct SimulateOptions {
 };
 
 int run_simulate(const SimulateOptions& o) {
-  check_output_file_option("--out", o.out, world_inputs(o.world));
+  check_output_file_option("--out", o.out, {"simulate writes a measurement file (CSV or HDF5)", kMeasurementExtensions},
+                           world_inputs(o.world));
   const auto signature = system_signature(o.world.system);
   const int n = static_cast<int>(signature.states.size());
   double input_delay = 0.0;

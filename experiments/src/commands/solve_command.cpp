@@ -54,9 +54,8 @@ int run_solve(const std::string& file, bool json) {
                              std::isfinite(s.final_gradient_norm) ? fmt::format("{:.2g}", s.final_gradient_norm) : "not finite",
                              r.nominal_cost);
   else if (s.termination == DdpTermination::InitialRolloutDiverged)
-    std::cerr << fmt::format("warning: not converged: the initial controls drive the model beyond the divergence "
-                             "bound (a state not finite or beyond |x| = {:g}); the cost is that of the states reached "
-                             "(try another problem.u_init)\n", kDivergedStateMagnitude);
+    std::cerr << fmt::format("warning: not converged: the initial controls {} (the cost is that of the states "
+                             "reached)\n", initial_rollout_failure(r.nominal_cost));
   return converged(s.termination) ? kExitSuccess : kExitInternalFailure;
 }
 

@@ -64,6 +64,7 @@ int sweep_command(const SweepArguments& a) {
     sweep = load_sweep_config(a.file);
     out = a.out.empty() ? sweep.out : std::filesystem::path(a.out);
     check_output_file_option(a.out.empty() ? "out (in the sweep file)" : "--out", out,
+                             {"sweep writes an HDF5 result file", kHdf5Extensions},
                              {{"SWEEP", a.file},
                               {"config (in the sweep file)", sweep.config},
                               system_input(sweep.system, "system (in the sweep file)")});

@@ -46,6 +46,15 @@ inline constexpr long kMaxUserEffects = 1'000;
 inline constexpr long kMaxBasisTerms = 100;
 /// Worker threads of one command.
 inline constexpr long kMaxThreads = 1'024;
+/// The largest cost weight (each diagonal entry of Q, R and Qf of a config), chosen so that the cost
+/// of any trajectory within the divergence bound is a finite double. A state or goal entry is within
+/// |x| <= 1e12 (kDivergedStateMagnitude, control/rollout.hpp), an initial control likewise, so an
+/// error e = x - goal has |e_i| <= 2e12 and e_i^2 <= 4e24. One weighted square is then at most
+/// 1e150 * 4e24 = 4e174; a stage cost sums n + m of them times dt, a trajectory T <= kMaxHorizon =
+/// 1e6 stages, an evaluation a mean of rollouts: the total stays below the largest double (1.8e308)
+/// while n * T * dt < 1e133, a margin no dimension or step of a real problem approaches. A weight of
+/// 1e308 instead makes a state of 1e1 overflow to inf, which the solver would see as divergence.
+inline constexpr double kMaxCostWeight = 1e150;
 /// Memory a command may plan to use for the arrays whose size the user controls (horizons x state
 /// dimensions, GP matrices); `profile --memory-budget-gb` sets its own.
 inline constexpr double kMemoryBudgetBytes = 8.0 * (1ull << 30);

@@ -11,6 +11,7 @@
 /// `system`, `state_names`, `control_names`.
 
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -28,7 +29,8 @@ struct Episode {
   Matrix x;     ///< T x n measured states
   Matrix u;     ///< T x m applied controls
   int length() const { return static_cast<int>(t.size()); }
-  /// The step, (t_last - t_first) / (T - 1); 0 for a single sample.
+  /// The step, (t_last - t_first) / (T - 1); 0 for a single sample. Finite whenever the step is
+  /// representable, also when the span t_last - t_first is not.
   double dt() const;
 };
 
@@ -58,6 +60,13 @@ class DataError : public std::runtime_error {
   std::filesystem::path file_;
   std::string location_;
 };
+
+/// Why `name` cannot name a state or control column of a measurement file, or nullopt. CSV fields
+/// are not quoted (docs/formats.md), so a name may not be empty, contain a comma or a line break
+/// ("\n", "\r"), or be `episode` or `t`, the fixed columns; any other text (spaces, quotes) reads
+/// back as written. A system whose names break this is refused where its names are made (a MuJoCo
+/// model on loading), before any data is written.
+std::optional<std::string> column_name_problem(std::string_view name);
 
 /// Reads and validates a CSV measurement file against `system`. Throws DataError naming the line
 /// (1-based, header = line 1) and the column for: a missing file, an empty file, a header whose
@@ -130,7 +139,9 @@ struct MeasurementSummary {
 
 /// Per-column min, max, mean and population std over all samples of all episodes, in the system's
 /// order; dt_min / dt_max over the episodes' Episode::dt(); duration = sum of (t_last - t_first).
-/// Statistics of a set without samples are 0.
+/// Statistics of a set without samples are 0. Every statistic of finite values is finite (scaled
+/// accumulation), except a duration or step beyond the largest double (times spanning more than
+/// 1.8e308 s), which is +inf: it is not representable, and the callers say so.
 MeasurementSummary summarize(const MeasurementSet& set);
 
 }  // namespace gpilqg

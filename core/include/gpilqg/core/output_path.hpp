@@ -7,8 +7,31 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace gpilqg {
+
+/// What a command writes to an output path and the names it accepts for it: `what` is the
+/// sentence's subject and verb ("plan writes an HDF5 policy file"), `extensions` the accepted
+/// endings, lower case with their dot ({".h5", ".hdf5"}). A file of a fixed format must carry its
+/// format's extension, so that every reader (gpilqg's own, h5py, pandas) that picks a format by the
+/// name reads it back as what it is.
+struct OutputFormat {
+  std::string what;
+  std::vector<std::string> extensions;
+};
+
+/// The extensions of each fixed format gpilqg writes.
+inline const std::vector<std::string> kHdf5Extensions{".h5", ".hdf5"};
+inline const std::vector<std::string> kCsvExtensions{".csv"};
+inline const std::vector<std::string> kTomlExtensions{".toml"};
+inline const std::vector<std::string> kJsonExtensions{".json"};
+/// A measurement file or log: CSV or HDF5, chosen by the name.
+inline const std::vector<std::string> kMeasurementExtensions{".csv", ".h5", ".hdf5"};
+
+/// Why `file`'s name does not end in one of `format.extensions` (compared case-insensitively), or
+/// nullopt: "plan writes an HDF5 policy file; expected a name ending in .h5 or .hdf5".
+std::optional<std::string> output_extension_problem(const std::filesystem::path& file, const OutputFormat& format);
 
 /// Why `file` cannot receive a result file, or nullopt when it can. It must be absent, a regular
 /// file or a symbolic link (the link is replaced, never written through); its name must fit the

@@ -51,8 +51,16 @@ AffinePolicy file_policy(const AffinePolicy& policy);
 void write_policy_file(const std::filesystem::path& file, const PolicyFile& policy, const gp::ResidualModel* model);
 
 /// Reads and checks a policy file: every dataset and attribute above, shapes consistent with each
-/// other and with the names. Throws InputError naming the file and the dataset or attribute.
+/// other and with the names, every number finite (x_bar, u_bar, K, dt > 0, the costs, the limits),
+/// u_min <= u_max entry by entry, round a whole number >= 0, system and the names not empty. Throws
+/// InputError naming the file and the dataset or attribute (and the first bad entry).
 PolicyFile read_policy_file(const std::filesystem::path& file);
+
+/// Throws InputError unless the system of `policy` (read from `file`) is `system`, the one it is used
+/// for: the same name, or for a MuJoCo model a model file of the same file name (the file stores the
+/// path the planner used): "p.h5: attribute '/policy@system' is 'quadrotor'; expected 'cartpole', the
+/// system it is used for". Callers compare the state and control names first, the more telling check.
+void check_policy_system(const PolicyFile& policy, const std::filesystem::path& file, const std::string& system);
 
 /// The file's /model rebuilt around `simulator` (its stored backend, sized by `settings`). Throws
 /// InputError naming the file when there is no /model or it does not fit the simulator.

@@ -58,4 +58,13 @@ QuadraticCost make_solve_cost(const SolveConfig& config);
 /// Builds the model and cost of the config and solves it.
 DdpResult solve_config(const SolveConfig& config);
 
+/// Why the initial rollout of a solve ended with termination InitialRolloutDiverged, given `cost`,
+/// the config's cost of the trajectory the solver returns: the states reached before the divergence
+/// bound (the last one repeated) and the initial controls. Finite: the states left the divergence
+/// bound (a state not finite or beyond kDivergedStateMagnitude) and were cut there. Not finite: no
+/// state was cut, the cost itself overflowed (the config's weights are bounded by
+/// limits::kMaxCostWeight so that this needs a horizon times dt beyond any real problem). The text
+/// completes "the initial controls ..." and ends with what to change.
+std::string initial_rollout_failure(double cost);
+
 }  // namespace gpilqg

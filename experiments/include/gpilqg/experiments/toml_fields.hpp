@@ -58,6 +58,11 @@ class TomlFields {
   /// An initial control (u_init), bounded the same way: a control beyond 1e12 drives every model past
   /// the divergence bound at the first step, and its quadratic cost overflows.
   Vector control_vector(const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) const;
+  /// The diagonal of a cost weight matrix (Q, R, Qf): vector(), and every entry within
+  /// [0, kMaxCostWeight] (1e150, core/limits.hpp), so that the cost of any trajectory within the
+  /// divergence bound stays finite: "field 'problem.Qf': entry 0 is 1e+308; expected a weight in
+  /// [0, 1e+150] (...)".
+  Vector weight_vector(const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) const;
   bool has(const std::string& path) const;
   /// A system's name (DESIGN.md sections 3 and 10) as the registry resolves it: a MuJoCo model file
   /// given by a relative path is relative to the config file's folder. Fails naming the field for an
