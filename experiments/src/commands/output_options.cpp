@@ -55,10 +55,10 @@ void check_output_file_option(const std::string& option, const std::filesystem::
   if (file.empty()) return;
   if (const auto problem = output_file_problem(file))
     throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
+  refuse_input(option, file, inputs);  // before the name's format: the input named is the more telling culprit
+  refuse_input(option, file, program_inputs());
   if (const auto problem = output_extension_problem(file, format))
     throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
-  refuse_input(option, file, inputs);
-  refuse_input(option, file, program_inputs());
   remove_and_name(stale_temporaries(file));
 }
 

@@ -20,14 +20,14 @@ struct CommandInput {
   std::filesystem::path file;
 };
 
-/// Checks `file` with output_file_problem (output_path.hpp), then with output_extension_problem
-/// against `format` (what the command writes there and the names that format takes); an empty path
-/// (option not given) passes. Every output option of a fixed format goes through here:
-/// "--out p.csv: plan writes an HDF5 policy file; expected a name ending in .h5 or .hdf5".
-/// An output that is the same file as one of `inputs` or of the program's inputs (same_file, e.g.
-/// `data import log.csv --out log.csv`) is refused too: writing it would replace the input. Throws
-/// InputError "<option> <file>: is the same file as <name> <input>, an input of the command; expected a
-/// file that is not one of its inputs".
+/// Checks, in this order, and throws InputError "<option> <file>: <problem>" at the first problem:
+///  1. output_file_problem (output_path.hpp): what is at the path, its folder, its name's length;
+///  2. the same file as one of `inputs` or of the program's inputs (same_file, e.g.
+///     `data import log.csv --out log.csv`): writing it would replace the input. "... is the same file
+///     as <name> <input>, an input of the command; expected a file that is not one of its inputs";
+///  3. output_extension_problem against `format` (what the command writes there and the names that
+///     format takes): "--out p.csv: plan writes an HDF5 policy file; expected a name ending in .h5 or .hdf5".
+/// An empty path (option not given) passes. Every output option of a fixed format goes through here.
 void check_output_file_option(const std::string& option, const std::filesystem::path& file, const OutputFormat& format,
                               const std::vector<CommandInput>& inputs = {});
 
