@@ -10,27 +10,13 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "hdf5_handle.hpp"
+
 namespace gpilqg {
 
 static_assert(std::is_same_v<hid_t, std::int64_t>, "dataset_size.hpp passes HDF5 identifiers as std::int64_t");
 
 namespace {
-
-/// Closes an HDF5 identifier of any kind when it goes out of scope.
-class Handle {
- public:
-  explicit Handle(hid_t id) : id_(id) {}
-  ~Handle() {
-    if (id_ >= 0) H5Idec_ref(id_);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  hid_t get() const { return id_; }
-  bool valid() const { return id_ >= 0; }
-
- private:
-  hid_t id_;
-};
 
 [[noreturn]] void cannot_tell(const char* what) {
   throw std::runtime_error(fmt::format("the HDF5 library cannot tell the {} of the object", what));
@@ -67,8 +53,8 @@ DeclaredSize hdf5_declared_size(std::int64_t object_id) {
   const H5I_type_t kind = H5Iget_type(object_id);
   if (kind != H5I_DATASET && kind != H5I_ATTR) cannot_tell("kind");
   const bool dataset = kind == H5I_DATASET;
-  const Handle space(dataset ? H5Dget_space(object_id) : H5Aget_space(object_id));
-  const Handle type(dataset ? H5Dget_type(object_id) : H5Aget_type(object_id));
+  const Hdf5Handle space(dataset ? H5Dget_space(object_id) : H5Aget_space(object_id));
+  const Hdf5Handle type(dataset ? H5Dget_type(object_id) : H5Aget_type(object_id));
   if (!space.valid()) cannot_tell("shape");
   if (!type.valid()) cannot_tell("type");
   DeclaredSize size;
@@ -80,7 +66,7 @@ DeclaredSize hdf5_declared_size(std::int64_t object_id) {
   if (H5Sget_simple_extent_type(space.get()) == H5S_NULL) size.dims = {0};
   size.element_bytes = H5Tget_size(type.get());
   if (dataset) {
-    const Handle plist(H5Dget_create_plist(object_id));
+    const Hdf5Handle plist(H5Dget_create_plist(object_id));
     if (!plist.valid()) cannot_tell("storage");
     const int filters = H5Pget_nfilters(plist.get());
     if (filters < 0) cannot_tell("filters");

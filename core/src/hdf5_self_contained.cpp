@@ -10,28 +10,13 @@
 #include <vector>
 
 #include "gpilqg/core/measurements.hpp"
+#include "hdf5_handle.hpp"
 
 namespace gpilqg {
 
 static_assert(std::is_same_v<hid_t, std::int64_t>, "hdf5_self_contained.hpp passes HDF5 identifiers as std::int64_t");
 
 namespace {
-
-/// Closes an HDF5 identifier of any kind when it goes out of scope.
-class Handle {
- public:
-  explicit Handle(hid_t id) : id_(id) {}
-  ~Handle() {
-    if (id_ >= 0) H5Idec_ref(id_);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  hid_t get() const { return id_; }
-  bool valid() const { return id_ >= 0; }
-
- private:
-  hid_t id_;
-};
 
 /// Names from the file as messages show them: at most 200 bytes, a longer one cut with "...".
 std::string shown(std::string name) {
@@ -64,7 +49,7 @@ std::string external_link_target(hid_t group, const char* name, std::size_t size
 
 /// Why the dataset `dataset` refers to data outside the file, or an empty string.
 std::string dataset_problem(hid_t dataset) {
-  const Handle plist(H5Dget_create_plist(dataset));
+  const Hdf5Handle plist(H5Dget_create_plist(dataset));
   if (!plist.valid()) throw std::runtime_error("the HDF5 library cannot tell where a dataset's values are stored");
   if (H5Pget_layout(plist.get()) == H5D_VIRTUAL) {
     size_t sources = 0;
@@ -110,7 +95,7 @@ herr_t visit_link(hid_t group, const char* name, const H5L_info_t* info, void* d
                                                      "), which may resolve outside the file"};
       return 1;
   }
-  const Handle opened(H5Oopen(group, name, H5P_DEFAULT));
+  const Hdf5Handle opened(H5Oopen(group, name, H5P_DEFAULT));
   if (!opened.valid()) {
     visit.failure = object + ": the HDF5 library cannot open it";
     return -1;

@@ -30,19 +30,6 @@ const SystemSignature& cartpole() {
   return signature;
 }
 
-fs::path write_text(const fs::path& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary);
-  out << text;
-  return file;
-}
-
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 /// The what() of the DataError thrown by `read`, or a note that none (or another type) was thrown.
 std::string data_error_of(const std::function<void()>& read) {
   try {
@@ -62,7 +49,7 @@ const std::string kHeader = "episode,t,x,x_dot,theta,theta_dot,force\n";
 
 TEST(MeasurementsCsv, ReadsEpisodesInFileOrder) {
   const auto dir = test::temporary_dir("measurements");
-  const auto file = write_text(dir / "ok.csv", kHeader +
+  const auto file = test::write_text(dir / "ok.csv", kHeader +
                                                    "3,0,0.01,0.09,-0.18,-0.59,-11.2\n"
                                                    "3,0.05,0.02,0.1,-0.2,-0.6,-11\n"
                                                    "3,0.1,0.03,0.11,-0.22,-0.61,-10.5\n"
@@ -97,7 +84,7 @@ TEST(MeasurementsCsv, AcceptsCrlfByteOrderMarkMissingFinalNewlineAndTrailingBlan
            {"no_final_newline.csv", header + rows},
            {"trailing_blank_lines.csv", header + rows + "\r\n\r\n  \n\n"}}) {
     SCOPED_TRACE(name);
-    const MeasurementSet set = read_measurements_csv(write_text(dir / name, text), cartpole());
+    const MeasurementSet set = read_measurements_csv(test::write_text(dir / name, text), cartpole());
     ASSERT_EQ(set.episodes.size(), 1u);
     EXPECT_EQ(set.episodes[0].length(), 3);
     EXPECT_EQ(set.episodes[0].u(2, 0), 5.0);
@@ -109,7 +96,7 @@ TEST(MeasurementsCsv, AcceptsCrlfByteOrderMarkMissingFinalNewlineAndTrailingBlan
 TEST(MeasurementsCsv, HeaderWithoutEpisodeColumnIsOneEpisode) {
   const auto dir = test::temporary_dir("measurements");
   const MeasurementSet set = read_measurements(
-      write_text(dir / "record.csv", "t,x,x_dot,theta,theta_dot,force\n0,1,2,3,4,5\n0.5,1.5,2,3,4,6\n1,2,2,3,4,7\n"),
+      test::write_text(dir / "record.csv", "t,x,x_dot,theta,theta_dot,force\n0,1,2,3,4,5\n0.5,1.5,2,3,4,6\n1,2,2,3,4,7\n"),
       cartpole());
   ASSERT_EQ(set.episodes.size(), 1u);
   EXPECT_EQ(set.episodes[0].id, 0);
@@ -118,7 +105,7 @@ TEST(MeasurementsCsv, HeaderWithoutEpisodeColumnIsOneEpisode) {
   EXPECT_EQ(set.episodes[0].x(1, 0), 1.5);
   EXPECT_EQ(set.episodes[0].u(2, 0), 7.0);
   try {
-    read_measurements(write_text(dir / "short_row.csv", "t,x,x_dot,theta,theta_dot,force\n0,1,2,3,4,5\n0.5,1,2,3,4\n"),
+    read_measurements(test::write_text(dir / "short_row.csv", "t,x,x_dot,theta,theta_dot,force\n0,1,2,3,4,5\n0.5,1,2,3,4\n"),
                       cartpole());
     FAIL() << "a short row was accepted";
   } catch (const DataError& e) {
@@ -132,10 +119,10 @@ TEST(MeasurementsCsv, AcceptsDtWithinRelativeToleranceAndRejectsBeyond) {
   // Times written with few digits: steps 0.0333 and 0.03330001 differ by 3e-7 relative (accepted);
   // 0.03331 differs by 3e-4 (rejected).
   const auto ok =
-      write_text(dir / "ok.csv", kHeader + "0,0,0,0,0,0,0\n0,0.0333,0,0,0,0,0\n0,0.06660001,0,0,0,0,0\n");
+      test::write_text(dir / "ok.csv", kHeader + "0,0,0,0,0,0,0\n0,0.0333,0,0,0,0,0\n0,0.06660001,0,0,0,0,0\n");
   EXPECT_NO_THROW(read_measurements(ok, cartpole()));
   const auto bad =
-      write_text(dir / "bad.csv", kHeader + "0,0,0,0,0,0,0\n0,0.0333,0,0,0,0,0\n0,0.06661,0,0,0,0,0\n");
+      test::write_text(dir / "bad.csv", kHeader + "0,0,0,0,0,0,0\n0,0.0333,0,0,0,0,0\n0,0.06661,0,0,0,0,0\n");
   const std::string error = data_error_of([&] { read_measurements(bad, cartpole()); });
   EXPECT_NE(error.find("bad.csv:line 4: "), std::string::npos) << error;
 }
@@ -237,7 +224,7 @@ class BadCsv : public ::testing::TestWithParam<BadCsvCase> {};
 
 TEST_P(BadCsv, IsRejectedWithFileLineAndExpectation) {
   const BadCsvCase& c = GetParam();
-  const auto file = write_text(test::temporary_dir("measurements") / (c.name + ".csv"), c.text);
+  const auto file = test::write_text(test::temporary_dir("measurements") / (c.name + ".csv"), c.text);
   const std::string error = data_error_of([&] { read_measurements(file, cartpole()); });
   EXPECT_EQ(error.rfind(file.string() + ":line ", 0), 0u)
       << "the error should start with the file and line: " << error;
@@ -250,7 +237,7 @@ INSTANTIATE_TEST_SUITE_P(Measurements, BadCsv, ::testing::ValuesIn(kBadCsvCases)
                          [](const ::testing::TestParamInfo<BadCsvCase>& info) { return info.param.name; });
 
 TEST(MeasurementsCsv, ErrorCarriesFileAndLocation) {
-  const auto file = write_text(test::temporary_dir("measurements") / "fields.csv", kHeader + kRow0a + "0,1\n");
+  const auto file = test::write_text(test::temporary_dir("measurements") / "fields.csv", kHeader + kRow0a + "0,1\n");
   try {
     read_measurements_csv(file, cartpole());
     FAIL() << "no error";
@@ -269,13 +256,13 @@ TEST(Measurements, MissingFileAndUnknownExtensionAreDataErrors) {
             (dir / "absent.csv").string() + ": no such file; expected a measurement file");
   EXPECT_EQ(data_error_of([&] { read_measurements(dir / "absent.h5", cartpole()); }),
             (dir / "absent.h5").string() + ": no such file; expected a measurement file");
-  const auto text = write_text(dir / "data.txt", kHeader + kRow0a + kRow0b);
+  const auto text = test::write_text(dir / "data.txt", kHeader + kRow0a + kRow0b);
   const std::string error = data_error_of([&] { read_measurements(text, cartpole()); });
   EXPECT_NE(
       error.find("data.txt: unknown measurement file extension '.txt'; expected '.csv', '.h5' or '.hdf5'"),
       std::string::npos)
       << error;
-  const auto not_hdf5 = write_text(dir / "data.h5", kHeader + kRow0a + kRow0b);
+  const auto not_hdf5 = test::write_text(dir / "data.h5", kHeader + kRow0a + kRow0b);
   EXPECT_NE(data_error_of([&] { read_measurements(not_hdf5, cartpole()); }).find("data.h5: not an HDF5 file"),
             std::string::npos);
 }
@@ -345,7 +332,7 @@ TEST(Measurements, RoundTripCsvHdf5CsvIsBitForBit) {
   const MeasurementSet from_hdf5 = read_measurements(dir / "copy.h5", cartpole());
   expect_same_set(original, from_hdf5);
   write_measurements(dir / "second.csv", from_hdf5);
-  const std::string first = read_text(dir / "first.csv"), second = read_text(dir / "second.csv");
+  const std::string first = test::read_text(dir / "first.csv"), second = test::read_text(dir / "second.csv");
   EXPECT_FALSE(first.empty());
   EXPECT_EQ(first, second);
   EXPECT_EQ(first.substr(0, kHeader.size()), kHeader);

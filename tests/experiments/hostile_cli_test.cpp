@@ -29,20 +29,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
-
-fs::path write(const fs::path& file, const std::string& text) {
-  std::ofstream(file, std::ios::binary) << text;
-  return file;
-}
-
-std::string contents(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 std::vector<std::string> listing(const fs::path& folder) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(folder)) names.push_back(entry.path().filename().string());
@@ -57,14 +43,14 @@ struct Inputs {
 };
 
 Inputs make_inputs(const fs::path& dir) {
-  Inputs in{dir / "data.csv", write(dir / "run.toml", test::kTinyRun), write(dir / "plan.toml", test::kTinyPlan),
+  Inputs in{dir / "data.csv", test::write_text(dir / "run.toml", test::kTinyRun), test::write_text(dir / "plan.toml", test::kTinyPlan),
             dir / "policy.h5", dir / "seed_1.h5", dir / "seed_2.h5",
-            write(dir / "sweep.toml", "system = \"cartpole\"\nconfig = \"run.toml\"\n[grid]\n\"loop.rollouts\" = [1, 2]\n")};
-  EXPECT_EQ(test::run_cli("simulate --system cartpole --episodes 4 --steps 60 --out " + quote(in.data)).status, 0);
-  EXPECT_EQ(test::run_cli("plan " + quote(in.plan_config) + " --out " + quote(in.policy)).status, 0);
+            test::write_text(dir / "sweep.toml", "system = \"cartpole\"\nconfig = \"run.toml\"\n[grid]\n\"loop.rollouts\" = [1, 2]\n")};
+  EXPECT_EQ(test::run_cli("simulate --system cartpole --episodes 4 --steps 60 --out " + test::quote(in.data)).status, 0);
+  EXPECT_EQ(test::run_cli("plan " + test::quote(in.plan_config) + " --out " + test::quote(in.policy)).status, 0);
   for (const auto& [seed, part] : {std::pair{"1", in.seed_1}, std::pair{"2", in.seed_2}})
-    EXPECT_EQ(test::run_cli("run cartpole --config " + quote(in.run_config) + " --first-seed " + seed + " --no-plots --out " +
-                            quote(part))
+    EXPECT_EQ(test::run_cli("run cartpole --config " + test::quote(in.run_config) + " --first-seed " + seed + " --no-plots --out " +
+                            test::quote(part))
                   .status,
               0);
   return in;
@@ -81,20 +67,20 @@ std::vector<Writer> writers(const Inputs& in) {
   return {
       {"simulate to HDF5", "simulate --system cartpole --episodes 4 --steps 200 --out {out}", "data.h5"},
       {"simulate to CSV", "simulate --system cartpole --episodes 4 --steps 200 --out {out}", "data.csv"},
-      {"diagnose --out", "diagnose --system cartpole --data " + quote(in.data) + " --gp-restarts 0 --out {out}", "report.h5"},
-      {"diagnose --write-model", "diagnose --system cartpole --data " + quote(in.data) + " --gp-restarts 0 --write-model {out}",
+      {"diagnose --out", "diagnose --system cartpole --data " + test::quote(in.data) + " --gp-restarts 0 --out {out}", "report.h5"},
+      {"diagnose --write-model", "diagnose --system cartpole --data " + test::quote(in.data) + " --gp-restarts 0 --write-model {out}",
        "model.toml"},
-      {"profile --out", "profile " + quote(in.data) + " --system cartpole --backends exact --sizes 60 --out {out}", "profile.h5"},
-      {"run --out", "run cartpole --config " + quote(in.run_config) + " --no-plots --out {out}", "run.h5"},
-      {"sweep --out", "sweep " + quote(in.sweep) + " --no-plots --out {out}", "sweep.h5"},
-      {"merge --out", "merge " + quote(in.seed_1) + " " + quote(in.seed_2) + " --no-plots --out {out}", "merged.h5"},
-      {"plan --out", "plan " + quote(in.plan_config) + " --out {out}", "policy.h5"},
-      {"rollout --out", "rollout --system cartpole --policy " + quote(in.policy) + " --out {out}", "log.csv"},
+      {"profile --out", "profile " + test::quote(in.data) + " --system cartpole --backends exact --sizes 60 --out {out}", "profile.h5"},
+      {"run --out", "run cartpole --config " + test::quote(in.run_config) + " --no-plots --out {out}", "run.h5"},
+      {"sweep --out", "sweep " + test::quote(in.sweep) + " --no-plots --out {out}", "sweep.h5"},
+      {"merge --out", "merge " + test::quote(in.seed_1) + " " + test::quote(in.seed_2) + " --no-plots --out {out}", "merged.h5"},
+      {"plan --out", "plan " + test::quote(in.plan_config) + " --out {out}", "policy.h5"},
+      {"rollout --out", "rollout --system cartpole --policy " + test::quote(in.policy) + " --out {out}", "log.csv"},
   };
 }
 
 std::string with_out(std::string command, const fs::path& out) {
-  command.replace(command.find("{out}"), 5, quote(out));
+  command.replace(command.find("{out}"), 5, test::quote(out));
   return command;
 }
 
@@ -139,7 +125,7 @@ TEST(HostileCli, AFullDiskUnderEveryWriterIsExit1AndKeepsThePreviousFile) {
     disk.empty();
     const fs::path out = dir / "disk" / w.file;
     const std::string previous = "the previous result of " + w.name + "\n";
-    write(out, previous);
+    test::write_text(out, previous);
     disk.fill();
     const auto r = test::run_cli(with_out(w.command, out));
     EXPECT_EQ(r.status, 1) << r.err;
@@ -147,7 +133,7 @@ TEST(HostileCli, AFullDiskUnderEveryWriterIsExit1AndKeepsThePreviousFile) {
     EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(out.string()), std::string::npos) << "the message names the file: " << r.err;
     EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
-    EXPECT_EQ(contents(out), previous);
+    EXPECT_EQ(test::read_text(out), previous);
     std::vector<std::string> expected{"filler", w.file};
     std::sort(expected.begin(), expected.end());
     EXPECT_EQ(listing(dir / "disk"), expected) << "no temporary or checkpoint left";
@@ -158,18 +144,18 @@ TEST(HostileCli, OutputPathsThatCannotBeWrittenAreExit2BeforeAnyWork) {
   const fs::path dir = test::temporary_dir("hostile_paths");
   ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0600), 0);
   fs::create_directory(dir / "folder");
-  write(dir / "a_file", "x");
+  test::write_text(dir / "a_file", "x");
   struct Case {
     std::string arguments, message;
   };
   const std::string simulate = "simulate --system cartpole --episodes 1 --steps 20 ";
   const std::vector<Case> cases = {
       {simulate + "--out /dev/null", "--out /dev/null: is a character device; expected a regular file or a new file name"},
-      {simulate + "--out " + quote(dir / "fifo"), "is a FIFO (named pipe); expected a regular file or a new file name"},
-      {simulate + "--out " + quote(dir / "folder"), "is a folder; expected a regular file or a new file name"},
-      {simulate + "--out " + quote(dir / "a_file" / "x.csv"), "a_file is a regular file; expected a folder"},
-      {"run cartpole --plots " + quote(dir / "a_file"), "--plots " + (dir / "a_file").string() + ": is a regular file; expected a folder"},
-      {simulate + "--out " + quote(dir / (std::string(256, 'n') + ".csv")), "the file name has 260 bytes; expected at most 255"},
+      {simulate + "--out " + test::quote(dir / "fifo"), "is a FIFO (named pipe); expected a regular file or a new file name"},
+      {simulate + "--out " + test::quote(dir / "folder"), "is a folder; expected a regular file or a new file name"},
+      {simulate + "--out " + test::quote(dir / "a_file" / "x.csv"), "a_file is a regular file; expected a folder"},
+      {"run cartpole --plots " + test::quote(dir / "a_file"), "--plots " + (dir / "a_file").string() + ": is a regular file; expected a folder"},
+      {simulate + "--out " + test::quote(dir / (std::string(256, 'n') + ".csv")), "the file name has 260 bytes; expected at most 255"},
   };
   for (const Case& c : cases) {
     const auto r = test::run_cli(c.arguments);
@@ -183,7 +169,7 @@ TEST(HostileCli, OutputPathsThatCannotBeWrittenAreExit2BeforeAnyWork) {
 TEST(HostileCli, ALongLegalFileNameIsWrittenAndTemporariesOfDeadProcessesAreRemoved) {
   const fs::path dir = test::temporary_dir("hostile_names");
   const fs::path out = dir / (std::string(250, 'n') + ".csv");  // 254 bytes: legal, its temporary name is shortened
-  const std::string simulate = "simulate --system cartpole --episodes 1 --steps 20 --out " + quote(out);
+  const std::string simulate = "simulate --system cartpole --episodes 1 --steps 20 --out " + test::quote(out);
   // A temporary left by a process that no longer runs (a child that has exited) beside the target.
   const pid_t child = ::fork();
   if (child == 0) ::_exit(0);
@@ -191,7 +177,7 @@ TEST(HostileCli, ALongLegalFileNameIsWrittenAndTemporariesOfDeadProcessesAreRemo
   std::string name = atomic_temporary_path(out).filename().string();
   name = name.substr(0, name.rfind(".tmp-") + 5) + std::to_string(child) + "-0";
   const fs::path leftover = dir / name;
-  write(leftover, "half a file");
+  test::write_text(leftover, "half a file");
   const auto r = test::run_cli(simulate);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::is_regular_file(out));
@@ -218,12 +204,12 @@ transfer = false
   auto config_with_horizon = [&](const std::string& horizon, const std::string& name) {
     std::string text = tasks;
     text.replace(text.find("HORIZON"), 7, horizon);
-    return quote(write(dir / name, text));
+    return test::quote(test::write_text(dir / name, text));
   };
   struct Case {
     std::string arguments, message;
   };
-  const std::string out = " --out " + quote(dir / "out.csv");
+  const std::string out = " --out " + test::quote(dir / "out.csv");
   const std::vector<Case> cases = {
       {"run cartpole --config " + config_with_horizon("1000000000", "h1e9.toml"),
        "field 'tasks[0].horizon': is 1000000000; expected an integer from 2 to 1000000"},
@@ -261,13 +247,13 @@ transfer = false
 TEST(HostileCli, TooManySeedsLeaveNoCheckpointAndAnEmptyCheckpointDoesNotBlockANewRun) {
   const fs::path dir = test::temporary_dir("hostile_checkpoint");
   const fs::path out = dir / "run.h5";
-  const auto refused = test::run_cli("run cartpole --seeds 1000000 --no-plots --out " + quote(out));
+  const auto refused = test::run_cli("run cartpole --seeds 1000000 --no-plots --out " + test::quote(out));
   EXPECT_EQ(refused.status, 2) << refused.err;
   EXPECT_EQ(listing(dir), std::vector<std::string>{});
   // A checkpoint folder whose manifest was never written (a start killed at the wrong moment).
   fs::create_directory(dir / "run.h5.checkpoint");
-  const auto run = test::run_cli("run cartpole --config " + quote(write(dir / "tiny.toml", test::kTinyRun)) +
-                                 " --no-plots --out " + quote(out));
+  const auto run = test::run_cli("run cartpole --config " + test::quote(test::write_text(dir / "tiny.toml", test::kTinyRun)) +
+                                 " --no-plots --out " + test::quote(out));
   EXPECT_EQ(run.status, 0) << run.err;
   EXPECT_EQ(listing(dir), (std::vector<std::string>{"run.h5", "tiny.toml"}));
 }

@@ -38,21 +38,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
-
-fs::path write(const fs::path& file, const std::string& text) {
-  fs::create_directories(file.parent_path());
-  std::ofstream(file, std::ios::binary) << text;
-  return file;
-}
-
-std::string contents(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 fs::path fifo(const fs::path& file) {
   fs::create_directories(file.parent_path());
   EXPECT_EQ(::mkfifo(file.c_str(), 0600), 0) << file;
@@ -78,8 +63,8 @@ test::CommandResult run_cli(const std::string& arguments, rlim_t max_file_bytes 
   ::waitpid(child, &raw, 0);
   test::CommandResult result;
   result.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  result.out = contents(dir / "out.txt");
-  result.err = contents(dir / "err.txt");
+  result.out = test::read_text(dir / "out.txt");
+  result.err = test::read_text(dir / "err.txt");
   return result;
 }
 
@@ -227,8 +212,8 @@ TEST(HostileFiles, TheCommandsRefuseAnExternalLinkToAFifoWithExit2) {
   make_hdf5(file, [&](hid_t f, const char* path, hid_t links) { external_link(pipe, f, path, links); });
   const std::string message =
       file.string() + ":/episodes/0/x: is an external link to " + pipe.string() + ":/x; expected data stored in the file itself";
-  for (const std::string& arguments : {"data info " + quote(file) + " --system cartpole",
-                                       "rollout --system cartpole --policy " + quote(file) + " --out " + quote(dir / "log.csv")}) {
+  for (const std::string& arguments : {"data info " + test::quote(file) + " --system cartpole",
+                                       "rollout --system cartpole --policy " + test::quote(file) + " --out " + test::quote(dir / "log.csv")}) {
     const auto r = run_cli(arguments);
     EXPECT_EQ(r.status, 2) << arguments << "\n" << r.err;
     EXPECT_NE(r.err.find(message), std::string::npos) << arguments << "\n" << r.err;
@@ -304,7 +289,7 @@ TEST(HostileFiles, EveryFileAMujocoModelNamesIsCheckedBeforeMujocoOpensIt) {
     for (const auto& [name, text] : c.files) {
       if (text == "FIFO") fifo(dir / name);
       else if (text == "ZERO") fs::create_symlink("/dev/zero", dir / name);
-      else write(dir / name, text);
+      else test::write_text(dir / name, text);
     }
     const fs::path model = dir / c.model;
     const auto outcome = test::call_with_timeout([&] { find_system(model.string()); }, std::chrono::seconds(10),
@@ -333,9 +318,9 @@ TEST(HostileFiles, EveryFileAMujocoModelNamesIsCheckedBeforeMujocoOpensIt) {
 
 TEST(HostileFiles, SimulateRefusesAModelIncludingAFifoWithExit2) {
   const fs::path dir = test::temporary_dir("hostile_files_mujoco_cli");
-  const fs::path model = write(dir / "main.xml", "<mujoco><include file=\"inc.xml\"/>" + std::string(kBody) + "</mujoco>");
+  const fs::path model = test::write_text(dir / "main.xml", "<mujoco><include file=\"inc.xml\"/>" + std::string(kBody) + "</mujoco>");
   fifo(dir / "inc.xml");
-  const auto r = run_cli("simulate --system " + quote(model) + " --out " + quote(dir / "data.csv"));
+  const auto r = run_cli("simulate --system " + test::quote(model) + " --out " + test::quote(dir / "data.csv"));
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find((dir / "inc.xml").string() + ": is a FIFO (named pipe), not a regular file; expected an MJCF file"),
             std::string::npos)
@@ -348,13 +333,13 @@ TEST(HostileFiles, AnOutputThatIsAnInputIsExit2AndTheInputIsKept) {
   const fs::path dir = test::temporary_dir("hostile_files_same");
   // A log and map that import (the output would replace the log); the other inputs need not be
   // valid: the outputs are checked before any input is read.
-  const fs::path log = write(dir / "log.csv", "time,x,xd,th,thd,f\n0.00,0,0,0,0,1\n0.02,0,0,0,0,1\n0.04,0,0,0,0,1\n");
-  const fs::path map = write(dir / "map.toml", "[time]\ncolumn = \"time\"\n[states]\nx = \"x\"\nx_dot = \"xd\"\ntheta = \"th\"\n"
+  const fs::path log = test::write_text(dir / "log.csv", "time,x,xd,th,thd,f\n0.00,0,0,0,0,1\n0.02,0,0,0,0,1\n0.04,0,0,0,0,1\n");
+  const fs::path map = test::write_text(dir / "map.toml", "[time]\ncolumn = \"time\"\n[states]\nx = \"x\"\nx_dot = \"xd\"\ntheta = \"th\"\n"
                                                 "theta_dot = \"thd\"\n[controls]\nforce = \"f\"\n");
-  const fs::path data = write(dir / "data.csv", "data\n"), model = write(dir / "model.toml", "# model\n");
-  const fs::path config = write(dir / "plan.toml", "# plan\n"), policy = write(dir / "policy.h5", "policy\n");
-  const fs::path run_config = write(dir / "run.toml", test::kTinyRun), part = write(dir / "part.h5", "part\n");
-  const fs::path sweep = write(dir / "sweep.toml", "system = \"cartpole\"\nconfig = \"run.toml\"\n[grid]\n\"loop.rollouts\" = [1, 2]\n");
+  const fs::path data = test::write_text(dir / "data.csv", "data\n"), model = test::write_text(dir / "model.toml", "# model\n");
+  const fs::path config = test::write_text(dir / "plan.toml", "# plan\n"), policy = test::write_text(dir / "policy.h5", "policy\n");
+  const fs::path run_config = test::write_text(dir / "run.toml", test::kTinyRun), part = test::write_text(dir / "part.h5", "part\n");
+  const fs::path sweep = test::write_text(dir / "sweep.toml", "system = \"cartpole\"\nconfig = \"run.toml\"\n[grid]\n\"loop.rollouts\" = [1, 2]\n");
   fs::create_hard_link(log, dir / "hard.csv");
   fs::create_symlink(data, dir / "link.csv");
   const std::string simulate = "simulate --system cartpole --episodes 1 --steps 20 ";
@@ -365,39 +350,39 @@ TEST(HostileFiles, AnOutputThatIsAnInputIsExit2AndTheInputIsKept) {
     fs::path input_file;  ///< the file that must be kept
   };
   const std::vector<Case> cases = {
-      {"data import " + quote(log) + " --system cartpole --map " + quote(map) + " --out {out}", log, "LOG " + log.string(), log},
-      {"data import " + quote(log) + " --system cartpole --map " + quote(map) + " --out {out}", dir / "hard.csv",
+      {"data import " + test::quote(log) + " --system cartpole --map " + test::quote(map) + " --out {out}", log, "LOG " + log.string(), log},
+      {"data import " + test::quote(log) + " --system cartpole --map " + test::quote(map) + " --out {out}", dir / "hard.csv",
        "LOG " + log.string(), log},
-      {"data import " + quote(log) + " --system cartpole --map " + quote(map) + " --out {out}", map, "--map " + map.string(), map},
-      {"diagnose --system cartpole --data " + quote(data) + " --out {out}", data, "--data " + data.string(), data},
-      {"diagnose --system cartpole --data " + quote(dir / "link.csv") + " --out {out}", data,
+      {"data import " + test::quote(log) + " --system cartpole --map " + test::quote(map) + " --out {out}", map, "--map " + map.string(), map},
+      {"diagnose --system cartpole --data " + test::quote(data) + " --out {out}", data, "--data " + data.string(), data},
+      {"diagnose --system cartpole --data " + test::quote(dir / "link.csv") + " --out {out}", data,
        "--data " + (dir / "link.csv").string(), data},
-      {"diagnose --system cartpole --data " + quote(data) + " --model " + quote(model) + " --write-model {out}", model,
+      {"diagnose --system cartpole --data " + test::quote(data) + " --model " + test::quote(model) + " --write-model {out}", model,
        "--model " + model.string(), model},
-      {simulate + "--world-model " + quote(model) + " --out {out}", model, "--world-model " + model.string(), model},
-      {"plan " + quote(config) + " --out {out}", config, "CONFIG " + config.string(), config},
-      {"plan " + quote(config) + " --data " + quote(data) + " --previous " + quote(policy) + " --out {out}", policy,
+      {simulate + "--world-model " + test::quote(model) + " --out {out}", model, "--world-model " + model.string(), model},
+      {"plan " + test::quote(config) + " --out {out}", config, "CONFIG " + config.string(), config},
+      {"plan " + test::quote(config) + " --data " + test::quote(data) + " --previous " + test::quote(policy) + " --out {out}", policy,
        "--previous " + policy.string(), policy},
-      {"rollout --system cartpole --policy " + quote(policy) + " --out {out}", policy, "--policy " + policy.string(), policy},
-      {"run cartpole --config " + quote(run_config) + " --no-plots --out {out}", run_config, "--config " + run_config.string(),
+      {"rollout --system cartpole --policy " + test::quote(policy) + " --out {out}", policy, "--policy " + policy.string(), policy},
+      {"run cartpole --config " + test::quote(run_config) + " --no-plots --out {out}", run_config, "--config " + run_config.string(),
        run_config},
-      {"sweep " + quote(sweep) + " --no-plots --out {out}", sweep, "SWEEP " + sweep.string(), sweep},
-      {"sweep " + quote(sweep) + " --no-plots --out {out}", run_config, "config (in the sweep file) " + run_config.string(),
+      {"sweep " + test::quote(sweep) + " --no-plots --out {out}", sweep, "SWEEP " + sweep.string(), sweep},
+      {"sweep " + test::quote(sweep) + " --no-plots --out {out}", run_config, "config (in the sweep file) " + run_config.string(),
        run_config},
-      {"profile " + quote(part) + " --backends exact --out {out}", part, "DATA " + part.string(), part},
-      {"merge " + quote(policy) + " " + quote(part) + " --no-plots --out {out}", part, "PART " + part.string(), part},
+      {"profile " + test::quote(part) + " --backends exact --out {out}", part, "DATA " + part.string(), part},
+      {"merge " + test::quote(policy) + " " + test::quote(part) + " --no-plots --out {out}", part, "PART " + part.string(), part},
   };
   for (const Case& c : cases) {
-    const std::string arguments = replaced(c.arguments, "{out}", quote(c.out));
+    const std::string arguments = replaced(c.arguments, "{out}", test::quote(c.out));
     SCOPED_TRACE(arguments);
-    const std::string kept = contents(c.input_file);
+    const std::string kept = test::read_text(c.input_file);
     const auto r = run_cli(arguments);
     EXPECT_EQ(r.status, 2) << r.err;
     const std::string option = arguments.find("--write-model") != std::string::npos ? "--write-model" : "--out";
     const std::string message = option + " " + c.out.string() + ": is the same file as " + c.input +
                                 ", an input of the command; expected a file that is not one of its inputs";
     EXPECT_NE(r.err.find(message), std::string::npos) << r.err << "\nexpected\n" << message;
-    EXPECT_EQ(contents(c.input_file), kept);
+    EXPECT_EQ(test::read_text(c.input_file), kept);
   }
 }
 
@@ -407,11 +392,11 @@ TEST(HostileFiles, AFileSizeLimitIsExit1NamingTheFileAndKeepsThePreviousOne) {
   const fs::path dir = test::temporary_dir("hostile_files_fsize");
   for (const std::string name : {"data.csv", "data.h5"}) {
     SCOPED_TRACE(name);
-    const fs::path out = write(dir / name, "the previous file\n");
-    const auto r = run_cli("simulate --system cartpole --episodes 4 --steps 200 --out " + quote(out), 16384);
+    const fs::path out = test::write_text(dir / name, "the previous file\n");
+    const auto r = run_cli("simulate --system cartpole --episodes 4 --steps 200 --out " + test::quote(out), 16384);
     EXPECT_EQ(r.status, 1) << r.err;
     EXPECT_NE(r.err.find(out.string() + ": not written: writing failed (File too large)"), std::string::npos) << r.err;
-    EXPECT_EQ(contents(out), "the previous file\n");
+    EXPECT_EQ(test::read_text(out), "the previous file\n");
   }
   for (const auto& entry : fs::directory_iterator(dir))
     EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << "left behind: " << entry.path();

@@ -136,4 +136,19 @@ CommandResult run_cli(const std::string& arguments) {
   return result;
 }
 
+std::string quote(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
+
+std::filesystem::path write_text(const std::filesystem::path& file, const std::string& text) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::ofstream(file, std::ios::binary) << text;
+  return file;
+}
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 }  // namespace gpilqg::test

@@ -47,6 +47,15 @@ struct CommandResult {
 };
 CommandResult run_cli(const std::string& arguments);
 
+/// `path` in single quotes, for the arguments of run_cli (the tests' paths hold no quote).
+std::string quote(const std::filesystem::path& path);
+
+/// Writes `text` to `file` byte for byte (creating its folder) and returns `file`.
+std::filesystem::path write_text(const std::filesystem::path& file, const std::string& text);
+
+/// The bytes of `file` ("" when it cannot be read).
+std::string read_text(const std::filesystem::path& file);
+
 }  // namespace gpilqg::test
 
 #define EXPECT_MATRIX_NEAR(actual, expected, abs_tol) \
