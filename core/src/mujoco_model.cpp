@@ -71,14 +71,6 @@ std::mutex& load_mutex() {
   return mutex;
 }
 
-std::string file_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) throw std::invalid_argument(fmt::format("{}: cannot read the model file", path));
-  return text.str();
-}
-
 /// A URDF with the motors of urdf_actuators.hpp: MuJoCo loads the URDF, writes it back as MJCF, and
 /// loads that with an <actuator> section added, from memory (named after the URDF, in its folder, so
 /// that mesh files resolve as they do for the URDF).
@@ -107,7 +99,7 @@ mjModel* load_urdf(const std::string& path, const std::string& text, char* error
     std::filesystem::remove(saved, ec);
     throw std::runtime_error(fmt::format("{}: MuJoCo could not convert the URDF to MJCF: {}", path, one_line(error)));
   }
-  std::string mjcf = file_text(saved.string());
+  std::string mjcf = model_file_text(saved.string());
   std::filesystem::remove(saved, ec);
   const std::size_t end = mjcf.rfind("</mujoco>");
   if (end == std::string::npos)
@@ -140,7 +132,7 @@ std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
   route_warnings_to_stderr();
   check_input_file_as<std::invalid_argument>(path, kMaxConfigFileBytes, "a MuJoCo model (MJCF .xml or URDF)");
   char error[1024] = "";
-  const std::string text = file_text(path);
+  const std::string text = model_file_text(path);
   check_mujoco_model_files(path, text);  // included and asset files: MuJoCo opens them unchecked
   mjModel* m = nullptr;
   {

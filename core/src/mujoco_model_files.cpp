@@ -50,14 +50,6 @@ bool check_named_file(const std::string& file, std::uintmax_t max_bytes, const s
   return true;
 }
 
-std::string read_text(const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) throw std::invalid_argument(fmt::format("{}: cannot read the model file", file));
-  return text.str();
-}
-
 class Scan {
  public:
   explicit Scan(const std::string& path) {
@@ -127,7 +119,7 @@ class Scan {
     std::error_code error;
     const fs::path canonical = fs::weakly_canonical(file, error);
     if (depth >= kMaxIncludeDepth || !included_.insert(error ? file : canonical.string()).second) return;
-    walk_text(read_text(file), file, depth + 1);
+    walk_text(model_file_text(file), file, depth + 1);
   }
 
   std::string model_dir_;
@@ -143,6 +135,14 @@ void check_mujoco_model_files(const std::string& path, const std::string& text) 
   Scan scan(path);
   scan.walk_text(text, path, 0);
   scan.check_assets();
+}
+
+std::string model_file_text(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in && !in.eof()) throw std::invalid_argument(fmt::format("{}: cannot read the model file", file));
+  return text.str();
 }
 
 }  // namespace gpilqg

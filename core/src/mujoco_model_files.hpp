@@ -28,4 +28,8 @@ namespace gpilqg {
 /// kMaxConfigFileBytes (included XML). Text that is not well-formed XML is left to MuJoCo's message.
 void check_mujoco_model_files(const std::string& path, const std::string& text);
 
+/// The bytes of a model file (the model itself or one it includes); throws std::invalid_argument
+/// "<file>: cannot read the model file" when reading fails.
+std::string model_file_text(const std::string& file);
+
 }  // namespace gpilqg
