@@ -11,6 +11,7 @@
 #include "gpilqg/core/limits.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/utf8.hpp"
+#include "gpilqg/experiments/config_model.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
 #include "gpilqg/gp/fitted_moment_matcher.hpp"
@@ -94,33 +95,50 @@ Vector non_negative(const TomlFields& f, const std::string& path, int size, std:
   return v;
 }
 
-/// [world]: `model`, another model file with the same states and controls (relative to the config's
-/// folder), and `parameters`, overrides by parameter name; both optional. Every override is checked by
-/// building the world once.
+/// [world]: `model`, another model file with the same states and controls or a model file of the
+/// diagnosis (config_model.hpp), relative to the config's folder, and `parameters`, overrides by
+/// parameter name; both optional. Every override is checked by building the world once.
 void read_world(const TomlFields& f, const toml::table& root, RunConfig& c, const SystemSignature& signature) {
+  c.world.system = c.system;
+  c.world.preset = Preset::RealWorld;
   if (!f.has("world")) return;
   f.only_keys("world", {"model", "parameters"});
-  if (f.has("world.model")) {
-    c.world_model = f.system_name("world.model");
-    const std::string mismatch = signature_mismatch(signature, system_signature(c.world_model));
+  if (f.has("world.model") && is_diagnosis_model_file(f.string("world.model"))) {
+    c.world = read_config_model(f, "world.model", c.system, Preset::RealWorld);
+  } else if (f.has("world.model")) {
+    c.world.system = f.system_name("world.model");
+    const std::string mismatch = signature_mismatch(signature, system_signature(c.world.system));
     if (!mismatch.empty()) f.fail("world.model", mismatch);
   }
   if (const toml::node* node = root.at_path("world.parameters").node()) {
     const toml::table* table = node->as_table();
     if (table == nullptr) f.fail("world.parameters", "is not a table; expected name = value entries");
     for (const auto& [key, value] : *table)
-      c.world_parameters[std::string(key.str())] = f.number("world.parameters." + toml_key(std::string(key.str())));
+      c.world.parameters[std::string(key.str())] = f.number("world.parameters." + toml_key(std::string(key.str())));
   }
   try {
-    (void)make_system(c.world_model.empty() ? c.system : c.world_model, Preset::RealWorld, c.world_parameters);
+    (void)c.world.build(ActuatorNoise{});
   } catch (const std::invalid_argument& e) {
     f.fail("world.parameters", e.what());
   }
 }
 
+/// The config's text as the result file keeps it: with every file it names (system.model, world.model)
+/// as resolved against the config's folder, so that the text means the same read from anywhere.
+std::string stored_text(const TomlFields& f, const toml::table& root) {
+  toml::table stored = root;
+  for (const char* table : {"system", "world"})
+    if (const std::string path = fmt::format("{}.model", table); f.has(path))
+      if (toml::table* section = stored[table].as_table()) section->insert_or_assign("model", f.file_path(path).string());
+  std::ostringstream text;
+  text << toml::toml_formatter{stored};
+  return text.str();
+}
+
 RunConfig read_run_config(const toml::table& root, const std::string& source, const std::string& system) {
   const TomlFields f(root, source);
   f.only_keys("", {"system", "world", "noise", "control", "tasks", "loop", "gp", "solver", "mpc", "pddp"});
+  f.only_keys("system", {"name", "model", "dt", "integrator", "substeps"});
   RunConfig c;
   c.system = f.system_name("system.name");
   if (!same_system(c.system, system))
@@ -137,6 +155,7 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
     c.substeps = f.integer_in("system.substeps", 1, limits::kMaxSubsteps);
   }
 
+  c.simulator = read_config_model(f, "system.model", c.system, Preset::Simulator);
   read_world(f, root, c, signature);
 
   c.noise.multiplicative_std = non_negative(f, "noise.actuator_multiplicative", m, Vector());
@@ -201,9 +220,7 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
     if (const auto problem = limits::trajectory_memory_problem(c.tasks[i].horizon, n, m, c.pddp))
       f.fail(fmt::format("tasks[{}].horizon", i), *problem);
 
-  std::ostringstream text;
-  text << toml::toml_formatter{root};
-  c.text = text.str();
+  c.text = stored_text(f, root);
   return c;
 }
 
@@ -230,7 +247,8 @@ RunConfig parse_run_config(const std::string& system, const std::string& overrid
   const toml::table defaults = TomlFields::parse_text(default_text, defaults_source);
   if (override_text.empty()) return read_run_config(defaults, defaults_source, system);
   toml::table root = TomlFields::parse_text(override_text, source);
-  TomlFields::merge(root, defaults);
+  // Optional fields without a default: the simulator's and the world's model files, world overrides.
+  TomlFields::merge(root, defaults, {"system.model", "world", "world.model", "world.parameters"});
   return read_run_config(root, source, system);
 }
 

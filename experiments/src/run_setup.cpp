@@ -8,15 +8,10 @@
 namespace gpilqg {
 
 RunModels make_run_models(const RunConfig& c) {
-  const auto make = [&](Preset preset) -> std::shared_ptr<const StepModel> {
-    if (preset == Preset::RealWorld)  // the world: another model file and parameter overrides when configured
-      return make_step_model(make_system(c.world_model.empty() ? c.system : c.world_model, preset, c.world_parameters,
-                                         c.noise),
-                             c.integrator, c.dt, c.substeps);
-    return make_step_model(make_system(c.system, preset, {}, c.noise), c.integrator, c.dt,
-                                                 c.substeps);
+  const auto step_model = [&](const ModelSpec& model) {
+    return make_step_model(model.build(c.noise), c.integrator, c.dt, c.substeps);
   };
-  return {make(Preset::RealWorld), make(Preset::Simulator)};
+  return {step_model(c.world), step_model(c.simulator)};
 }
 
 QuadraticCost make_task_cost(const RunConfig& c, const RunTask& task) {

@@ -6,6 +6,7 @@
 
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/limits.hpp"
+#include "gpilqg/experiments/config_model.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
 
@@ -24,7 +25,7 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   f.only_keys("", sections);
   f.require_section("system");
   f.require_section("problem");
-  f.only_keys("system", {"name", "preset", "integrator", "dt", "substeps"});
+  f.only_keys("system", {"name", "preset", "model", "integrator", "dt", "substeps"});
   std::vector<std::string> noise_keys = {"actuator_additive", "actuator_multiplicative", "state"};
   noise_keys.insert(noise_keys.end(), extra_noise_keys.begin(), extra_noise_keys.end());
   f.only_keys("noise", noise_keys);
@@ -40,8 +41,11 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   const int m = static_cast<int>(signature.controls.size());
 
   const std::string preset = f.string("system.preset", "sim");
-  if (auto p = parse_preset(preset)) c.preset = *p;
-  else f.fail("system.preset", fmt::format("'{}'; expected \"sim\" or \"real\"", preset));
+  const auto parsed_preset = parse_preset(preset);
+  if (!parsed_preset) f.fail("system.preset", fmt::format("'{}'; expected \"sim\" or \"real\"", preset));
+  if (f.has("system.model") && f.has("system.preset"))
+    f.fail("system.preset", "is given with system.model, whose file names its own preset; expected one of the two");
+  c.simulator = read_config_model(f, "system.model", c.system, *parsed_preset);
   if (!f.own_integrator(c.system, "system.integrator", "system.substeps")) {
     c.integrator = f.integrator("system.integrator", "euler");
     c.substeps = f.integer_in("system.substeps", 1, limits::kMaxSubsteps, 1);
@@ -88,7 +92,7 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
 }
 
 std::shared_ptr<const StepModel> make_solve_model(const SolveConfig& c) {
-  return make_step_model(make_system(c.system, c.preset, {}, c.noise), c.integrator, c.dt, c.substeps);
+  return make_step_model(c.simulator.build(c.noise), c.integrator, c.dt, c.substeps);
 }
 
 QuadraticCost make_solve_cost(const SolveConfig& c) {

@@ -1,5 +1,6 @@
 #include "gpilqg/experiments/toml_fields.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -42,11 +43,12 @@ std::string keys_of(const toml::table& table) {
 
 /// Fills `overrides` with every entry of `base` it lacks, recursing into tables both have. The
 /// user's nodes stay where they were parsed, so they keep their source lines for later errors.
-void merge_level(toml::table& overrides, const toml::table& base, const std::string& prefix) {
+void merge_level(toml::table& overrides, const toml::table& base, const std::string& prefix,
+                 const std::vector<std::string>& optional) {
   for (const auto& [key, node] : overrides) {
     const std::string name(key.str());
     const std::string path = prefix.empty() ? name : prefix + "." + name;
-    if (base.get(name) == nullptr) {
+    if (base.get(name) == nullptr && std::find(optional.begin(), optional.end(), path) == optional.end()) {
       const auto& source = node.source();
       throw InputError(fmt::format("{}:line {}: unknown field '{}'; expected one of: {}",
                                    source.path ? *source.path : std::string("<config>"), source.begin.line, path,
@@ -57,13 +59,16 @@ void merge_level(toml::table& overrides, const toml::table& base, const std::str
     toml::node* mine = overrides.get(key.str());
     if (mine == nullptr) overrides.insert(key.str(), node);
     else if (mine->is_table() && node.is_table())
-      merge_level(*mine->as_table(), *node.as_table(), prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str()));
+      merge_level(*mine->as_table(), *node.as_table(),
+                  prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str()), optional);
   }
 }
 
 }  // namespace
 
-void TomlFields::merge(toml::table& overrides, const toml::table& base) { merge_level(overrides, base, ""); }
+void TomlFields::merge(toml::table& overrides, const toml::table& base, const std::vector<std::string>& optional) {
+  merge_level(overrides, base, "", optional);
+}
 
 std::string toml_key(const std::string& key) {
   const bool bare = !key.empty() && key.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") ==
@@ -225,13 +230,15 @@ Vector TomlFields::weight_vector(const std::string& path, int size, std::optiona
   return v;
 }
 
+std::filesystem::path TomlFields::file_path(const std::string& path) const {
+  const std::filesystem::path named = string(path);
+  if (named.is_relative()) return (std::filesystem::path(source_of(find(path))).parent_path() / named).lexically_normal();
+  return named;
+}
+
 std::string TomlFields::system_name(const std::string& path) const {
   std::string name = string(path);
-  if (is_model_file_name(name) && std::filesystem::path(name).is_relative()) {
-    const toml::node* node = find(path);
-    const std::filesystem::path config(source_of(node));
-    name = (config.parent_path() / name).lexically_normal().string();
-  }
+  if (is_model_file_name(name)) name = file_path(path).string();
   try {
     (void)find_system(name);
   } catch (const std::invalid_argument& e) {

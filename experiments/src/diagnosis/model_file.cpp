@@ -32,10 +32,10 @@ void check_values(const ModelSpec& model, const LibraryEffect& effect, const Vec
   }
 }
 
-}  // namespace
-
-ModelSpec read_model_file(const std::filesystem::path& file, const std::string& system) {
-  const toml::table root = TomlFields::parse(file);
+/// A model from its parsed TOML; `file` names the source in errors, `system_origin` what named the
+/// system the file must agree with.
+ModelSpec read_model_table(const toml::table& root, const std::filesystem::path& file, const std::string& system,
+                           const std::string& system_origin) {
   const TomlFields fields(root, file);
   fields.only_keys("", {"model", "parameters", "user_effects", "effects"});
   fields.require_section("model");
@@ -45,7 +45,8 @@ ModelSpec read_model_file(const std::filesystem::path& file, const std::string& 
   // valid when the model file is given by another path.
   const std::string named = fields.string("model.system");
   if (named != system && named != system_signature(system).name)
-    fields.fail("model.system", fmt::format("is '{}' but --system is '{}'; expected the same system", named, system));
+    fields.fail("model.system",
+                fmt::format("is '{}' but {} is '{}'; expected the same system", named, system_origin, system));
   model.system = system;
   const std::string preset = fields.string("model.preset", std::string("sim"));
   const auto parsed = parse_preset(preset);
@@ -115,6 +116,16 @@ ModelSpec read_model_file(const std::filesystem::path& file, const std::string& 
     fields.fail("effects", "is not a table; expected [effects] with name = value entries");
   }
   return model;
+}
+
+}  // namespace
+
+ModelSpec read_model_file(const std::filesystem::path& file, const std::string& system, const std::string& system_origin) {
+  return read_model_table(TomlFields::parse(file), file, system, system_origin);
+}
+
+ModelSpec parse_model_text(const std::string& text, const std::string& source, const std::string& system) {
+  return read_model_table(TomlFields::parse_text(text, source), source, system, "the system");
 }
 
 std::string model_file_text(const ModelSpec& model, const std::vector<std::string>& comment) {

@@ -6,9 +6,10 @@
 /// are replaced whole, and a key the defaults do not have is an error naming the file and line.
 ///
 ///   [system]  name, dt, integrator ("euler"|"rk4"), substeps      (world, true model and simulator;
-///             a MuJoCo model has neither integrator nor substeps: its own are the simulator)
-///   [world]   model (a second model file), parameters (name = value): the real world, for systems
-///             without a default config (MuJoCo models, plugins); the built-ins' is their "real" preset
+///             a MuJoCo model has neither integrator nor substeps: its own are the simulator);
+///             model (optional): a model file of `gpilqg diagnose` as the simulator
+///   [world]   model (a second model file, or a model file of the diagnosis), parameters (name =
+///             value): the real world; without them the system's "real" preset
 ///   [noise]   actuator_multiplicative (m), actuator_additive (m), observation (n)
 ///   [control] u_init (m), u_min, u_max (m, optional)
 ///   [[tasks]] name, x0, goal, horizon, Q, R, Qf, track_line, transfer
@@ -26,6 +27,7 @@
 #include <vector>
 
 #include "gpilqg/control/mpc.hpp"
+#include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/noise.hpp"
 #include "gpilqg/experiments/gp_settings.hpp"
@@ -51,9 +53,13 @@ struct RunConfig {
   double dt = 0.0;
   Integrator integrator = Integrator::RK4;
   int substeps = 0;
+  /// The simulator: [system] model (a model file of the diagnosis, config_model.hpp) or the "sim"
+  /// preset. GP-ILQG's residual GP has it as its mean function.
+  ModelSpec simulator;
   // [world]
-  std::string world_model;                         ///< another model file with the same joints and actuators
-  std::map<std::string, double> world_parameters;  ///< parameter overrides of the world
+  /// The real world: the "real" preset, another model file with the same joints and actuators, or a
+  /// model file of the diagnosis ([world] model), with [world] parameters as overrides.
+  ModelSpec world;
   // [noise]
   ActuatorNoise noise;     ///< the world's process noise, known to every model (the paper's F)
   Vector observation_std;  ///< n entries

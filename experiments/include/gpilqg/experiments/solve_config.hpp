@@ -1,8 +1,9 @@
 #pragma once
 /// @file solve_config.hpp
-/// One trajectory-optimisation problem described in TOML (DESIGN.md section 8, `gpilqg solve`):
+/// One trajectory-optimisation problem described in TOML (`gpilqg solve`; docs/formats.md, "Problem config"):
 ///
-///   [system]   name, preset ("sim"|"real"), integrator ("euler"|"rk4"), dt, substeps (optional)
+///   [system]   name, preset ("sim"|"real") or model (a model file of `gpilqg diagnose`,
+///              config_model.hpp), integrator ("euler"|"rk4"), dt, substeps (optional)
 ///   [noise]    actuator_additive, actuator_multiplicative (m entries), state (n entries)   optional
 ///   [problem]  horizon, x0, goal, Q, R, Qf (diagonals), u_min, u_max (optional), u_init (optional, m)
 ///   [solver]   algorithm ("ilqr"|"ilqg"|"robust_ilqg"), max_iterations, tolerance (relative cost
@@ -17,6 +18,7 @@
 
 #include "gpilqg/control/ddp_solver.hpp"
 #include "gpilqg/core/cost.hpp"
+#include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/noise.hpp"
 #include "gpilqg/core/systems.hpp"
@@ -27,7 +29,8 @@ class TomlFields;
 
 struct SolveConfig {
   std::string system = "cartpole";
-  Preset preset = Preset::Simulator;
+  /// The model planned with: [system] model, or the system at [system] preset (config_model.hpp).
+  ModelSpec simulator;
   Integrator integrator = Integrator::Euler;
   double dt = 0.05;
   int substeps = 1;
@@ -49,7 +52,7 @@ SolveConfig read_solve_config(const TomlFields& fields, const std::vector<std::s
                               const std::string& default_algorithm,
                               const std::vector<std::string>& extra_noise_keys = {});
 
-/// The config's simulator: [system] (its preset, integrator, sub-steps) with [noise], at step dt.
+/// The config's simulator: [system] (its model or preset, integrator, sub-steps) with [noise], at step dt.
 std::shared_ptr<const StepModel> make_solve_model(const SolveConfig& config);
 
 /// The config's cost: dt (0.5 e'Qe + 0.5 u'Ru) per step and 0.5 e'Qf e at the end, e = x - goal.

@@ -32,8 +32,9 @@ class TomlFields {
   /// Completes `overrides` with `base` (the defaults): tables merge key by key, every other value the
   /// user gave (arrays included) replaces the default. A key `base` does not have is an InputError
   /// naming the overriding source, its line and the keys that exist there. The user's nodes are kept
-  /// in place, so later errors still name their file and line.
-  static void merge(toml::table& overrides, const toml::table& base);
+  /// in place, so later errors still name their file and line. `optional` lists the dotted paths the
+  /// user may give although `base` has no default for them (e.g. "system.model", "world").
+  static void merge(toml::table& overrides, const toml::table& base, const std::vector<std::string>& optional = {});
 
   TomlFields(const toml::table& root, std::filesystem::path file) : root_(root), file_(std::move(file)) {}
 
@@ -64,6 +65,9 @@ class TomlFields {
   /// [0, 1e+150] (...)".
   Vector weight_vector(const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) const;
   bool has(const std::string& path) const;
+  /// A file named by the string field at `path`: a relative path is relative to the folder of the
+  /// config file that holds the field.
+  std::filesystem::path file_path(const std::string& path) const;
   /// A system's name (DESIGN.md sections 3 and 10) as the registry resolves it: a MuJoCo model file
   /// given by a relative path is relative to the config file's folder. Fails naming the field for an
   /// unknown system or a model file that cannot be loaded.

@@ -42,8 +42,13 @@
 
 namespace gpilqg::diagnosis {
 
-/// Reads a model file. `system` is the --system given on the command line: the file must agree.
-ModelSpec read_model_file(const std::filesystem::path& file, const std::string& system);
+/// Reads a model file. `system` is the system it is used for (the command's --system, a config's
+/// [system] name), named `system_origin` in the error when the file's [model] system differs.
+ModelSpec read_model_file(const std::filesystem::path& file, const std::string& system,
+                          const std::string& system_origin = "--system");
+
+/// The same from the text model_file_text wrote (e.g. kept in a result file); `source` names it in errors.
+ModelSpec parse_model_text(const std::string& text, const std::string& source, const std::string& system);
 
 /// The TOML text of a model (the format above), preceded by `comment` lines written as "# ...".
 std::string model_file_text(const ModelSpec& model, const std::vector<std::string>& comment = {});

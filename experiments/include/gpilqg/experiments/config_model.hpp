@@ -1,0 +1,32 @@
+#pragma once
+/// @file config_model.hpp
+/// The model a config names for its system: `[system] model = "F.toml"` (the simulator of `solve`,
+/// `plan`, `rollout --cost` and `run`) or `[world] model = "W.toml"` (the world of `run`), a model
+/// file of `gpilqg diagnose` (diagnosis/model_file.hpp: a preset, recalibrated parameters, effects
+/// of the library and effects the user declared). Without the field, the system's bare preset.
+///
+/// As the simulator of GP-ILQG this model is the residual GP's mean function (the paper's
+/// x_{t+1} = f_sim(x_t, u_t) + GP residual): what the diagnosis named, the model already has, and the
+/// GP learns only what it still misses.
+
+#include <string>
+
+#include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/systems.hpp"
+
+namespace gpilqg {
+
+class TomlFields;
+
+/// The model file named by field `path` of the config `fields` (relative to the config's folder), for
+/// `system`; or, when the field is absent, `system` at `preset`. The file's own errors (a model of
+/// another system, an unknown effect or parameter, a value out of range) name its file, line and
+/// field, behind the config's field. A model with an input delay fails too: the step models the
+/// solvers and `run`'s rollouts use apply each control at once (only `gpilqg simulate` delays it).
+ModelSpec read_config_model(const TomlFields& fields, const std::string& path, const std::string& system, Preset preset);
+
+/// True when `name` names a model file of the diagnosis (it ends in ".toml", any case) rather than a
+/// system or a MuJoCo model file.
+bool is_diagnosis_model_file(const std::string& name);
+
+}  // namespace gpilqg
