@@ -4,6 +4,7 @@
 
 #include "gpilqg/core/hdf5_reader.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/gp/backend_registry.hpp"
 #include "gpilqg/gp/gp_io.hpp"
 #include "gpilqg/gp/residual_model.hpp"
@@ -126,14 +127,23 @@ void write_algorithm_run(const std::filesystem::path& file, const AlgorithmRun& 
     h5.write_matrix("/data/x_next", run.data.x_next);
     h5.write_vector("/data/iteration", run.data.iteration);
     for (std::size_t k = 0; k < run.iterations.size(); ++k) write_record(h5, fmt::format("/iter_{}", k), run.iterations[k]);
+    if (const auto& d = run.diagnosis) {
+      h5.write_scalar("/diagnosis/round", d->round);
+      h5.write_scalar("/diagnosis/adopted", d->adopted ? 1.0 : 0.0);
+      h5.write_scalar("/diagnosis/seconds", d->seconds);
+      h5.write_scalar("/diagnosis/transitions", d->transitions);
+      h5.attribute("/diagnosis/round", "verdict", d->verdict);
+      h5.attribute("/diagnosis/round", "reason", d->reason);
+      h5.attribute("/diagnosis/round", "model", diagnosis::model_file_text(d->model));
+    }
     h5.close();
   }
   if (const auto* model = dynamic_cast<const gp::ResidualModel*>(run.final_model.get()))
     gp::save_residual_model(file, kModelGroup, *model);
 }
 
-AlgorithmRun read_algorithm_run(const std::filesystem::path& file, std::shared_ptr<const StepModel> simulator,
-                                const gp::BackendSettings& settings) {
+AlgorithmRun read_algorithm_run(const std::filesystem::path& file, const std::string& system,
+                                const SimulatorOf& simulator_of, const gp::BackendSettings& settings) {
   AlgorithmRun run;
   std::string backend;
   {
@@ -147,12 +157,25 @@ AlgorithmRun read_algorithm_run(const std::filesystem::path& file, std::shared_p
     const Vector iteration = h5.read_vector("/data/iteration");
     for (const double i : iteration) run.data.iteration.push_back(static_cast<int>(i));
     for (int k = 0; k < iterations; ++k) run.iterations.push_back(read_record(h5, fmt::format("/iter_{}", k)));
+    if (h5.exists("/diagnosis/round")) {
+      LoopDiagnosis d;
+      d.round = static_cast<int>(h5.read_scalar("/diagnosis/round"));
+      d.adopted = h5.read_scalar("/diagnosis/adopted") != 0.0;
+      d.seconds = h5.read_scalar("/diagnosis/seconds");
+      d.transitions = static_cast<int>(h5.read_scalar("/diagnosis/transitions"));
+      d.verdict = h5.string_attribute("/diagnosis/round", "verdict");
+      d.reason = h5.string_attribute("/diagnosis/round", "reason");
+      d.model = diagnosis::parse_model_text(h5.string_attribute("/diagnosis/round", "model"),
+                                            file.string() + ":/diagnosis/round attribute 'model'", system);
+      d.changes = d.model.describe();
+      run.diagnosis = std::move(d);
+    }
     if (h5.exists(std::string(kModelGroup) + "/0")) backend = h5.string_attribute(std::string(kModelGroup) + "/0", "backend");
   }
   if (!backend.empty()) {
     const auto gp_backend = gp::make_backend(backend, settings);
     run.final_model = std::make_shared<const gp::ResidualModel>(
-        gp::load_residual_model(file, kModelGroup, std::move(simulator), *gp_backend));
+        gp::load_residual_model(file, kModelGroup, simulator_of(run.diagnosis), *gp_backend));
     if (!run.iterations.empty()) run.iterations.back().plan.model = run.final_model;
   }
   return run;

@@ -5,6 +5,7 @@
 #include <functional>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gpilqg/control/belief_space.hpp"
 #include "gpilqg/experiments/gp_ilqg_round.hpp"
@@ -29,14 +30,20 @@ void report(const TaskContext& c, const std::string& name, int k, const Iteratio
 }
 
 /// Plans from data; fills the record's fit time and hyperparameters and may keep the plan's model.
-using DataPlanner = std::function<Plan(const TransitionData& data, const Plan* previous, IterationRecord& record)>;
+/// `run` is the run so far (its diagnosis decides the simulator).
+using DataPlanner =
+    std::function<Plan(const TransitionData& data, const Plan* previous, IterationRecord& record, const AlgorithmRun& run)>;
+/// Called after the rollouts of round k have been added to run.data.
+using AfterRollouts = std::function<void(AlgorithmRun& run, int k)>;
 
 /// The loop every data-driven algorithm shares (Algorithm 1's structure): plan from the data,
 /// evaluate, stop when the policy no longer changes, else roll the policy out config.rollouts times
 /// with exploration and add what was measured. With `borrowed`, the data of iteration k is what that
 /// run had at its iteration k, and nothing is collected.
 AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, TransitionData initial, std::uint64_t seed,
-                           const DataPlanner& planner, const AlgorithmRun* borrowed = nullptr) {
+                           const DataPlanner& planner, const AlgorithmRun* borrowed = nullptr,
+                           const AfterRollouts& after_rollouts = {},
+                           const std::optional<LoopDiagnosis>& inherited = std::nullopt) {
   std::optional<AlgorithmRun> restored = c.journal != nullptr ? c.journal->restore(c, seed, name) : std::nullopt;
   AlgorithmRun run;
   if (restored) {
@@ -44,6 +51,7 @@ AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, Transi
   } else {
     run.name = name;
     run.data = std::move(initial);
+    run.diagnosis = inherited;
   }
   const int K = c.config.iterations;
   bool stopped = run.converged_at >= 0 && borrowed == nullptr;
@@ -61,7 +69,7 @@ AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, Transi
     } else {
       IterationRecord record;
       record.data_rows = data.size();
-      record.plan = planner(data, previous != nullptr ? &previous->plan : nullptr, record);
+      record.plan = planner(data, previous != nullptr ? &previous->plan : nullptr, record, run);
       record.evaluation = evaluate(c, record.plan, seed);
       if (previous != nullptr) {
         record.policy_change = record.plan.policy.distance(previous->plan.policy);
@@ -77,6 +85,7 @@ AlgorithmRun learning_loop(const TaskContext& c, const std::string& name, Transi
           run.data.append(roll_out(c, record.plan, c.config.exploration_std, rng), k);
         }
         record.rollout_seconds = seconds_since(start);
+        if (after_rollouts) after_rollouts(run, k);
       }
       report(c, name, k, record);
       run.final_model = record.plan.model;
@@ -126,27 +135,57 @@ AlgorithmRun run_fixed_model(const TaskContext& c, const std::string& name, std:
 }
 
 AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp::GpBackend& backend,
-                         TransitionData initial, std::uint64_t seed) {
+                         TransitionData initial, std::uint64_t seed, const std::optional<LoopDiagnosis>& inherited) {
   const DdpTask task = ddp_task(c);
-  const DataPlanner planner = [&](const TransitionData& data, const Plan* previous, IterationRecord& record) {
+  std::shared_ptr<const StepModel> diagnosed;  // built once, when the run adopts a diagnosed model
+  const auto simulator_of = [&](const AlgorithmRun& run) {
+    if (!run.diagnosis || !run.diagnosis->adopted) return c.models.simulator;
+    if (!diagnosed) diagnosed = planning_simulator(c.config, c.models.simulator, run.diagnosis);
+    return diagnosed;
+  };
+  const DataPlanner planner = [&](const TransitionData& data, const Plan* previous, IterationRecord& record,
+                                  const AlgorithmRun& run) {
+    const std::shared_ptr<const StepModel> simulator = simulator_of(run);
     GpRoundInputs inputs;
     inputs.data = &data;
     inputs.backend = &backend;
-    // The previous iteration's GP (warm start, re-sample rule) is the model its plan was made on.
-    inputs.previous_model =
-        previous != nullptr ? std::dynamic_pointer_cast<const gp::ResidualModel>(previous->model) : nullptr;
+    // The previous iteration's GP (warm start, re-sample rule) is the model its plan was made on; a GP
+    // of another mean function (before the diagnosed model was adopted) learned another residual.
+    const bool new_mean = static_cast<int>(run.iterations.size()) == diagnosed_from(run.diagnosis);
+    inputs.previous_model = previous != nullptr && !new_mean
+                                ? std::dynamic_pointer_cast<const gp::ResidualModel>(previous->model)
+                                : nullptr;
     inputs.previous_u_bar = warm_start(previous);
     inputs.fit = fit_options(c, seed, name, data.size());
     inputs.variant = c.config.gp_variant;
     inputs.threads = c.threads;
     inputs.observation_std = c.config.observation_std;
-    GpRound round = plan_gp_ilqg_round(task, c.models.simulator, inputs);
+    GpRound round = plan_gp_ilqg_round(task, simulator, inputs);
     record.fit_seconds = round.fit_seconds;
     record.hyperparameters = std::move(round.hyperparameters);
     record.noise_floor = std::move(round.noise_floor);
     return std::move(round.plan);
   };
-  return learning_loop(c, name, std::move(initial), seed, planner);
+  const AfterRollouts diagnose = [&](AlgorithmRun& run, int k) {
+    if (k != c.config.diagnose_after || run.diagnosis) return;
+    const std::string prefix = fmt::format("{} {} round {}: diagnosis", c.task.name, name, k);
+    if (c.progress) c.progress(fmt::format("{} of {} transitions", prefix, run.data.size()));
+    const auto stream = derive_seed(seed, c.task_index, RandomStream::Diagnosis, {stream_id(name), static_cast<std::uint64_t>(k)});
+    run.diagnosis = diagnose_loop_data(c.config, run.data, k, stream);
+    const LoopDiagnosis& d = *run.diagnosis;
+    if (c.progress)
+      c.progress(fmt::format("{}: {} in {:.1f} s; {}", prefix, d.verdict, d.seconds,
+                             d.adopted ? fmt::format("the simulator from round {} on: {}", k + 1, fmt::join(d.changes, "; "))
+                                       : "the simulator stays: " + d.reason));
+  };
+  const bool adopted = inherited && inherited->adopted;
+  std::optional<LoopDiagnosis> carried;
+  if (adopted) {
+    carried = inherited;
+    carried->round = -1;
+  }
+  return learning_loop(c, name, std::move(initial), seed, planner, nullptr,
+                       c.config.diagnose_after >= 0 && !adopted ? diagnose : AfterRollouts{}, carried);
 }
 
 namespace {
@@ -154,7 +193,7 @@ namespace {
 /// PDDP's plan from data: n GPs on z = [x; u] -> x' - x (no simulator), moment matching, DDP over the
 /// belief from N(x0, diag(observation_std^2)); the policy acts on measured states (belief_space.hpp).
 DataPlanner pddp_planner(const TaskContext& c, const std::string& name, std::uint64_t seed) {
-  return [&c, name, seed](const TransitionData& data, const Plan* previous, IterationRecord& record) {
+  return [&c, name, seed](const TransitionData& data, const Plan* previous, IterationRecord& record, const AlgorithmRun&) {
     if (data.size() == 0) return open_loop_plan(c);  // no data, no model: PDDP's initial controls
     const auto start = std::chrono::steady_clock::now();
     const int n = static_cast<int>(data.x.cols()), m = static_cast<int>(data.u.cols());

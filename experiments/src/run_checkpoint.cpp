@@ -141,7 +141,10 @@ std::optional<AlgorithmRun> RunCheckpoint::restore(const TaskContext& context, s
                                                    const std::string& name) const {
   const std::filesystem::path file = unit_file(context, seed, name);
   if (!std::filesystem::exists(file)) return std::nullopt;
-  AlgorithmRun run = read_algorithm_run(file, context.models.simulator, context.config.gp.backend_settings);
+  const SimulatorOf simulator_of = [&](const std::optional<LoopDiagnosis>& diagnosis) {
+    return planning_simulator(context.config, context.models.simulator, diagnosis);
+  };
+  AlgorithmRun run = read_algorithm_run(file, context.config.system, simulator_of, context.config.gp.backend_settings);
   if (run.name != name)
     throw std::runtime_error(fmt::format("{}: holds algorithm '{}', expected '{}'", file.string(), run.name, name));
   if (static_cast<int>(run.iterations.size()) > context.config.iterations + 1)

@@ -137,7 +137,7 @@ std::string stored_text(const TomlFields& f, const toml::table& root) {
 
 RunConfig read_run_config(const toml::table& root, const std::string& source, const std::string& system) {
   const TomlFields f(root, source);
-  f.only_keys("", {"system", "world", "noise", "control", "tasks", "loop", "gp", "solver", "mpc", "pddp"});
+  f.only_keys("", {"system", "world", "noise", "control", "tasks", "loop", "diagnosis", "gp", "solver", "mpc", "pddp"});
   f.only_keys("system", {"name", "model", "dt", "integrator", "substeps"});
   RunConfig c;
   c.system = f.system_name("system.name");
@@ -177,6 +177,13 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
   c.policy_tolerance = f.number("loop.policy_tolerance");
   if (c.policy_tolerance < 0.0) f.fail("loop.policy_tolerance", "must be >= 0");
   c.evaluation_rollouts = f.integer_in("loop.evaluation_rollouts", 1, limits::kMaxRollouts);
+
+  f.only_keys("diagnosis", {"after_round"});
+  c.diagnose_after = f.integer_in("diagnosis.after_round", -1, limits::kMaxLoopIterations, -1);
+  if (c.diagnose_after >= c.iterations)
+    f.fail("diagnosis.after_round", fmt::format("is {}; expected -1 (no diagnosis) or a round from 0 to {} (loop.iterations "
+                                                "- 1: the last round whose rollouts a later plan uses)",
+                                                c.diagnose_after, c.iterations - 1));
 
   c.gp = read_gp_settings(f, GpSettings{});  // every field is in the merged defaults
 
@@ -248,7 +255,7 @@ RunConfig parse_run_config(const std::string& system, const std::string& overrid
   if (override_text.empty()) return read_run_config(defaults, defaults_source, system);
   toml::table root = TomlFields::parse_text(override_text, source);
   // Optional fields without a default: the simulator's and the world's model files, world overrides.
-  TomlFields::merge(root, defaults, {"system.model", "world", "world.model", "world.parameters"});
+  TomlFields::merge(root, defaults, {"system.model", "world", "world.model", "world.parameters", "diagnosis"});
   return read_run_config(root, source, system);
 }
 

@@ -253,6 +253,13 @@ void write_algorithm(Hdf5Writer& h5, const Parts& parts, const TaskPlan& plan, c
       }
     }
     h5.write_array(path, dims, out);
+    if (name == "diagnosed_from")  // its per-seed texts (run_results_io.hpp), in the seeds' new order
+      for (const char* attribute : {"diagnosis", "model"}) {
+        std::vector<std::string> texts;
+        for (const auto& [seed, source] : sources)
+          texts.push_back(parts[source.part].h5->string_list_attribute(path, attribute).at(source.column));
+        h5.attribute(path, attribute, texts);
+      }
   }
 }
 

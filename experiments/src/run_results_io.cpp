@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
+
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
 #include "gpilqg/core/systems.hpp"
@@ -17,6 +19,27 @@
 
 namespace gpilqg {
 namespace {
+
+/// <group>/{diagnosed_from, diagnosis_round} (S) and their per-seed texts, when a seed's run has a
+/// diagnosis inside the loop (loop_diagnosis.hpp).
+void write_loop_diagnosis(Hdf5Writer& h5, const std::string& group, const TaskResults& task, std::size_t a) {
+  bool any = false;
+  for (const auto& seed_runs : task.seeds) any = any || seed_runs[a].diagnosis.has_value();
+  if (!any) return;
+  std::vector<double> from, round;
+  std::vector<std::string> summary, model;
+  for (const auto& seed_runs : task.seeds) {
+    const auto& d = seed_runs[a].diagnosis;
+    from.push_back(diagnosed_from(d));
+    round.push_back(d ? d->round : -1);
+    summary.push_back(d ? diagnosis_summary(*d) : std::string());
+    model.push_back(d && d->adopted ? diagnosis::model_file_text(d->model) : std::string());
+  }
+  h5.write_vector(group + "/diagnosed_from", from);
+  h5.write_vector(group + "/diagnosis_round", round);
+  h5.attribute(group + "/diagnosed_from", "diagnosis", summary);
+  h5.attribute(group + "/diagnosed_from", "model", model);
+}
 
 using u64 = std::uint64_t;
 
@@ -67,6 +90,7 @@ void write_algorithm(Hdf5Writer& h5, const std::string& group, const TaskResults
   std::vector<double> converged;
   for (std::size_t s = 0; s < S; ++s) converged.push_back(task.seeds[s][a].converged_at);
   h5.write_vector(group + "/converged_at", converged);
+  write_loop_diagnosis(h5, group, task, a);
 
   const std::size_t E = first.iterations.front().evaluation.costs.size();
   std::vector<double> evaluation_costs;
@@ -238,7 +262,7 @@ std::string_view gp_leaf(std::string_view dataset) {
 
 std::optional<std::size_t> seed_axis(std::string_view dataset) {
   if (is_one_of(dataset, kIterationBySeed) || dataset == "evaluation_costs") return 1;
-  if (dataset == "converged_at") return 0;
+  if (dataset == "converged_at" || dataset == "diagnosed_from" || dataset == "diagnosis_round") return 0;
   if (is_one_of(iteration_leaf(dataset), kPlanBySeed)) return 0;
   const std::string_view gp = gp_leaf(dataset);
   if (gp == "hyper" || gp == "fitted" || gp == "noise_floor") return 1;

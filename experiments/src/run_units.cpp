@@ -91,7 +91,10 @@ AlgorithmRun run_unit(const RunConfig& config, const RunOptions& options, const 
       return run_fixed_model(context, unit.algorithm, models.simulator, unit.seed);
     case UnitKind::GpIlqg: {
       const auto backend = gp::make_backend(unit.backend, config.gp.backend_settings);
-      return run_gp_ilqg(context, unit.algorithm, *backend, initial_data(), unit.seed);
+      // A transfer task starts from the model the previous task's diagnosis adopted, if any.
+      const std::optional<LoopDiagnosis> inherited =
+          unit.depends_on.empty() ? std::nullopt : completed(unit.depends_on.front()).diagnosis;
+      return run_gp_ilqg(context, unit.algorithm, *backend, initial_data(), unit.seed, inherited);
     }
     case UnitKind::PddpOnGpData:
       return run_pddp_on_data_of(context, completed(unit.depends_on.front()), unit.seed);

@@ -1,6 +1,6 @@
 #pragma once
 /// @file algorithm_runs.hpp
-/// The algorithms of `gpilqg run` on one task and one seed (DESIGN.md section 7 names):
+/// The algorithms of `gpilqg run` on one task and one seed (docs/experiments.md):
 ///
 ///   ilqg_real   iLQG on the true (real-world) model: the reference optimum
 ///   ilqg_sim    iLQG on the simulator only
@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "gpilqg/experiments/loop_diagnosis.hpp"
 #include "gpilqg/experiments/task_actions.hpp"
 #include "gpilqg/experiments/transition_data.hpp"
 #include "gpilqg/gp/backend.hpp"
@@ -43,6 +44,9 @@ struct AlgorithmRun {
   int converged_at = -1;  ///< first iteration whose policy change fell below the tolerance (-1: never)
   TransitionData data;    ///< everything it collected, including data carried over from an earlier task
   std::shared_ptr<const StepModel> final_model;  ///< the last plan's model (GP-ILQG: the residual model)
+  /// gp_ilqg with [diagnosis] after_round: the diagnosis of its data, or the model its previous task
+  /// adopted (loop_diagnosis.hpp); empty before the diagnosis and without one.
+  std::optional<LoopDiagnosis> diagnosis;
 };
 
 /// Where each algorithm's progress is kept, so that an interrupted run can continue from its last
@@ -66,9 +70,13 @@ void attach_fixed_model(AlgorithmRun& run, const std::shared_ptr<const StepModel
 AlgorithmRun run_fixed_model(const TaskContext& context, const std::string& name,
                              std::shared_ptr<const StepModel> model, std::uint64_t seed);
 
-/// Algorithm 1 with `backend`, starting from `initial` data (an earlier task's, or empty).
+/// Algorithm 1 with `backend`, starting from `initial` data (an earlier task's, or empty). The plans use
+/// the config's simulator, or the diagnosed model from the round after [diagnosis] after_round when
+/// the diagnosis explained the data (loop_diagnosis.hpp); `inherited`, the diagnosis of the previous
+/// task's run, is the model from iteration 0 on when it adopted one.
 AlgorithmRun run_gp_ilqg(const TaskContext& context, const std::string& name, const gp::GpBackend& backend,
-                         TransitionData initial, std::uint64_t seed);
+                         TransitionData initial, std::uint64_t seed,
+                         const std::optional<LoopDiagnosis>& inherited = std::nullopt);
 
 /// The solver options of PDDP's plans: [solver] with [pddp] max_iterations as the only cap. No wall-time
 /// limit: DdpOptions' default 60 s used to stop the quadrotor's PDDP solves after 2 to 6 of their 10

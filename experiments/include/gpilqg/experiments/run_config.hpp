@@ -14,6 +14,7 @@
 ///   [control] u_init (m), u_min, u_max (m, optional)
 ///   [[tasks]] name, x0, goal, horizon, Q, R, Qf, track_line, transfer
 ///   [loop]    iterations, rollouts, exploration (m), policy_tolerance, evaluation_rollouts
+///   [diagnosis] after_round (optional): diagnose the data after this round (loop_diagnosis.hpp)
 ///   [gp]      backend, exact_points, inducing, frequencies, restarts, max_evaluations
 ///   [solver]  max_iterations, tolerance, gradient_tolerance, gp_algorithm ("robust_ilqg"|"ilqg")
 ///   [mpc]     enabled, horizon, first_solve_iterations, iterations_per_step
@@ -73,6 +74,11 @@ struct RunConfig {
   Vector exploration_std;
   double policy_tolerance = 0.0;
   int evaluation_rollouts = 0;
+  // [diagnosis]
+  /// after_round: the round after whose rollouts gp_ilqg diagnoses its data and, when the verdict is
+  /// "explained", plans on with the diagnosed model as the simulator (loop_diagnosis.hpp); -1: never.
+  /// Optional, -1 when absent.
+  int diagnose_after = -1;
   // [gp]
   GpSettings gp;
   // [solver]

@@ -1,6 +1,6 @@
 #pragma once
 /// @file run_results_io.hpp
-/// The result file of `gpilqg run` (DESIGN.md section 7; README "Results file" documents it with an
+/// The result file of `gpilqg run` (docs/formats.md, "Results file of `gpilqg run`", documents it with an
 /// h5py example). S seeds, K + 1 iterations, E evaluation rollouts, T steps, n states, m controls,
 /// D = n + m GP inputs; every dataset is float64:
 ///
@@ -19,6 +19,11 @@
 ///   /<task>/<algorithm>/iter_<k>/K (S x T x m x n), k (S x m x T): its feedback and feed-forward
 ///   /<task>/<algorithm>/iter_<k>/{predicted_cost, solve_time} (S)
 ///   /<task>/<algorithm>/iter_<k>/{eval_x, eval_u} (S x n x T+1, S x m x T): the first evaluation rollout
+///   /<task>/<algorithm>/{diagnosed_from, diagnosis_round} (S): with the diagnosis inside the loop
+///                           ([diagnosis] after_round), the first iteration planned on the diagnosed
+///                           model and the round whose data were diagnosed (-1: none, or a model the
+///                           previous task adopted); attrs of diagnosed_from: diagnosis (S texts:
+///                           verdict, what was found, when, the values), model (S model files; "" if none)
 ///   /<task>/<algorithm>/gp/<state>/hyper (K+1 x S x D+2): [log l; log sf; log sn], zeros where
 ///                           gp/<state>/fitted (K+1 x S) is 0 (no GP yet); gp_ilqg algorithms only
 ///   /<task>/figure1/...     the 1-D model slice (the paper's Figure 1), model_slice_io.hpp
@@ -51,7 +56,7 @@ inline constexpr std::int64_t kRunResultsSchemaVersion = 2;
 ///   axis 1: the (K+1 x S) matrices (cost, normalised_cost, time_*, data_rows, repeated, diverged,
 ///           policy_change), evaluation_costs (K+1 x S x E), gp/<state>/hyper (K+1 x S x D+2) and
 ///           gp/<state>/fitted (K+1 x S);
-///   axis 0: converged_at (S) and every iter_<k>/ dataset (S x ...).
+///   axis 0: converged_at, diagnosed_from, diagnosis_round (S) and every iter_<k>/ dataset (S x ...).
 /// std::nullopt: not a dataset of this layout (a file of another gpilqg version).
 std::optional<std::size_t> seed_axis(std::string_view dataset);
 

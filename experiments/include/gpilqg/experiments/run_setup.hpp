@@ -38,6 +38,7 @@ enum class RandomStream : std::uint64_t {
   DataRollout = 2,  ///< index: algorithm, iteration, rollout
   GpFit = 3,        ///< index: algorithm, iteration
   RandomData = 4,   ///< index: algorithm, rollout (pddp_own's initial random episodes)
+  Diagnosis = 5,    ///< index: algorithm, round (the GP fits of the diagnosis inside the loop)
 };
 std::mt19937_64 make_rng(std::uint64_t seed, int task, RandomStream stream, std::initializer_list<std::uint64_t> index);
 /// A 64-bit seed drawn from the same streams (for APIs that take a seed, e.g. FitOptions::seed).

@@ -1,0 +1,223 @@
+/// The diagnosed model as GP-ILQG's simulator: a model file of `gpilqg diagnose` in a config's
+/// [system] and [world], and the diagnosis inside the loop ([diagnosis] after_round). Checked against
+/// the truth the world was built with: the rollouts of a world with a longer pole and Coulomb friction
+/// on the cart are diagnosed to those two effects at their values, and the plans after the diagnosis
+/// are made on the residual GP around that model; the checkpoint and the result file keep it.
+
+#include "gpilqg/experiments/loop_diagnosis.hpp"
+
+#include <random>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "gpilqg/core/hdf5_reader.hpp"
+#include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/algorithm_runs.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/run_checkpoint.hpp"
+#include "gpilqg/experiments/run_experiment.hpp"
+#include "gpilqg/experiments/run_results_io.hpp"
+#include "gpilqg/experiments/plan_config.hpp"
+#include "gpilqg/gp/residual_model.hpp"
+#include "same_run_results.hpp"
+#include "test_support.hpp"
+#include "tiny_run_config.hpp"
+
+namespace gpilqg {
+namespace {
+
+constexpr double kFriction = 3.0;  // [N], the world's Coulomb friction on the cart
+
+/// The world of these tests: the "real" preset (its pole is longer than the simulator's) with Coulomb
+/// friction on the cart, as a model file.
+std::filesystem::path write_world(const std::filesystem::path& folder) {
+  const auto file = folder / "world.toml";
+  test::write_text(file, fmt::format("[model]\nsystem = \"cartpole\"\npreset = \"real\"\n[effects]\n"
+                                     "cart_coulomb_friction = {{ mu = {}, v0 = 0.05 }}\n",
+                                     kFriction));
+  return file;
+}
+
+/// Expects `text` to hold every one of `parts`.
+void expect_holds(const std::string& text, std::initializer_list<std::string> parts) {
+  for (const auto& part : parts) EXPECT_NE(text.find(part), std::string::npos) << "'" << part << "' not in: " << text;
+}
+
+double parameter(const Dynamics& system, const std::string& name) {
+  for (const Parameter& p : system.parameters())
+    if (p.name == name) return p.value;
+  throw std::runtime_error("no parameter " + name);
+}
+
+double real_pole_length() { return parameter(*make_system("cartpole", Preset::RealWorld), "pole_length"); }
+
+TEST(EpisodesOf, SplitsTransitionsWhereARolloutStartsAgainOrTheRoundChanges) {
+  TransitionData data;
+  data.x.resize(5, 1);
+  data.u.resize(5, 1);
+  data.x_next.resize(5, 1);
+  data.x << 0, 1, 0, 1, 2;  // rollout 0: 0 -> 1 -> 2; rollout 1: 0 -> 1; rollout 2 (round 1): 2 -> 3
+  data.x_next << 1, 2, 1, 2, 3;
+  data.u << 10, 11, 12, 13, 14;
+  data.iteration = {0, 0, 0, 0, 1};
+  SystemSignature signature;
+  signature.states = {{"x", "m"}};
+  signature.controls = {{"u", "N"}};
+  const MeasurementSet set = episodes_of(data, signature, 0.1);
+  ASSERT_EQ(set.episodes.size(), 3u);
+  EXPECT_EQ(set.episodes[0].x.col(0).transpose(), (Vector(3) << 0, 1, 2).finished().transpose());
+  EXPECT_EQ(set.episodes[0].u(1, 0), 11.0);
+  EXPECT_EQ(set.episodes[1].x.col(0).transpose(), (Vector(3) << 0, 1, 2).finished().transpose());
+  EXPECT_EQ(set.episodes[2].x.col(0).transpose(), (Vector(2) << 2, 3).finished().transpose());
+  EXPECT_DOUBLE_EQ(set.episodes[0].dt(), 0.1);
+}
+
+TEST(LoopDiagnosis, FindsTheLongerPoleAndTheCartFrictionInRolloutsOfTheWorld) {
+  const auto folder = test::temporary_dir("loop_diagnosis_world");
+  const RunConfig config = parse_run_config(
+      "cartpole", fmt::format("[world]\nmodel = \"{}\"\n", write_world(folder).string()), (folder / "c.toml").string());
+  ASSERT_EQ(config.world.forces.size(), 1u);
+  // Rollouts of the world under a smooth random drive, measured with 1 mm / 1 mrad noise.
+  const auto world = make_step_model(config.world.build({}), config.integrator, config.dt, config.substeps);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> normal;
+  MeasurementSet set;
+  set.system = system_signature("cartpole");
+  constexpr int T = 60;
+  for (int episode = 0; episode < 8; ++episode) {
+    Episode e;
+    e.t = Vector::LinSpaced(T + 1, 0.0, T * config.dt);
+    e.x = Matrix::Zero(T + 1, 4);
+    e.u = Matrix::Zero(T + 1, 1);
+    Vector x = Vector::Zero(4), next(4);
+    const double amplitude = 6.0 + 2.0 * episode, phase = normal(rng);
+    for (int t = 0; t <= T; ++t) {
+      for (int i = 0; i < 4; ++i) e.x(t, i) = x(i) + 1e-3 * normal(rng);
+      e.u(t, 0) = amplitude * std::sin(0.35 * t + phase) + 2.0 * normal(rng);
+      world->step(x, e.u.row(t).transpose(), next);
+      x = next;
+    }
+    set.episodes.push_back(std::move(e));
+  }
+  TransitionData data;
+  data.append(set, 0);
+  const LoopDiagnosis d = diagnose_loop_data(config, data, 0, 11);
+  ASSERT_EQ(d.verdict, "explained") << d.reason;
+  EXPECT_TRUE(d.adopted);
+  ASSERT_TRUE(d.model.parameters.count("pole_length"));
+  EXPECT_NEAR(d.model.parameters.at("pole_length"), real_pole_length(), 0.05 * real_pole_length());
+  ASSERT_EQ(d.model.forces.size(), 1u);
+  EXPECT_EQ(d.model.forces.front().first, "cart_coulomb_friction");
+  EXPECT_NEAR(d.model.forces.front().second(0), kFriction, 0.1 * kFriction);
+  EXPECT_EQ(diagnosed_from(d), 1);
+  std::filesystem::remove_all(folder);
+}
+
+/// The tiny run of the experiment tests in the world above, diagnosing after round 0 of four rollouts.
+RunConfig diagnosing_config(const std::filesystem::path& folder) {
+  std::string text = test::kTinyRun;
+  const std::string loop = "[loop]\niterations = 2\nrollouts = 1\n";
+  text.replace(text.find(loop), loop.size(), "[loop]\niterations = 2\nrollouts = 4\nexploration = [8.0]\n");
+  text.replace(text.find("[pddp]\n"), 7, "[pddp]\nenabled = false\n");
+  text += fmt::format("[world]\nmodel = \"{}\"\n[diagnosis]\nafter_round = 0\n", write_world(folder).string());
+  return parse_run_config("cartpole", text, (folder / "run.toml").string());
+}
+
+TEST(LoopDiagnosis, PlansAfterTheDiagnosedRoundOnTheDiagnosedModelAndKeepsItInTheResult) {
+  const auto folder = test::temporary_dir("loop_diagnosis_run");
+  const RunConfig config = diagnosing_config(folder);
+  RunOptions options;
+  options.seeds = {5};
+  const RunResults results = run_experiment(config, options);
+  for (std::size_t t = 0; t < 2; ++t) {
+    const auto& runs = results.tasks[t].seeds.front();
+    const auto gp_ilqg = std::find_if(runs.begin(), runs.end(), [](const AlgorithmRun& r) { return r.name == "gp_ilqg"; });
+    ASSERT_NE(gp_ilqg, runs.end());
+    ASSERT_TRUE(gp_ilqg->diagnosis.has_value());
+    const LoopDiagnosis& d = *gp_ilqg->diagnosis;
+    SCOPED_TRACE(diagnosis_summary(d));
+    EXPECT_EQ(d.round, t == 0 ? 0 : -1);  // the transfer task starts from the first task's model
+    ASSERT_TRUE(d.adopted);
+    // Iteration 0 of the first task plans on the simulator; every plan on data after the diagnosis on
+    // a GP around the diagnosed model, which holds the world's friction.
+    const auto* first = dynamic_cast<const gp::ResidualModel*>(gp_ilqg->iterations[t == 0 ? 1 : 0].plan.model.get());
+    ASSERT_NE(first, nullptr);
+    EXPECT_NE(first->simulator_ptr(), results.tasks[t].seeds.front().front().final_model);
+    EXPECT_NE(first->simulator_ptr().get(), nullptr);
+    ASSERT_EQ(d.model.forces.size(), 1u);
+    EXPECT_EQ(d.model.forces.front().first, "cart_coulomb_friction");
+  }
+  const auto file = folder / "run.h5";
+  write_run_results(file, results);
+  const Hdf5Reader h5(file);
+  const std::string group = "/" + config.tasks[0].name + "/gp_ilqg";
+  EXPECT_EQ(h5.read_vector(group + "/diagnosed_from")(0), 1.0);
+  EXPECT_EQ(h5.read_vector(group + "/diagnosis_round")(0), 0.0);
+  EXPECT_NE(h5.string_list_attribute(group + "/diagnosed_from", "diagnosis").at(0).find("cart_coulomb_friction"),
+            std::string::npos);
+  EXPECT_NE(h5.string_list_attribute(group + "/diagnosed_from", "model").at(0).find("[effects]"), std::string::npos);
+  EXPECT_FALSE(h5.exists("/" + config.tasks[0].name + "/ilqg_real/diagnosed_from"));
+
+  // Stopped right after the diagnosis and resumed: the same results, the same diagnosed model.
+  const auto checkpoint = folder / "run.h5.checkpoint";
+  {
+    RunCheckpoint first = RunCheckpoint::create(checkpoint, config, options);
+    int saves = 0;
+    first.set_stop_requested([&saves] { return ++saves == 4; });  // ilqg_real, ilqg_sim, gp_ilqg 0, 1
+    RunOptions stopping = options;
+    stopping.journal = &first;
+    EXPECT_THROW(run_experiment(config, stopping), RunInterrupted);
+  }
+  RunCheckpoint second = RunCheckpoint::resume(checkpoint, config, options);
+  RunOptions resuming = options;
+  resuming.journal = &second;
+  const RunResults resumed = run_experiment(config, resuming);
+  EXPECT_GT(second.restored_count(), 0);
+  test::expect_same_results(resumed, results);
+  std::filesystem::remove_all(folder);
+}
+
+TEST(ConfigModel, AConfigNamesItsSimulatorAndWorldByModelFilesAndBadOnesAreRefused) {
+  const auto folder = test::temporary_dir("config_model");
+  write_world(folder);
+  test::write_text(folder / "quadrotor.toml", "[model]\nsystem = \"quadrotor\"\n");
+  test::write_text(folder / "delayed.toml", "[model]\nsystem = \"cartpole\"\n[effects]\ninput_delay = 1.0\n");
+  const std::string source = (folder / "c.toml").string();
+  // The simulator of `run`, by a path relative to the config; the stored text names it absolutely.
+  const RunConfig run = parse_run_config("cartpole", "[system]\nmodel = \"world.toml\"\n", source);
+  EXPECT_EQ(run.simulator.preset, Preset::RealWorld);
+  EXPECT_EQ(run.simulator.forces.size(), 1u);
+  EXPECT_NE(run.text.find((folder / "world.toml").string()), std::string::npos);
+  const auto error_of = [&](const std::string& text) {
+    try {
+      (void)parse_run_config("cartpole", text, source);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  expect_holds(error_of("[system]\nmodel = \"quadrotor.toml\"\n"),
+                   {"c.toml:line 2: field 'system.model'", "field 'model.system': is 'quadrotor'", "'cartpole'"});
+  expect_holds(error_of("[system]\nmodel = \"delayed.toml\"\n"), {"field 'system.model'", "input delay of 1"});
+  expect_holds(error_of("[system]\nmodel = \"none.toml\"\n"), {"field 'system.model'", "none.toml"});
+  expect_holds(error_of("[diagnosis]\nafter_round = 4\n"), {"field 'diagnosis.after_round'", "from 0 to 3"});
+  expect_holds(error_of("[diagnosis]\nafter_round = 0\nevery = 1\n"), {"diagnosis.every"});
+
+  // `solve` and `plan`: [system] model is the simulator, instead of a preset.
+  const auto solve = folder / "solve.toml";
+  std::string plan = test::kTinyPlan;
+  const std::string preset = "preset = \"sim\"";
+  test::write_text(solve, plan.replace(plan.find(preset), preset.size(), "model = \"world.toml\""));
+  const SolveConfig config = read_plan_config(solve).problem;
+  EXPECT_EQ(config.simulator.forces.size(), 1u);
+  const Vector x = Vector::Zero(4), u = Vector::Zero(1);
+  Vector with_friction(4), world_step(4);
+  make_solve_model(config)->step(x, u, with_friction);
+  make_step_model(run.simulator.build(config.noise), config.integrator, config.dt, config.substeps)->step(x, u, world_step);
+  EXPECT_EQ(with_friction, world_step);
+  std::filesystem::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace gpilqg
