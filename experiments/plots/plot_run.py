@@ -84,6 +84,22 @@ def plain_log_labels(ax):
         ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
+def draw_diagnosis(ax, alg, color):
+    """The diagnosis inside the loop: a dashed line before the first iteration planned on the diagnosed
+    model, labelled with what the diagnosis found (the first seed that adopted it at that iteration)."""
+    if "diagnosed_from" not in alg:
+        return
+    starts = alg["diagnosed_from"][()]
+    texts = [t.decode() if isinstance(t, bytes) else str(t) for t in alg["diagnosed_from"].attrs["diagnosis"]]
+    for start in sorted(set(int(v) for v in starts if v >= 0)):
+        seeds = [s for s, v in enumerate(starts) if int(v) == start]
+        found = texts[seeds[0]].split(": ", 1)[-1]
+        ax.axvline(start - 0.5, color=color, linestyle="--", linewidth=0.8)
+        label = f"diagnosed ({len(seeds)}/{len(starts)} seeds): " + "\n".join(found.split("; "))
+        ax.annotate(label, xy=(start - 0.45, 0.97), xycoords=("data", "axes fraction"), fontsize=5.5, va="top",
+                    color=color)
+
+
 def plot_cost(task, group, out):
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
     seeds = 1
@@ -106,6 +122,7 @@ def plot_cost(task, group, out):
         if seeds > 1:
             ax.fill_between(it, np.minimum(lo, COST_CEILING), np.minimum(hi, COST_CEILING), color=line.get_color(),
                             alpha=0.15, linewidth=0)
+        draw_diagnosis(ax, group[name], line.get_color())
     ax.set_xlabel("iteration")
     ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
     ax.set_ylabel("cost / cost of iLQG on the true model")

@@ -140,7 +140,7 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
   std::shared_ptr<const StepModel> diagnosed;  // built once, when the run adopts a diagnosed model
   const auto simulator_of = [&](const AlgorithmRun& run) {
     if (!run.diagnosis || !run.diagnosis->adopted) return c.models.simulator;
-    if (!diagnosed) diagnosed = planning_simulator(c.config, c.models.simulator, run.diagnosis);
+    if (!diagnosed) diagnosed = planning_simulator(loop_model(c.config), c.config.noise, c.models.simulator, run.diagnosis);
     return diagnosed;
   };
   const DataPlanner planner = [&](const TransitionData& data, const Plan* previous, IterationRecord& record,
@@ -171,7 +171,7 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     const std::string prefix = fmt::format("{} {} round {}: diagnosis", c.task.name, name, k);
     if (c.progress) c.progress(fmt::format("{} of {} transitions", prefix, run.data.size()));
     const auto stream = derive_seed(seed, c.task_index, RandomStream::Diagnosis, {stream_id(name), static_cast<std::uint64_t>(k)});
-    run.diagnosis = diagnose_loop_data(c.config, run.data, k, stream);
+    run.diagnosis = diagnose_loop_data(loop_model(c.config), run.data, k, stream);
     const LoopDiagnosis& d = *run.diagnosis;
     if (c.progress)
       c.progress(fmt::format("{}: {} in {:.1f} s; {}", prefix, d.verdict, d.seconds,

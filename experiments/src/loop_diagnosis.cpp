@@ -37,29 +37,35 @@ MeasurementSet episodes_of(const TransitionData& data, const SystemSignature& si
   return set;
 }
 
-LoopDiagnosis diagnose_loop_data(const RunConfig& config, const TransitionData& data, int round, std::uint64_t seed,
+LoopModel loop_model(const RunConfig& config) { return {config.simulator, config.integrator, config.substeps, config.dt}; }
+
+LoopDiagnosis diagnose_loop_data(const LoopModel& model, const TransitionData& data, int round, std::uint64_t seed,
                                  const std::function<void(const std::string&)>& progress) {
   const auto start = std::chrono::steady_clock::now();
   LoopDiagnosis out;
   out.round = round;
   out.transitions = data.size();
-  out.model = config.simulator;
+  out.model = model.simulator;
   diagnosis::DiagnoseRequest request;  // the command's defaults, with --auto
-  request.system = config.system;
+  request.system = model.simulator.system;
   request.auto_select = true;
-  request.integrator = std::string(to_string(config.integrator));
+  request.integrator = std::string(to_string(model.integrator));
   request.seed = seed;
   diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(request);
-  options.model = config.simulator;
-  options.substeps = config.substeps;
+  options.model = model.simulator;
+  options.substeps = model.substeps;
   options.progress = progress;
   try {
     const diagnosis::DiagnosisReport report =
-        diagnosis::diagnose(episodes_of(data, system_signature(config.system), config.dt), options);
+        diagnosis::diagnose(episodes_of(data, system_signature(model.simulator.system), model.dt), options);
     out.verdict = report.verdict.status;
     out.reason = report.verdict.reason;
-    out.adopted = out.verdict == "explained";
+    out.adopted = out.verdict == "explained" && report.model_next.input_delay == 0.0;
     if (out.adopted) out.model = report.model_next;
+    else if (out.verdict == "explained")  // the solvers and rollouts apply each control at once
+      out.reason = fmt::format("the diagnosed model has an input delay of {} control periods, which the planners do not "
+                               "apply; {}",
+                               report.model_next.input_delay, out.reason);
   } catch (const std::invalid_argument& e) {  // data the diagnosis cannot use: the loop goes on without it
     out.verdict = "failed";
     out.reason = e.what();
@@ -69,10 +75,11 @@ LoopDiagnosis diagnose_loop_data(const RunConfig& config, const TransitionData& 
   return out;
 }
 
-std::shared_ptr<const StepModel> planning_simulator(const RunConfig& config, const std::shared_ptr<const StepModel>& simulator,
+std::shared_ptr<const StepModel> planning_simulator(const LoopModel& model, const ActuatorNoise& noise,
+                                                    const std::shared_ptr<const StepModel>& simulator,
                                                     const std::optional<LoopDiagnosis>& diagnosis) {
   if (!diagnosis || !diagnosis->adopted) return simulator;
-  return make_step_model(diagnosis->model.build(config.noise), config.integrator, config.dt, config.substeps);
+  return make_step_model(diagnosis->model.build(noise), model.integrator, model.dt, model.substeps);
 }
 
 std::string diagnosis_summary(const LoopDiagnosis& d) {

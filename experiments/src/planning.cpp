@@ -11,6 +11,7 @@
 #include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/core/version.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/run_setup.hpp"
 
 namespace gpilqg {
@@ -57,7 +58,7 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   const SolveConfig& c = request.config.problem;
   const GpSettings& gp_settings = request.config.gp;
   const SystemSignature signature = system_signature(c.system);
-  const std::shared_ptr<const StepModel> simulator = make_solve_model(c);
+  std::shared_ptr<const StepModel> simulator = make_solve_model(c);
   const int m = simulator->control_dim();
   const QuadraticCost cost = make_solve_cost(c);
 
@@ -71,6 +72,16 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   task.solver = c.solver;
 
   const TransitionData data = read_data(request.data_files, signature, c.dt);
+  PlannedPolicy out;
+  ModelSpec planned_on = c.simulator;
+  if (request.diagnose && data.size() > 0) {
+    const LoopModel model{c.simulator, c.integrator, c.substeps, c.dt};
+    out.diagnosis = diagnose_loop_data(model, data, static_cast<int>(request.data_files.size()) - 1,
+                                       derive_seed(request.seed, 0, RandomStream::Diagnosis, {stream_id(kAlgorithm), 0}));
+    simulator = planning_simulator(model, c.noise, simulator, out.diagnosis);
+    if (out.diagnosis->adopted) planned_on = out.diagnosis->model;
+  }
+  const std::string simulator_text = diagnosis::model_file_text(planned_on);
   const auto backend = gp::make_backend(gp_settings.backend, gp_settings.backend_settings);
 
   GpRoundInputs inputs;
@@ -92,12 +103,13 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
         throw InputError(fmt::format("{}: group '/model' was fitted with backend '{}'; expected the config's [gp] "
                                      "backend '{}' (a warm start needs the same backend)",
                                      request.previous->string(), previous.model_backend, gp_settings.backend));
-      inputs.previous_model = read_policy_model(*request.previous, simulator, gp_settings.backend_settings);
+      // The previous GP learned the error of the simulator it was planned on: a warm start needs the same.
+      if (previous.simulator_model.empty() || previous.simulator_model == simulator_text)
+        inputs.previous_model = read_policy_model(*request.previous, simulator, gp_settings.backend_settings);
     }
   }
 
   GpRound result = plan_gp_ilqg_round(task, simulator, inputs);
-  PlannedPolicy out;
   out.model = std::dynamic_pointer_cast<const gp::ResidualModel>(result.plan.model);
   out.summary = result.plan.summary;
   out.data_rows = data.size();
@@ -117,6 +129,7 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   for (const auto& file : request.data_files) f.data_files.push_back(file.string());
   f.created = utc_timestamp();
   f.gpilqg_version = kVersionString;
+  f.simulator_model = simulator_text;
   return out;
 }
 

@@ -144,6 +144,7 @@ void write_policy_file(const std::filesystem::path& file, const PolicyFile& p, c
       h5.attribute(kPolicy, "data_files", p.data_files);
       h5.attribute(kPolicy, "created", p.created.empty() ? utc_timestamp() : p.created);
       h5.attribute(kPolicy, "gpilqg_version", p.gpilqg_version);
+      if (!p.simulator_model.empty()) h5.attribute(kPolicy, "simulator_model", p.simulator_model);
       h5.close();
     }
     if (model != nullptr) gp::save_residual_model(temporary, kModel, *model);
@@ -174,6 +175,7 @@ PolicyFile read_policy_file(const std::filesystem::path& file) {
     p.data_files = h5.has_attribute(g, "data_files") ? h5.string_list_attribute(g, "data_files") : std::vector<std::string>{};
     p.created = h5.string_attribute(g, "created");
     p.gpilqg_version = h5.string_attribute(g, "gpilqg_version");
+    if (h5.has_attribute(g, "simulator_model")) p.simulator_model = h5.string_attribute(g, "simulator_model");
     const auto n = static_cast<std::uint64_t>(p.state_names.size()), m = static_cast<std::uint64_t>(p.control_names.size());
     const auto T = static_cast<std::uint64_t>(horizon);
     const auto expect = [&](const std::string& name, std::vector<std::uint64_t> dims, const char* shape) {

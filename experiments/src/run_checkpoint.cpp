@@ -142,7 +142,7 @@ std::optional<AlgorithmRun> RunCheckpoint::restore(const TaskContext& context, s
   const std::filesystem::path file = unit_file(context, seed, name);
   if (!std::filesystem::exists(file)) return std::nullopt;
   const SimulatorOf simulator_of = [&](const std::optional<LoopDiagnosis>& diagnosis) {
-    return planning_simulator(context.config, context.models.simulator, diagnosis);
+    return planning_simulator(loop_model(context.config), context.config.noise, context.models.simulator, diagnosis);
   };
   AlgorithmRun run = read_algorithm_run(file, context.config.system, simulator_of, context.config.gp.backend_settings);
   if (run.name != name)

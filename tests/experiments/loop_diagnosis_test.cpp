@@ -18,7 +18,9 @@
 #include "gpilqg/experiments/run_checkpoint.hpp"
 #include "gpilqg/experiments/run_experiment.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/plan_config.hpp"
+#include "gpilqg/experiments/policy_file.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 #include "same_run_results.hpp"
 #include "test_support.hpp"
@@ -84,8 +86,8 @@ TEST(LoopDiagnosis, FindsTheLongerPoleAndTheCartFrictionInRolloutsOfTheWorld) {
   std::normal_distribution<double> normal;
   MeasurementSet set;
   set.system = system_signature("cartpole");
-  constexpr int T = 60;
-  for (int episode = 0; episode < 8; ++episode) {
+  constexpr int T = 40;
+  for (int episode = 0; episode < 6; ++episode) {
     Episode e;
     e.t = Vector::LinSpaced(T + 1, 0.0, T * config.dt);
     e.x = Matrix::Zero(T + 1, 4);
@@ -102,7 +104,7 @@ TEST(LoopDiagnosis, FindsTheLongerPoleAndTheCartFrictionInRolloutsOfTheWorld) {
   }
   TransitionData data;
   data.append(set, 0);
-  const LoopDiagnosis d = diagnose_loop_data(config, data, 0, 11);
+  const LoopDiagnosis d = diagnose_loop_data(loop_model(config), data, 0, 11);
   ASSERT_EQ(d.verdict, "explained") << d.reason;
   EXPECT_TRUE(d.adopted);
   ASSERT_TRUE(d.model.parameters.count("pole_length"));
@@ -176,6 +178,51 @@ TEST(LoopDiagnosis, PlansAfterTheDiagnosedRoundOnTheDiagnosedModelAndKeepsItInTh
   EXPECT_GT(second.restored_count(), 0);
   test::expect_same_results(resumed, results);
   std::filesystem::remove_all(folder);
+}
+
+TEST(LoopDiagnosis, PlanDiagnosesTheLogsWritesTheModelAndTheNextRoundPlansOnIt) {
+  // The loop on a robot: plan, roll out on the world, plan --diagnose (the model file for the next
+  // config), roll out, plan with [system] model = the diagnosed model.
+  const auto dir = test::temporary_dir("plan_diagnose");
+  write_world(dir);
+  const std::string plan_text = test::kTinyPlan;
+  const auto bare = test::write_text(dir / "plan.toml", plan_text);
+  const auto cli = [&](const std::string& arguments) {
+    const auto r = test::run_cli(arguments);
+    EXPECT_EQ(r.status, 0) << arguments << "\n" << r.err;
+    return r;
+  };
+  const auto rollout = [&](const std::string& policy, const std::string& log) {
+    cli(fmt::format("rollout --system cartpole --world-model {} --policy {} --out {} --seed 3 --episodes 4 "
+                    "--exploration 8 --observation-noise 0.001",
+                    test::quote(dir / "world.toml"), test::quote(dir / policy), test::quote(dir / log)));
+  };
+  cli(fmt::format("plan {} --out {}", test::quote(bare), test::quote(dir / "p0.h5")));
+  rollout("p0.h5", "d0.h5");
+  const auto diagnosed = cli(fmt::format("plan {} --data {} --previous {} --diagnose --write-model {} --out {}",
+                                         test::quote(bare), test::quote(dir / "d0.h5"), test::quote(dir / "p0.h5"),
+                                         test::quote(dir / "F.toml"), test::quote(dir / "p1.h5")));
+  expect_holds(diagnosed.out, {"diagnosis: explained after round 0", "cart_coulomb_friction", "wrote it to"});
+  const ModelSpec model = diagnosis::read_model_file(dir / "F.toml", "cartpole");
+  ASSERT_EQ(model.forces.size(), 1u);
+  EXPECT_EQ(model.forces.front().first, "cart_coulomb_friction");
+  const PolicyFile p1 = read_policy_file(dir / "p1.h5");
+  EXPECT_EQ(p1.simulator_model, diagnosis::model_file_text(model));
+  rollout("p1.h5", "d1.h5");
+
+  // The next round on [system] model = F.toml: its GP warm-starts from p1's, fitted around the same
+  // simulator; the bare config's cannot.
+  std::string with_model = plan_text;
+  const std::string preset = "preset = \"sim\"";
+  const auto modelled = test::write_text(dir / "modelled.toml", with_model.replace(with_model.find(preset), preset.size(),
+                                                                                   "model = \"F.toml\""));
+  const std::string data = fmt::format("--data {} --data {} --previous {} --json", test::quote(dir / "d0.h5"),
+                                       test::quote(dir / "d1.h5"), test::quote(dir / "p1.h5"));
+  const auto next = cli(fmt::format("plan {} {} --out {}", test::quote(modelled), data, test::quote(dir / "p2.h5")));
+  EXPECT_NE(next.out.find("\"gp_warm_start\":true"), std::string::npos) << next.out;
+  const auto other = cli(fmt::format("plan {} {} --out {}", test::quote(bare), data, test::quote(dir / "p2_bare.h5")));
+  EXPECT_NE(other.out.find("\"gp_warm_start\":false"), std::string::npos) << other.out;
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ConfigModel, AConfigNamesItsSimulatorAndWorldByModelFilesAndBadOnesAreRefused) {

@@ -1,5 +1,5 @@
 /// `gpilqg plan CONFIG.toml [--data FILE]... [--previous POLICY.h5] --out POLICY.h5 [--seed S] [--json]`:
-/// one round of Algorithm 1 on measurements from the real system (DESIGN.md section 11).
+/// one round of Algorithm 1 on measurements from the real system (docs/real-robot.md).
 
 #include <iostream>
 #include <memory>
@@ -7,12 +7,14 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "commands.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "option_checks.hpp"
 #include "output_options.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/planning.hpp"
 #include "gpilqg/experiments/solve_config.hpp"
 
@@ -27,17 +29,24 @@ struct PlanOptions {
   std::string out;
   std::uint64_t seed = 1;
   bool json = false;
+  bool diagnose = false;
+  std::string write_model;
 };
 
 int run_plan(const PlanOptions& o) {
   std::vector<CommandInput> inputs = {{"CONFIG", o.config}, {"--previous", o.previous}};
   for (const auto& file : o.data) inputs.push_back({"--data", file});
   check_output_file_option("--out", o.out, {"plan writes an HDF5 policy file", kHdf5Extensions}, inputs);
+  if (!o.write_model.empty()) {
+    check_output_file_option("--write-model", o.write_model, {"plan writes a TOML model file", kTomlExtensions}, inputs);
+    if (same_file(o.write_model, o.out)) throw InputError("--write-model and --out name the same file; expected two files");
+  }
   PlanRequest request;
   request.config = read_plan_config(o.config);
   for (const auto& file : o.data) request.data_files.emplace_back(file);
   if (!o.previous.empty()) request.previous = o.previous;
   request.seed = o.seed;
+  request.diagnose = o.diagnose;
   const PlannedPolicy planned = plan_policy(request);
   const DdpSummary& s = planned.summary;
   if (s.termination == DdpTermination::InitialRolloutDiverged) {
@@ -50,6 +59,9 @@ int run_plan(const PlanOptions& o) {
     return kExitInternalFailure;
   }
   write_policy_file(o.out, planned.file, planned.model.get());
+  const auto& d = planned.diagnosis;
+  if (!o.write_model.empty() && d && d->adopted)
+    diagnosis::write_model_file(o.write_model, d->model, {"diagnosed by `gpilqg plan --diagnose` on " + fmt::format("{}", fmt::join(o.data, ", "))});
   if (o.json) {
     nlohmann::json out = policy_json(planned.file, planned.model.get());
     out["out"] = o.out;
@@ -61,9 +73,20 @@ int run_plan(const PlanOptions& o) {
     out["data_rows"] = planned.data_rows;
     out["fit_time_s"] = planned.fit_seconds;
     out["gp_warm_start"] = planned.warm_started_gp;
+    if (d)
+      out["diagnosis"] = {{"verdict", d->verdict}, {"reason", d->reason}, {"adopted", d->adopted},
+                          {"changes", d->changes}, {"transitions", d->transitions}, {"seconds", d->seconds},
+                          {"model", d->adopted ? diagnosis::model_file_text(d->model) : std::string()},
+                          {"model_file", d->adopted ? o.write_model : std::string()}};
     std::cout << out.dump() << '\n';
   } else {
     const PolicyFile& f = planned.file;
+    if (d) {
+      std::cout << "diagnosis: " << diagnosis_summary(*d) << '\n';
+      if (d->adopted)
+        std::cout << (o.write_model.empty() ? std::string("  planned on the diagnosed model (--write-model F.toml keeps it)\n")
+                                            : fmt::format("  planned on the diagnosed model; wrote it to {}\n", o.write_model));
+    }
     if (planned.model)
       std::cout << fmt::format("round {}: residual GP ({}) fitted on {} transitions from {} file(s) in {:.1f} s{}\n",
                                f.round, planned.model->output(0).backend_name(), planned.data_rows,
@@ -92,10 +115,16 @@ void add_plan_command(CLI::App& app, CommandAction& action) {
                                      "the newest rollouts. None: plan on the simulator alone (round 0)");
   cmd->add_option("--previous", o->previous, "The previous round's policy file: warm start of the controls and "
                                              "of the GP, and the re-sample rule");
-  cmd->add_option("--out", o->out, "The policy file to write (HDF5, DESIGN.md section 11)")->required();
+  cmd->add_option("--out", o->out, "The policy file to write (HDF5, docs/formats.md)")->required();
   cmd->add_option("--seed", o->seed, "Seed of the GP fit; equal seeds give the policies of `gpilqg run` with that seed")
       ->capture_default_str()
       ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
+  cmd->add_flag("--diagnose", o->diagnose,
+                "Diagnose the data first (`diagnose --auto` against the config's simulator); if the verdict is "
+                "\"explained\", plan on the diagnosed model as the GP's mean");
+  cmd->add_option("--write-model", o->write_model, "With --diagnose: write the diagnosed model file (TOML) for the "
+                                                   "next round's [system] model")
+      ->needs("--diagnose");
   cmd->add_flag("--json", o->json, "Print the policy file's content and the solver's summary as one JSON document");
   cmd->callback([&action, o] { action = [o] { return run_plan(*o); }; });
 }

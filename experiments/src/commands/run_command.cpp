@@ -65,6 +65,11 @@ void print_summary(const RunResults& results) {
       }
       std::cout << line << '\n';
     }
+    for (std::size_t a = 0; a < task.algorithms.size(); ++a)
+      for (std::size_t s = 0; s < task.seeds.size(); ++s)
+        if (const auto& d = task.seeds[s][a].diagnosis)
+          std::cout << fmt::format("  {} diagnosis, seed {}: {}\n", task.algorithms[a], results.options.seeds[s],
+                                   diagnosis_summary(*d));
   }
 }
 

@@ -13,10 +13,13 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/integrator.hpp"
+#include "gpilqg/core/noise.hpp"
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/core/step_model.hpp"
 #include "gpilqg/experiments/run_config.hpp"
@@ -44,15 +47,27 @@ struct LoopDiagnosis {
 /// Times are k dt.
 MeasurementSet episodes_of(const TransitionData& data, const SystemSignature& signature, double dt);
 
-/// Diagnoses `data` (episodes_of) against config.simulator with `--auto` and the command's defaults,
+/// The model a loop diagnoses against and how it steps: its simulator, integrator, sub-steps and dt.
+struct LoopModel {
+  ModelSpec simulator;
+  Integrator integrator = Integrator::RK4;
+  int substeps = 1;
+  double dt = 0.0;
+};
+
+/// Diagnoses `data` (episodes_of) against model.simulator with `--auto` and the command's defaults,
 /// the GP's random stream seeded by `seed`. Data the diagnosis cannot use (too few rollouts to hold
 /// some out, for example) give verdict "failed" with the reason; nothing is thrown for them.
-LoopDiagnosis diagnose_loop_data(const RunConfig& config, const TransitionData& data, int round, std::uint64_t seed,
+LoopDiagnosis diagnose_loop_data(const LoopModel& model, const TransitionData& data, int round, std::uint64_t seed,
                                  const std::function<void(const std::string&)>& progress = {});
 
-/// The step model of the simulator a run's plans use: the diagnosed model when `diagnosis` adopted one,
-/// else `simulator`.
-std::shared_ptr<const StepModel> planning_simulator(const RunConfig& config, const std::shared_ptr<const StepModel>& simulator,
+/// A run's LoopModel: its simulator, integrator, sub-steps and control period.
+LoopModel loop_model(const RunConfig& config);
+
+/// The step model of the simulator the plans use: the diagnosed model (with `noise`, stepped as
+/// `model` says) when `diagnosis` adopted one, else `simulator`.
+std::shared_ptr<const StepModel> planning_simulator(const LoopModel& model, const ActuatorNoise& noise,
+                                                    const std::shared_ptr<const StepModel>& simulator,
                                                     const std::optional<LoopDiagnosis>& diagnosis);
 
 /// One line for messages and the result file: the verdict, when and on what, and the model's changes

@@ -1,7 +1,6 @@
 #pragma once
 /// @file planning.hpp
-/// `gpilqg plan` as a library call: one round of Algorithm 1 on measurement files (DESIGN.md section
-/// 11). It builds the simulator and the task of a PlanConfig, reads the data files into labelled
+/// `gpilqg plan` as a library call: one round of Algorithm 1 on measurement files (docs/real-robot.md). It builds the simulator and the task of a PlanConfig, reads the data files into labelled
 /// transitions (file i is round label i, so the last file holds the newest rollouts, on which the
 /// re-sample rule is judged), takes the previous policy file's controls and GP as the warm start, and
 /// calls plan_gp_ilqg_round, the step `gpilqg run` takes for gp_ilqg.
@@ -17,6 +16,7 @@
 #include <vector>
 
 #include "gpilqg/experiments/gp_ilqg_round.hpp"
+#include "gpilqg/experiments/loop_diagnosis.hpp"
 #include "gpilqg/experiments/plan_config.hpp"
 #include "gpilqg/experiments/policy_file.hpp"
 
@@ -27,6 +27,9 @@ struct PlanRequest {
   std::vector<std::filesystem::path> data_files;      ///< measurement files (CSV or HDF5), oldest first
   std::optional<std::filesystem::path> previous;      ///< the previous round's policy file
   std::uint64_t seed = 1;
+  /// Diagnose the data first (`gpilqg plan --diagnose`, loop_diagnosis.hpp) and, when the verdict is
+  /// "explained", plan on the diagnosed model as the simulator.
+  bool diagnose = false;
 };
 
 struct PlannedPolicy {
@@ -36,6 +39,7 @@ struct PlannedPolicy {
   int data_rows = 0;                                 ///< transitions the GP was fitted on
   double fit_seconds = 0.0;
   bool warm_started_gp = false;                      ///< the previous file's GP was the fit's start
+  std::optional<LoopDiagnosis> diagnosis;            ///< with request.diagnose and data
 };
 
 /// The round. Throws DataError or InputError naming the file and the line, dataset or attribute for

@@ -1,13 +1,14 @@
 #pragma once
 /// @file policy_file.hpp
-/// The policy file of `gpilqg plan` (DESIGN.md section 11, a fixed contract): what a robot's
+/// The policy file of `gpilqg plan` (docs/formats.md, "Policy file", a fixed contract): what a robot's
 /// controller runs, and what the next round warm-starts from.
 ///
 ///   /policy/x_bar   (T+1) x n   the planned nominal states
 ///   /policy/u_bar   T x m       the nominal controls
 ///   /policy/K       T x m x n   the feedback gains
 ///   /policy attributes: dt, horizon, system, state_names, control_names, u_min and u_max (when
-///     limited), predicted_cost, expected_cost, round, data_files, created, gpilqg_version
+///     limited), predicted_cost, expected_cost, round, data_files, created, gpilqg_version,
+///     simulator_model (the simulator planned on, as the text of a model file of `gpilqg diagnose`)
 ///   /model          the fitted residual GP in gp_io's layout (absent for a plan on the simulator alone)
 ///
 /// The control law at step t with the measured state x_t:
@@ -38,6 +39,9 @@ struct PolicyFile {
   std::vector<std::string> data_files;  ///< the measurement files the GP was fitted on, in order
   std::string created;          ///< UTC, ISO 8601
   std::string gpilqg_version;
+  /// The simulator the plan used (the GP's mean) as model file text (diagnosis/model_file.hpp); empty
+  /// in files of older versions. A warm start of the GP needs the same simulator.
+  std::string simulator_model;
   std::string model_backend;    ///< on reading: the backend of /model ("" when there is none)
 };
 
