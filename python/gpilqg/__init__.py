@@ -62,18 +62,22 @@ def solve(config, progress=None):
     return _gpilqg._solve(_config_source("solve", config), progress)
 
 
-def plan(config, data=(), previous=None, out=None, seed=1, progress=None):
+def plan(config, data=(), previous=None, out=None, seed=1, diagnose=False, write_model=None, progress=None):
     """One round of Algorithm 1 on measurement files, as ``gpilqg plan`` (docs/real-robot.md).
 
-    config: the plan config (file or dict); data: measurement files, oldest first; previous: the
-    previous round's policy file; out: where to write the policy file (optional); seed: the GP fit's.
-    Returns a Policy that can act: ``policy(t, x)``.
+    config: the plan config (file or dict; ``[system] model`` names a model file of ``diagnose`` as the
+    simulator); data: measurement files, oldest first; previous: the previous round's policy file;
+    out: where to write the policy file (optional); seed: the GP fit's; diagnose: diagnose the data
+    first and, when the verdict is "explained", plan on the diagnosed model (``plan --diagnose``);
+    write_model: with diagnose, where to write the diagnosed model file.
+    Returns a Policy that can act: ``policy(t, x)``; ``policy.diagnosis`` is the diagnosis's verdict,
+    reason and model (None without diagnose).
     """
     if config is None:
         raise InputError("plan: config is None; expected a file path or a dict of TOML tables")
     return _gpilqg._plan(_config_source("plan", config), _paths("plan", "data", data),
                          _path("plan", "previous", previous, optional=True), _path("plan", "out", out, optional=True),
-                         seed, progress)
+                         seed, bool(diagnose), _path("plan", "write_model", write_model, optional=True), progress)
 
 
 def run(system, config=None, seeds=1, first_seed=1, iterations=None, backends=(), out=None, progress=None):

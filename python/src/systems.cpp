@@ -5,6 +5,7 @@
 #include <pybind11/eigen.h>
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <cmath>
 
@@ -19,6 +20,7 @@
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
 
 namespace gpilqg::python {
 namespace {
@@ -247,22 +249,33 @@ and gpilqg.register_system(...) to use it by name in configs, solve, diagnose an
            }, py::arg("x"), py::arg("u"), "(xdot (n,), fx = df/dx (n, n), fu = df/du (n, m))");
 
   m.def("system", [](const std::string& name, const std::string& preset, const std::map<std::string, double>& parameters,
-                     const py::object& noise) {
+                     const py::object& noise, const std::optional<std::filesystem::path>& model) {
           for (const auto& [parameter, value] : parameters)
             if (!std::isfinite(value))
               raise_input_error(fmt::format("system: parameters['{}'] = {} is not finite", parameter, value));
+          if (model && preset != "sim")
+            raise_input_error("system: preset and model are both given; the model file names its own preset");
           try {
             const ActuatorNoise noise_model = noise_of(name, noise);
-            return std::const_pointer_cast<Dynamics>(make_system(name, preset_of(preset), parameters, noise_model));
+            if (!model) return std::const_pointer_cast<Dynamics>(make_system(name, preset_of(preset), parameters, noise_model));
+            ModelSpec spec = diagnosis::read_model_file(*model, name, "system's name");
+            for (const auto& [parameter, value] : parameters) spec.parameters[parameter] = value;
+            if (spec.input_delay != 0.0)
+              throw InputError(fmt::format("system: {} has an input delay of {} control periods; a Dynamics maps the "
+                                           "applied input to xdot and cannot hold it (gpilqg.simulate applies delays)",
+                                           model->string(), spec.input_delay));
+            return std::const_pointer_cast<Dynamics>(spec.build(noise_model));
           } catch (const std::invalid_argument& e) {  // an unknown name or parameter, a value out of range
             throw InputError(e.what());
           }
         },
         py::arg("name"), py::arg("preset") = "sim", py::arg("parameters") = std::map<std::string, double>{},
-        py::arg("noise") = py::none(), R"(
+        py::arg("noise") = py::none(), py::arg("model") = py::none(), R"(
 A system of the registry: "cartpole", "quadrotor", a MuJoCo model file (.xml, .urdf), a plugin's
 system or one registered from Python. preset: "sim" or "real"; parameters: overrides by name;
-noise: dict with actuator_additive (m,), actuator_multiplicative (m,), state (n,) standard deviations.)");
+noise: dict with actuator_additive (m,), actuator_multiplicative (m,), state (n,) standard deviations;
+model: a model file of `gpilqg diagnose` (--write-model) for this system, with its preset, parameters
+and effects (parameters then override its parameters): e.g. the simulator of a StepModel.)");
 
   m.def("systems", [] { return SystemRegistry::instance().names(); }, "The registered system names.");
 

@@ -18,6 +18,7 @@
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 #include "gpilqg/experiments/planning.hpp"
 #include "gpilqg/experiments/run_config.hpp"
@@ -29,10 +30,12 @@
 namespace gpilqg::python {
 namespace {
 
-/// A policy of `gpilqg plan` (DESIGN.md section 11) with the GP it was planned on.
+/// A policy of `gpilqg plan` (docs/formats.md, "Policy file") with the GP it was planned on and, with
+/// `diagnose`, the diagnosis of its data.
 struct Policy {
   PolicyFile file;
   std::shared_ptr<const gp::ResidualModel> model;
+  std::optional<LoopDiagnosis> diagnosis;
 };
 
 /// Progress lines of a DDP solve, and Ctrl-C between its iterations.
@@ -111,8 +114,11 @@ py::dict solve(const ConfigSource& source, const py::object& progress) {
 
 Policy plan(const ConfigSource& source, const std::vector<std::filesystem::path>& data,
             const std::optional<std::filesystem::path>& previous, const std::optional<std::filesystem::path>& out,
-            std::uint64_t seed, const py::object& progress) {
+            std::uint64_t seed, bool diagnose, const std::optional<std::filesystem::path>& write_model,
+            const py::object& progress) {
+  if (write_model && !diagnose) throw InputError("plan: write_model needs diagnose=True");
   PlanRequest request;
+  request.diagnose = diagnose;
   request.config = plan_config_of(source);
   request.data_files = data;
   request.previous = previous;
@@ -123,7 +129,9 @@ Policy plan(const ConfigSource& source, const std::vector<std::filesystem::path>
   if (planned.summary.termination == DdpTermination::InitialRolloutDiverged)
     throw std::runtime_error("the initial controls drive the model to non-finite states; no policy");
   if (out) write_policy_file(*out, planned.file, planned.model.get());
-  return {std::move(planned.file), std::move(planned.model)};
+  if (write_model && planned.diagnosis && planned.diagnosis->adopted)
+    diagnosis::write_model_file(*write_model, planned.diagnosis->model, {"diagnosed by gpilqg.plan(diagnose=True)"});
+  return {std::move(planned.file), std::move(planned.model), std::move(planned.diagnosis)};
 }
 
 std::string run(const std::string& system, const ConfigSource& source, int seeds, std::uint64_t first_seed,
@@ -235,6 +243,20 @@ Call it as policy(t, x). Arrays have one row per time step: x_bar (T+1, n), u_ba
       .def_property_readonly("horizon", [](const Policy& p) { return p.file.policy.horizon(); })
       .def_property_readonly("dt", [](const Policy& p) { return p.file.dt; })
       .def_property_readonly("system", [](const Policy& p) { return p.file.system; })
+      .def_property_readonly("simulator_model", [](const Policy& p) { return p.file.simulator_model; },
+                             "str: the simulator planned on, as the text of a model file of `gpilqg diagnose`")
+      .def_property_readonly("diagnosis", [](const Policy& p) -> py::object {
+            if (!p.diagnosis) return py::none();
+            const LoopDiagnosis& d = *p.diagnosis;
+            py::dict out;
+            out["verdict"] = d.verdict;
+            out["reason"] = d.reason;
+            out["adopted"] = d.adopted;
+            out["changes"] = d.changes;
+            out["transitions"] = d.transitions;
+            out["model"] = d.adopted ? diagnosis::model_file_text(d.model) : std::string();
+            return out;
+          }, "dict or None: plan(diagnose=True)'s verdict, reason, adopted, changes, transitions, model (file text)")
       .def_property_readonly("state_names", [](const Policy& p) { return p.file.state_names; })
       .def_property_readonly("control_names", [](const Policy& p) { return p.file.control_names; })
       .def_property_readonly("round", [](const Policy& p) { return p.file.round; })
@@ -247,7 +269,7 @@ Call it as policy(t, x). Arrays have one row per time step: x_bar (T+1, n), u_ba
              write_policy_file(file, p.file, p.model.get());
            }, py::arg("file"), "Writes the policy file (HDF5, atomically), with /model when there is one.");
 
-  m.def("read_policy", [](const std::filesystem::path& file) { return Policy{read_policy_file(file), nullptr}; },
+  m.def("read_policy", [](const std::filesystem::path& file) { return Policy{read_policy_file(file), nullptr, std::nullopt}; },
         py::arg("file"), "Reads a policy file of `gpilqg plan` (its /model is not loaded).");
 
   m.def("_solve", [](const py::object& config, const py::object& progress) { return solve(source_of(config), progress); },
@@ -255,10 +277,12 @@ Call it as policy(t, x). Arrays have one row per time step: x_bar (T+1, n), u_ba
   m.def("_plan",
         [](const py::object& config, const std::vector<std::filesystem::path>& data,
            const std::optional<std::filesystem::path>& previous, const std::optional<std::filesystem::path>& out,
-           std::uint64_t seed, const py::object& progress) {
-          return plan(source_of(config), data, previous, out, seed, progress);
+           std::uint64_t seed, bool diagnose, const std::optional<std::filesystem::path>& write_model,
+           const py::object& progress) {
+          return plan(source_of(config), data, previous, out, seed, diagnose, write_model, progress);
         },
-        py::arg("config"), py::arg("data"), py::arg("previous"), py::arg("out"), py::arg("seed"), py::arg("progress"));
+        py::arg("config"), py::arg("data"), py::arg("previous"), py::arg("out"), py::arg("seed"), py::arg("diagnose"),
+        py::arg("write_model"), py::arg("progress"));
   m.def("_run",
         [](const std::string& system, const py::object& config, int seeds, std::uint64_t first_seed,
            std::optional<int> iterations, const std::vector<std::string>& backends, const std::filesystem::path& out,

@@ -88,6 +88,46 @@ def test_plan_equals_the_command_line_and_its_policy_acts(tmp_path):
         policy(15, np.zeros(4))
 
 
+WORLD = """[model]
+system = "cartpole"
+preset = "real"
+[effects]
+cart_coulomb_friction = { mu = 3.0, v0 = 0.05 }
+"""
+
+
+def test_plan_diagnose_equals_the_command_line_and_the_model_is_a_simulator(tmp_path):
+    # A world with a longer pole and cart friction; plan --diagnose on its log, from the command line
+    # and from Python: the same diagnosed model file and policy.
+    (tmp_path / "world.toml").write_text(WORLD)
+    config = write_toml(tmp_path / "plan.toml", PLAN)
+    assert cli("plan", config, "--out", tmp_path / "p0.h5")[0] == 0
+    status, _, err = cli("rollout", "--system", "cartpole", "--world-model", tmp_path / "world.toml", "--policy",
+                         tmp_path / "p0.h5", "--episodes", "4", "--exploration", "8", "--observation-noise", "0.001",
+                         "--seed", "3", "--out", tmp_path / "d0.h5")
+    assert status == 0, err
+    status, out, err = cli("plan", config, "--data", tmp_path / "d0.h5", "--diagnose", "--write-model",
+                           tmp_path / "F_cli.toml", "--out", tmp_path / "p1_cli.h5")
+    assert status == 0, err
+    policy = gpilqg.plan(PLAN, data=[tmp_path / "d0.h5"], diagnose=True, write_model=tmp_path / "F.toml",
+                         out=tmp_path / "p1.h5")
+    assert policy.diagnosis["verdict"] == "explained" and policy.diagnosis["adopted"]
+    assert any("cart_coulomb_friction" in change for change in policy.diagnosis["changes"])
+    cli_model = (tmp_path / "F_cli.toml").read_text()
+    assert cli_model.split("\n", 1)[1] == (tmp_path / "F.toml").read_text().split("\n", 1)[1]  # but the comment
+    assert policy.simulator_model == policy.diagnosis["model"]
+    with h5py.File(tmp_path / "p1_cli.h5") as a:
+        np.testing.assert_array_equal(a["policy"]["K"][()], policy.K)
+    # The model file as a system: its step is the diagnosed simulator's, not the bare preset's.
+    diagnosed = gpilqg.system("cartpole", model=tmp_path / "F.toml")
+    bare = gpilqg.system("cartpole")
+    x, u = np.array([0.0, 0.5, 0.2, 0.0]), np.array([1.0])
+    assert abs(diagnosed.xdot(x, u)[1] - bare.xdot(x, u)[1]) > 0.5  # the 3 N Coulomb friction on the cart
+    with pytest.raises(gpilqg.InputError, match="model.system"):
+        (tmp_path / "q.toml").write_text('[model]\nsystem = "quadrotor"\n')
+        gpilqg.system("cartpole", model=tmp_path / "q.toml")
+
+
 def test_plan_errors_are_input_errors_with_the_commands_messages(tmp_path):
     with pytest.raises(gpilqg.InputError, match="solver.algorithm"):
         gpilqg.plan({**PLAN, "solver": {"algorithm": "ilqr"}})
