@@ -1,5 +1,6 @@
 #include "gpilqg/experiments/loop_diagnosis.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include <fmt/format.h>
@@ -53,7 +54,7 @@ LoopDiagnosis diagnose_loop_data(const LoopModel& model, const TransitionData& d
   request.seed = seed;
   diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(request);
   options.model = model.simulator;
-  options.substeps = model.substeps;
+  options.substeps = std::max(model.substeps, 1);  // a MuJoCo model steps with its own integrator (substeps 0)
   options.progress = progress;
   try {
     const diagnosis::DiagnosisReport report =

@@ -263,6 +263,19 @@ TEST(ConfigModel, AConfigNamesItsSimulatorAndWorldByModelFilesAndBadOnesAreRefus
   make_solve_model(config)->step(x, u, with_friction);
   make_step_model(run.simulator.build(config.noise), config.integrator, config.dt, config.substeps)->step(x, u, world_step);
   EXPECT_EQ(with_friction, world_step);
+
+  // From the command line: exit 2 naming the config's field and the model file's line and field.
+  test::write_text(folder / "negative.toml", "[model]\nsystem = \"cartpole\"\n[parameters]\npole_length = -1.0\n");
+  test::write_text(folder / "unknown.toml", "[model]\nsystem = \"cartpole\"\n[effects]\nwind = 1.0\n");
+  for (const auto& [model, expected] : {std::pair{"negative.toml", "negative.toml:line 4: field 'parameters.pole_length'"},
+                                        std::pair{"unknown.toml", "unknown.toml:line 4: field 'effects.wind': unknown effect"},
+                                        std::pair{"quadrotor.toml", "field 'model.system': is 'quadrotor'"}}) {
+    const auto config = test::write_text(folder / "bad_plan.toml", plan.replace(plan.find("model = "), plan.find('\n', plan.find("model = ")) - plan.find("model = "),
+                                                                                 fmt::format("model = \"{}\"", model)));
+    const auto r = test::run_cli("plan " + test::quote(config) + " --out " + test::quote(folder / "p.h5"));
+    EXPECT_EQ(r.status, 2) << model;
+    expect_holds(r.err, {"bad_plan.toml:line 3: field 'system.model'", expected});
+  }
   std::filesystem::remove_all(folder);
 }
 
