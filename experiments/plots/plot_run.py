@@ -95,7 +95,8 @@ def draw_diagnosis(ax, alg, color):
         seeds = [s for s, v in enumerate(starts) if int(v) == start]
         found = texts[seeds[0]].split(": ", 1)[-1]
         ax.axvline(start - 0.5, color=color, linestyle="--", linewidth=0.8)
-        label = f"diagnosed ({len(seeds)}/{len(starts)} seeds): " + "\n".join(found.split("; "))
+        seed = int(alg.file["seeds"][seeds[0]]) if "seeds" in alg.file else seeds[0] + 1
+        label = f"diagnosed ({len(seeds)}/{len(starts)} seeds; seed {seed}'s model): " + "\n".join(found.split("; "))
         ax.annotate(label, xy=(start - 0.45, 0.97), xycoords=("data", "axes fraction"), fontsize=5.5, va="top",
                     color=color)
 
