@@ -264,6 +264,22 @@ TEST(ConfigModel, AConfigNamesItsSimulatorAndWorldByModelFilesAndBadOnesAreRefus
   make_step_model(run.simulator.build(config.noise), config.integrator, config.dt, config.substeps)->step(x, u, world_step);
   EXPECT_EQ(with_friction, world_step);
 
+  // Declared user effects are part of the simulator: a constant force declared on the cart's x steps as
+  // the library's external force on the cart, and unlike the bare preset.
+  test::write_text(folder / "declared.toml", "[model]\nsystem = \"cartpole\"\n[[user_effects]]\nname = \"push\"\n"
+                                             "coordinate = \"x\"\nterms = [\"1\"]\n[effects]\npush = 2.0\n");
+  test::write_text(folder / "library.toml", "[model]\nsystem = \"cartpole\"\n[effects]\nexternal_force_x = 2.0\n");
+  const auto step_of = [&](const std::string& model) {
+    std::string text = test::kTinyPlan;
+    const auto config = test::write_text(folder / "step.toml", text.replace(text.find(preset), preset.size(), model));
+    Vector next(4);
+    make_solve_model(read_plan_config(config).problem)->step((Vector(4) << 0.1, 0.2, 0.3, 0.4).finished(), u, next);
+    return next;
+  };
+  const Vector declared = step_of("model = \"declared.toml\""), library = step_of("model = \"library.toml\"");
+  EXPECT_TRUE(declared.isApprox(library, 1e-12)) << declared.transpose() << " vs " << library.transpose();
+  EXPECT_GT((declared - step_of(preset)).norm(), 1e-3);
+
   // From the command line: exit 2 naming the config's field and the model file's line and field.
   test::write_text(folder / "negative.toml", "[model]\nsystem = \"cartpole\"\n[parameters]\npole_length = -1.0\n");
   test::write_text(folder / "unknown.toml", "[model]\nsystem = \"cartpole\"\n[effects]\nwind = 1.0\n");
