@@ -1,10 +1,8 @@
 #include "gpilqg/experiments/config_model.hpp"
 
-#include <algorithm>
-#include <cctype>
-
 #include <fmt/format.h>
 
+#include "gpilqg/core/output_path.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
@@ -12,10 +10,7 @@
 namespace gpilqg {
 
 bool is_diagnosis_model_file(const std::string& name) {
-  constexpr std::string_view kSuffix = ".toml";
-  if (name.size() <= kSuffix.size()) return false;
-  return std::equal(kSuffix.rbegin(), kSuffix.rend(), name.rbegin(),
-                    [](char a, char b) { return a == std::tolower(static_cast<unsigned char>(b)); });
+  return !output_extension_problem(name, OutputFormat{"a model file", kTomlExtensions}).has_value();
 }
 
 ModelSpec read_config_model(const TomlFields& f, const std::string& path, const std::string& system, Preset preset) {

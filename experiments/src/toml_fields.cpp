@@ -122,7 +122,7 @@ void TomlFields::fail(const std::string& path, const std::string& problem) const
 void TomlFields::require_section(const std::string& section) const {
   const toml::node* node = find(section);
   if (node == nullptr || !node->is_table())
-    throw InputError(fmt::format("{}: missing section [{}]; expected it (see DESIGN.md section 8)", file_.string(), section));
+    throw InputError(fmt::format("{}: missing section [{}]; expected it (see docs/formats.md)", file_.string(), section));
 }
 
 void TomlFields::only_keys(const std::string& section, const std::vector<std::string>& allowed) const {

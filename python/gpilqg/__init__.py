@@ -53,7 +53,7 @@ def _paths(who, name, values):
 
 
 def solve(config, progress=None):
-    """One trajectory-optimisation problem (the ``gpilqg solve`` schema, DESIGN.md section 8).
+    """One trajectory-optimisation problem (the ``gpilqg solve`` schema, docs/formats.md).
 
     config: a TOML file or a dict of its tables, e.g. ``{"system": {...}, "problem": {...}}``.
     Returns a dict: cost, expected_cost, termination, converged, iterations, gradient_norm,

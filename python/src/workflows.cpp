@@ -214,7 +214,7 @@ ConfigSource source_of(const py::object& config) {
 
 void bind_workflows(py::module_& m) {
   py::class_<Policy>(m, "Policy", R"(
-An affine feedback policy (DESIGN.md section 11): u_t = clip(u_bar[t] + K[t] (x - x_bar[t]), u_min, u_max).
+An affine feedback policy (docs/formats.md, "Policy file"): u_t = clip(u_bar[t] + K[t] (x - x_bar[t]), u_min, u_max).
 Call it as policy(t, x). Arrays have one row per time step: x_bar (T+1, n), u_bar (T, m), K (T, m, n).)")
       .def("__call__", [](const Policy& p, int t, const py::object& x_in) {
              if (t < 0 || t >= p.file.policy.horizon())

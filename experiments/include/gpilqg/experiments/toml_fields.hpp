@@ -68,7 +68,7 @@ class TomlFields {
   /// A file named by the string field at `path`: a relative path is relative to the folder of the
   /// config file that holds the field.
   std::filesystem::path file_path(const std::string& path) const;
-  /// A system's name (DESIGN.md sections 3 and 10) as the registry resolves it: a MuJoCo model file
+  /// A system's name (docs/formats.md, "Systems and their names") as the registry resolves it: a MuJoCo model file
   /// given by a relative path is relative to the config file's folder. Fails naming the field for an
   /// unknown system or a model file that cannot be loaded.
   std::string system_name(const std::string& path) const;
