@@ -283,13 +283,16 @@ def test_diagnose_reports_progress_and_ctrl_c_stops_it_between_effects():
 
     def progress(line):
         lines.append(line)
-        if line.startswith("effect 3/"):
+        if line.startswith("effect 2/"):
             _thread.interrupt_main()
 
     with pytest.raises(KeyboardInterrupt):
         gpilqg.diagnose("cartpole", data, progress=progress)
     assert lines[0] == "residual GP of the model fitted"
-    assert lines[-1].startswith("effect 3/"), lines
+    # Effects are fitted on several threads and Python handles the signal on the calling thread only: the
+    # call stops after the calling thread's current effect, so after effect 2 and before all 13 were fitted.
+    last, total = map(int, lines[-1].split()[1].split("/"))
+    assert 2 <= last < total, lines
 
 
 def test_diagnose_a_passive_pendulum_equals_the_command_line(tmp_path):
