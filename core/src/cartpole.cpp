@@ -6,18 +6,14 @@
 
 #include <Eigen/Dense>
 
+#include "parameter_checks.hpp"
+
 namespace gpilqg {
 
 namespace {
 
 using Mat2 = Eigen::Matrix2d;
 using Vec2 = Eigen::Vector2d;
-
-void require_positive(double value, const char* name) {
-  if (!std::isfinite(value) || value <= 0.0)
-    throw std::invalid_argument(std::string("cartpole parameter '") + name + "' = " +
-                                std::to_string(value) + "; expected a finite value > 0");
-}
 
 /// Mass matrix, its inverse and its derivative with respect to theta (the only coordinate it
 /// depends on). det M = mp l^2 (mc + mp s^2) > 0 for positive masses and length.
@@ -39,10 +35,10 @@ MassMatrix mass_matrix(const CartPoleParameters& p, double s, double c) {
 }  // namespace
 
 CartPole::CartPole(CartPoleParameters parameters) : p_(parameters) {
-  require_positive(p_.cart_mass, "cart_mass");
-  require_positive(p_.pole_mass, "pole_mass");
-  require_positive(p_.pole_length, "pole_length");
-  require_positive(p_.gravity, "gravity");
+  parameter_checks::require_positive("cartpole", p_.cart_mass, "cart_mass");
+  parameter_checks::require_positive("cartpole", p_.pole_mass, "pole_mass");
+  parameter_checks::require_positive("cartpole", p_.pole_length, "pole_length");
+  parameter_checks::require_positive("cartpole", p_.gravity, "gravity");
 }
 
 const std::string& CartPole::name() const {

@@ -71,9 +71,9 @@ std::optional<long> parse_episode_name(const std::string& name) {
   return value;
 }
 
-class Hdf5Reader {
+class MeasurementsHdf5Reader {
  public:
-  Hdf5Reader(const std::filesystem::path& file, const SystemSignature& system) : file_(file), system_(system) {}
+  MeasurementsHdf5Reader(const std::filesystem::path& file, const SystemSignature& system) : file_(file), system_(system) {}
 
   MeasurementSet read() {
     H5::Exception::dontPrint();
@@ -333,7 +333,7 @@ void write_array(H5::Group& group, const std::string& name, const RowMajor& valu
 }  // namespace
 
 MeasurementSet read_measurements_hdf5(const std::filesystem::path& file, const SystemSignature& system) {
-  return Hdf5Reader(file, system).read();
+  return MeasurementsHdf5Reader(file, system).read();
 }
 
 void write_measurements_hdf5(const std::filesystem::path& file, const MeasurementSet& set) {

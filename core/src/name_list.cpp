@@ -19,7 +19,7 @@ std::string bounded(const std::vector<Name>& names, std::string_view separator, 
   const std::size_t shown = std::min(names.size(), kMaxListedNames);
   for (std::size_t i = 0; i < shown; ++i) {
     if (i > 0) text += separator;
-    text += quote ? quoted(names[i]) : cut(names[i]);
+    text += quote ? name_list::quoted(names[i]) : cut(names[i]);
   }
   if (names.size() > shown) text += fmt::format("{}... and {} more", separator, names.size() - shown);
   return text;

@@ -9,6 +9,8 @@
 
 #include <Eigen/Dense>
 
+#include "parameter_checks.hpp"
+
 namespace gpilqg {
 
 namespace {
@@ -21,17 +23,6 @@ constexpr int kControlDim = 4;
 // First index of each 3-vector in the state.
 constexpr int kP = 0, kV = 3, kR = 6, kW = 9;
 
-void require(bool ok, double value, const char* name, const char* expected) {
-  if (!ok)
-    throw std::invalid_argument(std::string("quadrotor parameter '") + name + "' = " +
-                                std::to_string(value) + "; expected " + expected);
-}
-void require_positive(double value, const char* name) {
-  require(std::isfinite(value) && value > 0.0, value, name, "a finite value > 0");
-}
-void require_non_negative(double value, const char* name) {
-  require(std::isfinite(value) && value >= 0.0, value, name, "a finite value >= 0");
-}
 
 /// Cross-product matrix [a], [a] b = a x b.
 Mat3 hat(const Vec3& a) {
@@ -204,12 +195,12 @@ void write_input_matrix(const QuadrotorParameters& p, const Vec3& thrust, Matrix
 }  // namespace
 
 Quadrotor::Quadrotor(QuadrotorParameters parameters) : p_(parameters) {
-  require_positive(p_.mass, "mass");
-  require_non_negative(p_.kv, "kv");
-  require_non_negative(p_.km, "km");
-  require_positive(p_.inertia, "inertia");
-  require_positive(p_.rho, "rho");
-  require_positive(p_.gravity, "gravity");
+  parameter_checks::require_positive("quadrotor", p_.mass, "mass");
+  parameter_checks::require_non_negative("quadrotor", p_.kv, "kv");
+  parameter_checks::require_non_negative("quadrotor", p_.km, "km");
+  parameter_checks::require_positive("quadrotor", p_.inertia, "inertia");
+  parameter_checks::require_positive("quadrotor", p_.rho, "rho");
+  parameter_checks::require_positive("quadrotor", p_.gravity, "gravity");
 }
 
 const std::string& Quadrotor::name() const {
