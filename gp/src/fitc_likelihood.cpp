@@ -85,12 +85,6 @@ struct FitcLikelihood::Workspace {
   std::vector<Vector> partial_d;   // D + 2: sum_i (E'1)_i xs_id^2 | sum h | sum Gdiag
 };
 
-namespace {
-
-NlmlEvaluation failed(double jitter = 0.0) { return sparse_detail::failed_evaluation(jitter); }
-
-}  // namespace
-
 FitcLikelihood::FitcLikelihood(const MatrixCRef& X, const VectorCRef& r, int inducing, FitcJitter jitter,
                                JitterSchedule schedule, int threads)
     : X_(X),
@@ -138,7 +132,7 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
                                 " entries, expected " + std::to_string(layout_.size()) +
                                 " (D = " + std::to_string(layout_.input_dim) +
                                 ", M = " + std::to_string(layout_.inducing) + ")");
-  if (!theta.allFinite()) return failed();
+  if (!theta.allFinite()) return sparse_detail::failed_evaluation();
   if (!ws_) ws_ = std::make_unique<Workspace>();
   Workspace& w = *ws_;
   const int D = layout_.input_dim;
@@ -150,7 +144,7 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
   w.sn2 = std::exp(2.0 * theta(D + 1));
   if (!w.inv_ell.allFinite() || !(w.inv_ell.array() > 0.0).all() || !std::isfinite(w.sf2) || !(w.sf2 > 0.0) ||
       !std::isfinite(w.sn2))
-    return failed();
+    return sparse_detail::failed_evaluation();
 
   w.Xu = layout_.inducing_inputs(theta);
   w.Xus = (w.Xu.rowwise() - centre_.transpose()) * w.inv_ell.asDiagonal();
@@ -162,7 +156,7 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
   const double base = jitter_.jitter(w.sf2);
   const auto chol_u = cholesky_with_jitter(w.Kuu, base, w.sf2, schedule_, w.Luu);
   sparse_detail::merge(chol_u, e.status, e.jitter);
-  if (chol_u.status == FactorStatus::Failed) return failed(e.jitter);
+  if (chol_u.status == FactorStatus::Failed) return sparse_detail::failed_evaluation(e.jitter);
   w.snu2 = base + chol_u.extra_jitter;
   w.dsnu2 = 2.0 * ((jitter_.kind == FitcJitterKind::Relative ? base : 0.0) + chol_u.extra_jitter);
 
@@ -199,7 +193,7 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
     md.resize(M, D + 2);
     md.col(D + 1).noalias() = V * r_.segment(begin, n).cwiseQuotient(w.g.segment(begin, n));
   });
-  if (!w.g.allFinite() || !(w.g.array() > 0.0).all()) return failed(e.jitter);
+  if (!w.g.allFinite() || !(w.g.array() > 0.0).all()) return sparse_detail::failed_evaluation(e.jitter);
 
   // A = I + V Lambda^-1 V' = La La' (positive definite by construction; escalation as a safeguard).
   w.A.setIdentity(M, M);
@@ -210,7 +204,7 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
   }
   const auto chol_a = cholesky_with_jitter(w.A, 0.0, 1.0, schedule_, w.La);
   sparse_detail::merge(chol_a, e.status, e.jitter);
-  if (chol_a.status == FactorStatus::Failed) return failed(e.jitter);
+  if (chol_a.status == FactorStatus::Failed) return sparse_detail::failed_evaluation(e.jitter);
 
   // gamma = A^-1 V Lambda^-1 r,  alpha = Lambda^-1 (r - V' gamma) = (Qff + Lambda)^-1 r.
   w.La.triangularView<Eigen::Lower>().solveInPlace(w.gamma);
@@ -221,7 +215,7 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
 
   e.value = 0.5 * r_.dot(w.alpha) + w.La.diagonal().array().log().sum() + 0.5 * w.g.array().log().sum() +
             0.5 * static_cast<double>(N) * sparse_detail::kLog2Pi;
-  if (!std::isfinite(e.value)) return failed(e.jitter);
+  if (!std::isfinite(e.value)) return sparse_detail::failed_evaluation(e.jitter);
   return e;
 }
 
@@ -328,7 +322,7 @@ NlmlEvaluation FitcLikelihood::evaluate(const VectorCRef& theta, Vector* gradien
 
   if (!grad.allFinite()) {
     grad.setZero();
-    return failed(e.jitter);
+    return sparse_detail::failed_evaluation(e.jitter);
   }
   return e;
 }

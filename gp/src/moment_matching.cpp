@@ -42,7 +42,7 @@ using detail::view;
 
 namespace {
 
-[[noreturn]] void fail(const std::string& message) {
+[[noreturn]] void fail_se_ard(const std::string& message) {
   throw std::invalid_argument("SeArdMomentMatcher: " + message);
 }
 
@@ -100,26 +100,26 @@ namespace {
 /// and finite entries.
 void check_centres(const Matrix& x, const std::string& label, Eigen::Index d) {
   if (x.rows() == 0 || x.cols() == 0)
-    fail(label + " is " + shape(x.rows(), x.cols()) + ", need at least one row and one column");
+    fail_se_ard(label + " is " + shape(x.rows(), x.cols()) + ", need at least one row and one column");
   if (d > 0 && x.cols() != d)
-    fail(label + " has " + std::to_string(x.cols()) + " columns, expected D = " + std::to_string(d) +
+    fail_se_ard(label + " has " + std::to_string(x.cols()) + " columns, expected D = " + std::to_string(d) +
          " (the columns of centres[0])");
-  if (!x.allFinite()) fail(label + " has a non-finite entry");
+  if (!x.allFinite()) fail_se_ard(label + " has a non-finite entry");
 }
 
 }  // namespace
 
 SeArdMomentMatcher::SeArdMomentMatcher(Matrix inputs, std::vector<SeArdOutput> outputs) {
   check_centres(inputs, "inputs", 0);
-  if (outputs.empty()) fail("outputs is empty, need at least one output");
+  if (outputs.empty()) fail_se_ard("outputs is empty, need at least one output");
   std::vector<Matrix> centres(outputs.size(), inputs);
   build(std::move(centres), std::move(outputs), true);
 }
 
 SeArdMomentMatcher::SeArdMomentMatcher(std::vector<Matrix> centres, std::vector<SeArdOutput> outputs) {
-  if (outputs.empty()) fail("outputs is empty, need at least one output");
+  if (outputs.empty()) fail_se_ard("outputs is empty, need at least one output");
   if (centres.size() != outputs.size())
-    fail("centres has " + std::to_string(centres.size()) + " matrices for " + std::to_string(outputs.size()) +
+    fail_se_ard("centres has " + std::to_string(centres.size()) + " matrices for " + std::to_string(outputs.size()) +
          " outputs; expected one per output");
   for (std::size_t a = 0; a < centres.size(); ++a)
     check_centres(centres[a], "centres[" + std::to_string(a) + "]", a == 0 ? 0 : centres[0].cols());
@@ -136,17 +136,17 @@ void SeArdMomentMatcher::build(std::vector<Matrix> centres, std::vector<SeArdOut
     const std::string name = "outputs[" + std::to_string(a) + "]";
     const std::string rows = shared ? "rows of inputs" : "rows of centres[" + std::to_string(a) + "]";
     if (src.log_lengthscales.size() != d)
-      fail(name + ".log_lengthscales has " + std::to_string(src.log_lengthscales.size()) +
+      fail_se_ard(name + ".log_lengthscales has " + std::to_string(src.log_lengthscales.size()) +
            " entries, expected D = " + std::to_string(d) + " (columns of the centres)");
     if (src.beta.size() != n)
-      fail(name + ".beta has " + std::to_string(src.beta.size()) + " entries, expected N = " +
+      fail_se_ard(name + ".beta has " + std::to_string(src.beta.size()) + " entries, expected N = " +
            std::to_string(n) + " (" + rows + ")");
     if (src.Kinv.rows() != n || src.Kinv.cols() != n)
-      fail(name + ".Kinv is " + shape(src.Kinv.rows(), src.Kinv.cols()) + ", expected N x N = " + shape(n, n));
-    if (!src.log_lengthscales.allFinite()) fail(name + ".log_lengthscales has a non-finite entry");
-    if (!std::isfinite(src.log_signal_std)) fail(name + ".log_signal_std is not finite");
-    if (!src.beta.allFinite()) fail(name + ".beta has a non-finite entry");
-    if (!src.Kinv.allFinite()) fail(name + ".Kinv has a non-finite entry");
+      fail_se_ard(name + ".Kinv is " + shape(src.Kinv.rows(), src.Kinv.cols()) + ", expected N x N = " + shape(n, n));
+    if (!src.log_lengthscales.allFinite()) fail_se_ard(name + ".log_lengthscales has a non-finite entry");
+    if (!std::isfinite(src.log_signal_std)) fail_se_ard(name + ".log_signal_std is not finite");
+    if (!src.beta.allFinite()) fail_se_ard(name + ".beta has a non-finite entry");
+    if (!src.Kinv.allFinite()) fail_se_ard(name + ".Kinv has a non-finite entry");
     OutputData o;
     o.centres = std::move(centres[a]);
     o.inverse_squared_lengthscales = (-2.0 * src.log_lengthscales.array()).exp().matrix();
@@ -158,9 +158,9 @@ void SeArdMomentMatcher::build(std::vector<Matrix> centres, std::vector<SeArdOut
       return v.allFinite() && (v.array() > 0.0).all();
     };
     if (!positive_finite(o.inverse_squared_lengthscales) || !positive_finite(o.lengthscales))
-      fail(name + ".log_lengthscales out of range (1/l^2 or l^2 overflows)");
+      fail_se_ard(name + ".log_lengthscales out of range (1/l^2 or l^2 overflows)");
     if (!std::isfinite(o.signal_variance) || !(o.signal_variance > 0.0))
-      fail(name + ".log_signal_std out of range (sf^2 overflows)");
+      fail_se_ard(name + ".log_signal_std out of range (sf^2 overflows)");
     o.beta = std::move(src.beta);
     o.Kinv = std::move(src.Kinv);
     max_centres_ = std::max(max_centres_, n);

@@ -5,10 +5,6 @@
 
 namespace gpilqg::gp::detail {
 
-namespace {
-inline std::size_t at(int index) { return static_cast<std::size_t>(index); }
-}  // namespace
-
 void SimplicialFactor::compute_elimination_tree() {
   parent.assign(at(size), -1);
   for (int j = 0; j < size; ++j) {

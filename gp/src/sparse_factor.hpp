@@ -5,12 +5,16 @@
 /// sparse solve that prediction needs: only over the elimination-tree reach of the test point's
 /// neighbours, not over all N.
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "gpilqg/core/types.hpp"
 
 namespace gpilqg::gp::detail {
+
+/// The std::size_t position of a factor index (the factors hold int indices, as CHOLMOD does).
+inline std::size_t at(int index) { return static_cast<std::size_t>(index); }
 
 struct SimplicialFactor {
   int size = 0;

@@ -36,12 +36,6 @@ struct SsgpLikelihood::Workspace {
   std::vector<Matrix> partial_md;  // per worker: Phi' r (2m x 1), then dnlml/dS (m x D)
 };
 
-namespace {
-
-NlmlEvaluation failed(double jitter = 0.0) { return sparse_detail::failed_evaluation(jitter); }
-
-}  // namespace
-
 SsgpLikelihood::SsgpLikelihood(const MatrixCRef& X, const VectorCRef& r, int frequencies,
                                JitterSchedule schedule, int threads)
     : X_(X), r_(r), schedule_(schedule), threads_(threads), ws_(std::make_unique<Workspace>()) {
@@ -78,7 +72,7 @@ NlmlEvaluation SsgpLikelihood::factorise(const VectorCRef& theta) const {
                                 " entries, expected " + std::to_string(layout_.size()) +
                                 " (D = " + std::to_string(layout_.input_dim) +
                                 ", m = " + std::to_string(layout_.frequencies) + ")");
-  if (!theta.allFinite()) return failed();
+  if (!theta.allFinite()) return sparse_detail::failed_evaluation();
   if (!ws_) ws_ = std::make_unique<Workspace>();
   Workspace& w = *ws_;
   const int D = layout_.input_dim;
@@ -91,7 +85,7 @@ NlmlEvaluation SsgpLikelihood::factorise(const VectorCRef& theta) const {
   w.a = static_cast<double>(m) * w.sn2 / w.sf2;
   if (!w.inv_ell.allFinite() || !std::isfinite(w.sf2) || !(w.sf2 > 0.0) || !std::isfinite(w.sn2) ||
       !(w.sn2 > 0.0) || !std::isfinite(w.a) || !(w.a > 0.0))
-    return failed();
+    return sparse_detail::failed_evaluation();
   w.S = layout_.spectral_points(theta) * w.inv_ell.asDiagonal();
 
   // Per block of training points: features Phi = [cos(X S'), sin(X S')] and the partial sums of
@@ -115,7 +109,7 @@ NlmlEvaluation SsgpLikelihood::factorise(const VectorCRef& theta) const {
     b.resize(2 * m, 1);
     b.noalias() = Phi.transpose() * r_.segment(begin, n);
   });
-  if (!w.Phi.allFinite()) return failed();
+  if (!w.Phi.allFinite()) return sparse_detail::failed_evaluation();
   w.PhiTPhi.setZero(2 * m, 2 * m);
   w.b.setZero(2 * m);
   for (int k = 0; k < w.workers; ++k) {
@@ -128,7 +122,7 @@ NlmlEvaluation SsgpLikelihood::factorise(const VectorCRef& theta) const {
   const auto chol =
       sparse_detail::cholesky_with_jitter(w.PhiTPhi, w.a, 0.5 * static_cast<double>(N), schedule_, w.L);
   sparse_detail::merge(chol, e.status, e.jitter);
-  if (chol.status == FactorStatus::Failed) return failed(e.jitter);
+  if (chol.status == FactorStatus::Failed) return sparse_detail::failed_evaluation(e.jitter);
 
   // alpha = A^-1 Phi' r.
   w.alpha = w.b;
@@ -139,7 +133,7 @@ NlmlEvaluation SsgpLikelihood::factorise(const VectorCRef& theta) const {
   e.value = w.rr_minus_ba / (2.0 * w.sn2) + w.L.diagonal().array().log().sum() -
             static_cast<double>(m) * std::log(w.a) +
             0.5 * static_cast<double>(N) * (sparse_detail::kLog2Pi + std::log(w.sn2));
-  if (!std::isfinite(e.value)) return failed(e.jitter);
+  if (!std::isfinite(e.value)) return sparse_detail::failed_evaluation(e.jitter);
   return e;
 }
 
@@ -194,7 +188,7 @@ NlmlEvaluation SsgpLikelihood::evaluate(const VectorCRef& theta, Vector* gradien
 
   if (!grad.allFinite()) {
     grad.setZero();
-    return failed(e.jitter);
+    return sparse_detail::failed_evaluation(e.jitter);
   }
   return e;
 }

@@ -25,33 +25,33 @@ using detail::view;
 
 namespace {
 
-[[noreturn]] void fail(const std::string& message) {
+[[noreturn]] void fail_ssgp(const std::string& message) {
   throw std::invalid_argument("SsgpMomentMatcher: " + message);
 }
 
 }  // namespace
 
 SsgpMomentMatcher::SsgpMomentMatcher(std::vector<SsgpOutput> outputs) : outputs_(std::move(outputs)) {
-  if (outputs_.empty()) fail("outputs is empty, need at least one output");
+  if (outputs_.empty()) fail_ssgp("outputs is empty, need at least one output");
   const Eigen::Index d = outputs_[0].frequencies.cols();
   for (std::size_t a = 0; a < outputs_.size(); ++a) {
     const SsgpOutput& o = outputs_[a];
     const std::string name = "outputs[" + std::to_string(a) + "]";
     const Eigen::Index m = o.frequencies.rows();
     if (m == 0 || o.frequencies.cols() == 0)
-      fail(name + ".frequencies is " + shape(m, o.frequencies.cols()) + ", need at least one row and column");
+      fail_ssgp(name + ".frequencies is " + shape(m, o.frequencies.cols()) + ", need at least one row and column");
     if (o.frequencies.cols() != d)
-      fail(name + ".frequencies has " + std::to_string(o.frequencies.cols()) + " columns, expected D = " +
+      fail_ssgp(name + ".frequencies has " + std::to_string(o.frequencies.cols()) + " columns, expected D = " +
            std::to_string(d) + " (the columns of outputs[0].frequencies)");
     if (o.weights.size() != 2 * m)
-      fail(name + ".weights has " + std::to_string(o.weights.size()) + " entries, expected 2m = " +
+      fail_ssgp(name + ".weights has " + std::to_string(o.weights.size()) + " entries, expected 2m = " +
            std::to_string(2 * m) + " (twice the rows of frequencies)");
     if (o.variance.rows() != 2 * m || o.variance.cols() != 2 * m)
-      fail(name + ".variance is " + shape(o.variance.rows(), o.variance.cols()) + ", expected 2m x 2m = " +
+      fail_ssgp(name + ".variance is " + shape(o.variance.rows(), o.variance.cols()) + ", expected 2m x 2m = " +
            shape(2 * m, 2 * m));
-    if (!o.frequencies.allFinite()) fail(name + ".frequencies has a non-finite entry");
-    if (!o.weights.allFinite()) fail(name + ".weights has a non-finite entry");
-    if (!o.variance.allFinite()) fail(name + ".variance has a non-finite entry");
+    if (!o.frequencies.allFinite()) fail_ssgp(name + ".frequencies has a non-finite entry");
+    if (!o.weights.allFinite()) fail_ssgp(name + ".weights has a non-finite entry");
+    if (!o.variance.allFinite()) fail_ssgp(name + ".variance has a non-finite entry");
     max_frequencies_ = std::max(max_frequencies_, m);
   }
   input_dim_ = static_cast<int>(d);

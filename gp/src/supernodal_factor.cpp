@@ -10,7 +10,6 @@
 namespace gpilqg::gp::detail {
 
 namespace {
-inline std::size_t at(int index) { return static_cast<std::size_t>(index); }
 using ConstBlock = Eigen::Map<const Matrix>;
 }  // namespace
 
