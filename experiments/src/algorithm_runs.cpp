@@ -12,12 +12,10 @@
 #include "gpilqg/gp/gp_belief_dynamics.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 
+#include "elapsed_seconds.hpp"
+
 namespace gpilqg {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 void report(const TaskContext& c, const std::string& name, int k, const IterationRecord& r) {
   if (!c.progress) return;

@@ -16,13 +16,13 @@
 #include "gpilqg/gp/exact_gp.hpp"
 #include "gpilqg/gp/metrics.hpp"
 
+#include "elapsed_seconds.hpp"
+
 namespace gpilqg {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 /// The first `count` of one fixed permutation of [0, size) (seeded), in permutation order.
 std::vector<int> nested_subset(int size, int count, std::uint64_t seed) {

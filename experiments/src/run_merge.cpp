@@ -41,10 +41,6 @@ struct TaskPlan {
   std::map<std::uint64_t, std::size_t> data;     ///< per seed, the part whose /<task>/data rows are taken
 };
 
-bool contains(const std::vector<std::string>& names, const std::string& name) {
-  return std::find(names.begin(), names.end(), name) != names.end();
-}
-
 std::string name_of(const RunResultPart& part) { return part.file.string(); }
 
 /// A dataset's row-major values around one axis: `outer` blocks, each of `length` slices of `inner` values.
@@ -100,11 +96,11 @@ void require_same_datasets(const Parts& parts, const std::string& task, const st
   const auto& names_b = parts[b].task(task)->datasets.at(algorithm);
   const std::string group = fmt::format("/{}/{}/", task, algorithm);
   for (const auto& name : names_b)
-    if (!contains(names_a, name))
+    if (!contains_name(names_a, name))
       throw InputError(fmt::format("{}: dataset '{}{}' is not in {}; the parts were run differently (e.g. another --iterations)",
                                    name_of(parts[b]), group, name, name_of(parts[a])));
   for (const auto& name : names_a)
-    if (!contains(names_b, name))
+    if (!contains_name(names_b, name))
       throw InputError(fmt::format("{}: dataset '{}{}' of {} is missing; the parts were run differently (e.g. another --iterations)",
                                    name_of(parts[b]), group, name, name_of(parts[a])));
   for (const auto& name : names_a) {
@@ -163,7 +159,7 @@ TaskPlan plan_task(const Parts& parts, const std::string& task, const Seeds& see
         plan.main_link = true;
         plan.main_algorithm = t->main_algorithm;
       }
-      if (contains(t->algorithms, "gp_ilqg") && plain.empty()) plain = name_of(part);
+      if (contains_name(t->algorithms, "gp_ilqg") && plain.empty()) plain = name_of(part);
     }
   if (!linked.empty() && !plain.empty())
     throw InputError(fmt::format("{} has gp_ilqg as a link to {} on task {}, {} as an algorithm of its own; parts run with and "
@@ -174,7 +170,7 @@ TaskPlan plan_task(const Parts& parts, const std::string& task, const Seeds& see
     const RunTaskPart* in_part = parts[p].task(task);
     if (!in_part) continue;
     for (const std::string& algorithm : in_part->algorithms) {
-      if (!contains(plan.algorithms, algorithm)) {
+      if (!contains_name(plan.algorithms, algorithm)) {
         plan.algorithms.push_back(algorithm);
         plan.reference[algorithm] = p;
       } else {
@@ -197,7 +193,7 @@ TaskPlan plan_task(const Parts& parts, const std::string& task, const Seeds& see
     if (has == seeds) continue;
     std::vector<std::string> files;
     for (const RunResultPart& part : parts)
-      if (part.task(task) && contains(part.task(task)->algorithms, algorithm)) files.push_back(name_of(part));
+      if (part.task(task) && contains_name(part.task(task)->algorithms, algorithm)) files.push_back(name_of(part));
     throw InputError(fmt::format("{} on task {} has seeds {} but the merged file has seeds {}: every algorithm needs every "
                                  "seed (it is in {})",
                                  algorithm, task, fmt::join(has, ", "), fmt::join(seeds, ", "), fmt::join(files, ", ")));
@@ -361,7 +357,7 @@ MergeSummary merge_run_results(const std::vector<std::filesystem::path>& files, 
   for (const RunResultPart& part : parts) {
     all_seeds.insert(part.seeds.begin(), part.seeds.end());
     for (const RunTaskPart& task : part.tasks)
-      if (!contains(tasks, task.name)) tasks.push_back(task.name);
+      if (!contains_name(tasks, task.name)) tasks.push_back(task.name);
   }
   const Seeds seeds(all_seeds.begin(), all_seeds.end());
   std::vector<TaskPlan> plans;

@@ -32,10 +32,6 @@ std::string entry_index(std::size_t i, const std::vector<std::uint64_t>& dims) {
   return fmt::format("[{}]", index.empty() ? std::to_string(i) : fmt::format("{}", fmt::join(index, ", ")));
 }
 
-bool contains(const std::vector<std::string>& names, const std::string& name) {
-  return std::find(names.begin(), names.end(), name) != names.end();
-}
-
 class PartChecker {
  public:
   explicit PartChecker(RunResultPart& part) : part_(part), h5_(*part.h5) {}
@@ -75,7 +71,7 @@ class PartChecker {
       RunTaskPart& task = task_named(task_name);
       if (group == "data") task.data.push_back(name);
       else if (group == "figure1") task.figure1.push_back(name);
-      else if (contains(task.algorithms, group) && seed_axis(name)) task.datasets[group].push_back(name);
+      else if (contains_name(task.algorithms, group) && seed_axis(name)) task.datasets[group].push_back(name);
       else unknown(path);
     }
   }
@@ -88,7 +84,7 @@ class PartChecker {
           fail(fmt::format("algorithm '{}' of task '{}' (its 'algorithms' attribute) has no datasets", algorithm, task.name));
         for (const std::string& name : found->second) check_seed_axis(fmt::format("/{}/{}/{}", task.name, algorithm, name), name);
       }
-      if (task.has_main_link && !contains(task.algorithms, task.main_algorithm))
+      if (task.has_main_link && !contains_name(task.algorithms, task.main_algorithm))
         fail(fmt::format("the soft link '/{}/gp_ilqg' points to '{}', which is not one of the task's algorithms", task.name,
                          task.main_algorithm));
       check_data(task);
@@ -150,7 +146,7 @@ class PartChecker {
   /// data/seed names a seed of the file for every row, and every data/ dataset has one row per entry.
   void check_data(const RunTaskPart& task) const {
     const std::string group = "/" + task.name + "/data";
-    if (!contains(task.data, "seed")) fail(fmt::format("dataset '{}/seed' is missing", group));
+    if (!contains_name(task.data, "seed")) fail(fmt::format("dataset '{}/seed' is missing", group));
     const std::vector<double> seeds = h5_.read_array(group + "/seed");
     for (const double seed : seeds)
       if (!(seed >= 0.0 && seed <= static_cast<double>(limits::kMaxSeed)) || seed != std::floor(seed) ||
@@ -162,7 +158,7 @@ class PartChecker {
         fail(fmt::format("dataset '{}/{}' has shape ({}); expected {} rows, one per entry of '{}/seed'", group, name,
                          fmt::join(dims, ", "), seeds.size(), group));
     }
-    if (!seeds.empty() && !contains(task.algorithms, task.main_algorithm))
+    if (!seeds.empty() && !contains_name(task.algorithms, task.main_algorithm))
       fail(fmt::format("'{}' holds transitions but the task has no algorithm '{}' that collected them", group, task.main_algorithm));
   }
 
@@ -171,6 +167,10 @@ class PartChecker {
 };
 
 }  // namespace
+
+bool contains_name(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
 
 const RunTaskPart* RunResultPart::task(const std::string& name) const {
   for (const RunTaskPart& t : tasks)

@@ -54,4 +54,7 @@ struct RunResultPart {
 /// entry [0, 1] is nan; expected finite numbers").
 RunResultPart read_run_result_part(const std::filesystem::path& file);
 
+/// True when `name` is one of `names` (a task's algorithms, the tasks of the parts).
+bool contains_name(const std::vector<std::string>& names, const std::string& name);
+
 }  // namespace gpilqg

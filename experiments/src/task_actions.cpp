@@ -5,12 +5,10 @@
 
 #include "gpilqg/control/rollout.hpp"
 
+#include "elapsed_seconds.hpp"
+
 namespace gpilqg {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 Matrix repeated_u_init(const TaskContext& c) { return c.config.u_init.replicate(1, c.task.horizon); }
 
