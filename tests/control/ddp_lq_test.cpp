@@ -17,7 +17,7 @@ namespace gpilqg {
 namespace {
 
 constexpr int kN = 4, kM = 2, kT = 30;
-constexpr double kDt = 0.1;
+constexpr double kLqDt = 0.1;
 
 struct LqSetup {
   test::LinearStepModel model;
@@ -28,13 +28,13 @@ struct LqSetup {
 
 LqSetup random_lq(unsigned seed) {
   const Matrix F = test::random_vector(kN * kN, -0.5, 0.5, seed).reshaped(kN, kN);
-  const Matrix A = Matrix::Identity(kN, kN) + kDt * F;
-  const Matrix B = kDt * test::random_vector(kN * kM, -1.0, 1.0, seed + 1).reshaped(kN, kM);
+  const Matrix A = Matrix::Identity(kN, kN) + kLqDt * F;
+  const Matrix B = kLqDt * test::random_vector(kN * kM, -1.0, 1.0, seed + 1).reshaped(kN, kM);
   const Matrix L = test::random_vector(kN * kN, -1.0, 1.0, seed + 2).reshaped(kN, kN);
   const Matrix Q = L * L.transpose() + 0.1 * Matrix::Identity(kN, kN);
   const Matrix R = Matrix::Identity(kM, kM) * 0.5;
   const Matrix Qf = 10.0 * Matrix::Identity(kN, kN);
-  return {test::LinearStepModel(A, B, kDt), QuadraticCost(kDt, Q, R, Qf, Vector::Zero(kN)),
+  return {test::LinearStepModel(A, B, kLqDt), QuadraticCost(kLqDt, Q, R, Qf, Vector::Zero(kN)),
           test::random_vector(kN, -2.0, 2.0, seed + 3), Q, R, Qf};
 }
 
@@ -68,9 +68,9 @@ Riccati riccati(const LqSetup& s, const Matrix& A, const Matrix& B) {
   r.P[kT] = s.Qf;
   for (int t = kT - 1; t >= 0; --t) {
     const Matrix& P = r.P[static_cast<std::size_t>(t + 1)];
-    const Matrix H = kDt * s.R + B.transpose() * P * B;
+    const Matrix H = kLqDt * s.R + B.transpose() * P * B;
     r.K[static_cast<std::size_t>(t)] = -H.ldlt().solve(B.transpose() * P * A);
-    r.P[static_cast<std::size_t>(t)] = kDt * s.Q + A.transpose() * P * A + A.transpose() * P * B * r.K[static_cast<std::size_t>(t)];
+    r.P[static_cast<std::size_t>(t)] = kLqDt * s.Q + A.transpose() * P * A + A.transpose() * P * B * r.K[static_cast<std::size_t>(t)];
   }
   return r;
 }
@@ -133,7 +133,7 @@ TEST(DdpLinearQuadratic, IlqgWithAdditiveNoiseKeepsTheGainsAndAddsTheTraceTerms)
   // The trace terms in closed form: sum_t 0.5 dt sigma^2 tr(P_{t+1}) with the Riccati P.
   const Riccati r = riccati(s, system_A(s), system_B(s));
   double trace_terms = 0.0;
-  for (int t = 0; t < kT; ++t) trace_terms += 0.5 * kDt * 0.4 * 0.4 * r.P[static_cast<std::size_t>(t + 1)].trace();
+  for (int t = 0; t < kT; ++t) trace_terms += 0.5 * kLqDt * 0.4 * 0.4 * r.P[static_cast<std::size_t>(t + 1)].trace();
   EXPECT_NEAR(sto.nominal_cost, det.nominal_cost, 1e-12 * det.nominal_cost);
   EXPECT_NEAR(sto.expected_cost - sto.nominal_cost, trace_terms, 1e-10 * trace_terms);
   EXPECT_GT(trace_terms, 0.01 * sto.nominal_cost);  // the noise matters in this test

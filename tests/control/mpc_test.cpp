@@ -14,18 +14,18 @@
 namespace gpilqg {
 namespace {
 
-constexpr double kDt = 0.02;
+constexpr double kMpcDt = 0.02;
 constexpr int kSteps = 200;  // 4 s
 
 /// The paper's quadrotor task: track the straight line from start to goal in 4 s, with a higher
 /// weight on height; hover thrust as the control reference.
 QuadraticCost line_task(const Vector& start, const Vector& goal, double hover) {
   Matrix x_ref = straight_line_reference(start, goal, kSteps);
-  x_ref.block(3, 0, 3, kSteps) = ((goal - start).head(3) / (kSteps * kDt)).replicate(1, kSteps);  // v along the line
+  x_ref.block(3, 0, 3, kSteps) = ((goal - start).head(3) / (kSteps * kMpcDt)).replicate(1, kSteps);  // v along the line
   Vector q(12);
   q << 10, 10, 100, 1, 1, 1, 1, 1, 1, 0.1, 0.1, 0.1;  // height weighted 10x
   Vector qf = 10.0 * q;
-  return QuadraticCost::tracking(kDt, q.asDiagonal(), 0.1 * Matrix::Identity(4, 4), qf.asDiagonal(), x_ref,
+  return QuadraticCost::tracking(kMpcDt, q.asDiagonal(), 0.1 * Matrix::Identity(4, 4), qf.asDiagonal(), x_ref,
                                  Matrix::Constant(4, kSteps, hover));
 }
 
@@ -38,7 +38,7 @@ LineRun run_line_task(Preset planner, Preset world_preset) {
   auto plan_system = make_system("quadrotor", planner);
   auto world_system = make_system("quadrotor", world_preset);
   const double hover = std::static_pointer_cast<const Quadrotor>(plan_system)->hover_force();
-  IntegratedStepModel model(plan_system, Integrator::RK4, kDt), world(world_system, Integrator::RK4, kDt);
+  IntegratedStepModel model(plan_system, Integrator::RK4, kMpcDt), world(world_system, Integrator::RK4, kMpcDt);
   Vector start = Vector::Zero(12), goal = Vector::Zero(12);
   start(2) = 5.0;
   goal << 4, 0, 5, 0, 0, 0, 0, 0, 0, 0, 0, 0;

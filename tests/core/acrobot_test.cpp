@@ -17,11 +17,6 @@ namespace {
 using acrobot::Acrobot;
 using acrobot::AcrobotParameters;
 
-// Central differences with h = 1e-6: truncation ~ h^2 |f'''| / 6 and round-off ~ eps |f| / h stay
-// below 1e-8 for |f|, |f'''| up to ~100 on these states; a wrong term is O(0.01) or larger.
-constexpr double kStep = 1e-6;
-constexpr double kFdTolerance = 1e-7;
-
 const AcrobotParameters kParameterSets[] = {AcrobotParameters::simulator(), AcrobotParameters::real_world(),
                                            AcrobotParameters{0.6, 1.7, 0.8, 1.4, 9.81}};
 
@@ -35,10 +30,10 @@ TEST(Acrobot, AnalyticJacobiansMatchCentralDifferencesAtRandomPoints) {
       Vector xdot(4);
       system.evaluate(x, u, xdot, &jac);
       EXPECT_TRUE(test::matrices_near(xdot, system.f(x, u), 0.0)) << "seed " << seed;
-      const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return system.f(xs, u); }, x, kStep);
-      const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return system.f(x, us); }, u, kStep);
-      EXPECT_TRUE(test::matrices_near(jac.fx, fx, kFdTolerance, kFdTolerance)) << "seed " << seed;
-      EXPECT_TRUE(test::matrices_near(jac.fu, fu, kFdTolerance, kFdTolerance)) << "seed " << seed;
+      const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return system.f(xs, u); }, x, test::kFdStep);
+      const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return system.f(x, us); }, u, test::kFdStep);
+      EXPECT_TRUE(test::matrices_near(jac.fx, fx, test::kFdTolerance, test::kFdTolerance)) << "seed " << seed;
+      EXPECT_TRUE(test::matrices_near(jac.fu, fu, test::kFdTolerance, test::kFdTolerance)) << "seed " << seed;
     }
   }
 }
@@ -60,8 +55,8 @@ TEST(Acrobot, InputMatrixIsFuWithCentralDifferenceDerivatives) {
         system.input_matrix(xs, u, at);
         return Vector(at.b.col(0));
       };
-      EXPECT_TRUE(test::matrices_near(b.d_dx[0], test::numeric_jacobian(column, x, kStep), kFdTolerance,
-                                      kFdTolerance))
+      EXPECT_TRUE(test::matrices_near(b.d_dx[0], test::numeric_jacobian(column, x, test::kFdStep), test::kFdTolerance,
+                                      test::kFdTolerance))
           << "seed " << seed;
       EXPECT_TRUE(test::matrices_near(b.d_du[0], Matrix::Zero(4, 1), 0.0));
     }
@@ -85,10 +80,10 @@ TEST(Acrobot, GeneralisedForceMapDerivativesMatchCentralDifferences) {
           system.generalised_force_map(xs, at, nullptr);
           return Vector(at.col(k));
         };
-        const Matrix numeric = test::numeric_jacobian(column, x, kStep);  // 4 x 4: d W(:, k) / dx
+        const Matrix numeric = test::numeric_jacobian(column, x, test::kFdStep);  // 4 x 4: d W(:, k) / dx
         for (int j = 0; j < 4; ++j)
-          EXPECT_TRUE(test::matrices_near(dW[static_cast<std::size_t>(j)].col(k), numeric.col(j), kFdTolerance,
-                                          kFdTolerance))
+          EXPECT_TRUE(test::matrices_near(dW[static_cast<std::size_t>(j)].col(k), numeric.col(j), test::kFdTolerance,
+                                          test::kFdTolerance))
               << "seed " << seed << ", column " << k << ", x_" << j;
       }
     }

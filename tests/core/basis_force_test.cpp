@@ -18,8 +18,6 @@
 namespace gpilqg {
 namespace {
 
-constexpr double kStep = 1e-6;
-
 /// Every basis function, then products (with u, with tanh, of the two-piece qdot*abs(qdot), squares).
 const std::vector<std::string> kTerms = {"qdot", "tanh(qdot/v0)", "qdot*abs(qdot)", "q", "q^2", "q^3", "sin(q)",
                                          "cos(q)", "u", "1", "q*qdot", "u*qdot", "tanh(qdot/v0)*q^2",
@@ -55,8 +53,8 @@ void expect_derivatives_match_central_differences(const Dynamics& system, const 
     Matrix dQ_dx = Matrix::Zero(k, n), dQ_du = Matrix::Zero(k, m);
     effect.add_force(x, u, theta, Q, &dQ_dx, &dQ_du);
     EXPECT_TRUE(test::matrices_near(Q, force_at(effect, k, x, u, theta), 0.0));
-    const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return force_at(effect, k, xs, u, theta); }, x, kStep);
-    const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return force_at(effect, k, x, us, theta); }, u, kStep);
+    const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return force_at(effect, k, xs, u, theta); }, x, test::kFdStep);
+    const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return force_at(effect, k, x, us, theta); }, u, test::kFdStep);
     EXPECT_TRUE(test::matrices_near(dQ_dx, fx, 1e-6, 1e-6)) << "seed " << seed << "\n" << dQ_dx << "\n" << fx;
     EXPECT_TRUE(test::matrices_near(dQ_du, fu, 1e-6, 1e-6)) << "seed " << seed << "\n" << dQ_du << "\n" << fu;
     // Only the coordinate's component carries a force.

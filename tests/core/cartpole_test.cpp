@@ -13,12 +13,6 @@
 namespace gpilqg {
 namespace {
 
-// Central differences with step h have truncation error ~ h^2 |f'''| / 6 and round-off ~ eps |f| / h.
-// With h = 1e-6 and |f|, |f'''| of order 10-100 on these states, both are below 1e-8: the tolerance
-// 1e-7 leaves a margin of 10 and still catches any wrong term (those are O(0.01) or larger).
-constexpr double kStep = 1e-6;
-constexpr double kFdTolerance = 1e-7;
-
 TEST(CartPole, EulerStepMatchesReferenceOracle) {
   // tests/reference/ilqr_cartpole/README.md, "Unit checks" (Tassa's iLQG.m in Octave, Euler dt = 0.05).
   auto model = IntegratedStepModel(std::make_shared<CartPole>(), Integrator::Euler, 0.05);
@@ -54,10 +48,10 @@ TEST(CartPole, AnalyticJacobiansMatchCentralDifferencesAtRandomPoints) {
       DynamicsJacobians jac;
       Vector xdot(4);
       cp.evaluate(x, u, xdot, &jac);
-      const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return cp.f(xs, u); }, x, kStep);
-      const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return cp.f(x, us); }, u, kStep);
-      EXPECT_TRUE(test::matrices_near(jac.fx, fx, kFdTolerance, kFdTolerance)) << "seed " << seed;
-      EXPECT_TRUE(test::matrices_near(jac.fu, fu, kFdTolerance, kFdTolerance)) << "seed " << seed;
+      const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return cp.f(xs, u); }, x, test::kFdStep);
+      const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return cp.f(x, us); }, u, test::kFdStep);
+      EXPECT_TRUE(test::matrices_near(jac.fx, fx, test::kFdTolerance, test::kFdTolerance)) << "seed " << seed;
+      EXPECT_TRUE(test::matrices_near(jac.fu, fu, test::kFdTolerance, test::kFdTolerance)) << "seed " << seed;
       EXPECT_MATRIX_NEAR(xdot, cp.f(x, u), 0.0);
     }
   }
@@ -97,8 +91,8 @@ TEST(CartPole, InputMatrixIsFuAndItsDerivativeMatchesCentralDifferences) {
           cp.evaluate(xs, u, f, &j);
           return Vector(j.fu.col(0));
         },
-        x, kStep);
-    EXPECT_MATRIX_NEAR(b.d_dx[0], db, kFdTolerance);
+        x, test::kFdStep);
+    EXPECT_MATRIX_NEAR(b.d_dx[0], db, test::kFdTolerance);
     EXPECT_MATRIX_NEAR(b.d_du[0], Matrix::Zero(4, 1), 0.0);
   }
 }

@@ -15,8 +15,6 @@
 namespace gpilqg {
 namespace {
 
-constexpr double kStep = 1e-6;
-
 /// The model with every force of the library at a nonzero value and a gain of 1.2.
 ModelSpec everything(const std::string& system) {
   ModelSpec spec;
@@ -40,8 +38,8 @@ void expect_jacobians_match_central_differences(const Dynamics& model, double x_
     Vector xdot(n);
     model.evaluate(x, u, xdot, &jac);
     EXPECT_TRUE(test::matrices_near(xdot, model.f(x, u), 0.0)) << "f with and without Jacobians";
-    const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return model.f(xs, u); }, x, kStep);
-    const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return model.f(x, us); }, u, kStep);
+    const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return model.f(xs, u); }, x, test::kFdStep);
+    const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return model.f(x, us); }, u, test::kFdStep);
     EXPECT_TRUE(test::matrices_near(jac.fx, fx, 2e-6, 1e-6)) << "seed " << seed;
     EXPECT_TRUE(test::matrices_near(jac.fu, fu, 2e-6, 1e-6)) << "seed " << seed;
   }
@@ -85,7 +83,7 @@ TEST(Effects, CartPoleForceMapDerivativeMatchesCentralDifferences) {
             cp.generalised_force_map(xs, Ws, nullptr);
             return Vector(Ws.reshaped());
           },
-          x, kStep);
+          x, test::kFdStep);
       EXPECT_TRUE(test::matrices_near(Matrix(dW[static_cast<std::size_t>(j)].reshaped()), numeric.col(j), 1e-8, 1e-7));
     }
   }
@@ -108,7 +106,7 @@ TEST(Effects, CartPoleEnergyBalanceWithFrictionGainAndForce) {
   for (unsigned seed = 1; seed <= 10; ++seed) {
     const Vector x = test::random_vector(4, -2.0, 2.0, seed);
     const Vector u = test::random_vector(1, -5.0, 5.0, 50 + seed);
-    const Matrix grad_e = test::numeric_jacobian([&](const Vector& xs) { return Vector::Constant(1, cp.energy(xs)); }, x, kStep);
+    const Matrix grad_e = test::numeric_jacobian([&](const Vector& xs) { return Vector::Constant(1, cp.energy(xs)); }, x, test::kFdStep);
     const double dE_dt = (grad_e * model->f(x, u))(0);
     const double Qx = -b * x(1) - mu * std::tanh(x(1) / 0.05) + F - cd * std::abs(x(1)) * x(1) + Fx;
     const double Qt = -c * x(3) - tau * std::tanh(x(3) / 0.05) + Ft;

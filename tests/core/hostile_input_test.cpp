@@ -26,15 +26,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const SystemSignature& cartpole() {
-  static const SystemSignature signature = system_signature("cartpole");
-  return signature;
-}
-
 TEST(HostileInputs, EveryDataReaderRefusesThemWithDataError) {
   const std::vector<test::Reader> readers = {
-      {"read_measurements (CSV)", ".csv", kMaxDataFileBytes, [](const fs::path& f) { read_measurements(f, cartpole()); }},
-      {"read_measurements (HDF5)", ".h5", kMaxDataFileBytes, [](const fs::path& f) { read_measurements(f, cartpole()); }},
+      {"read_measurements (CSV)", ".csv", kMaxDataFileBytes, [](const fs::path& f) { read_measurements(f, test::cartpole_signature()); }},
+      {"read_measurements (HDF5)", ".h5", kMaxDataFileBytes, [](const fs::path& f) { read_measurements(f, test::cartpole_signature()); }},
       {"read_raw_log (CSV)", ".csv", kMaxDataFileBytes, [](const fs::path& f) { read_raw_log(f); }},
       {"read_raw_log (MAT)", ".mat", kMaxDataFileBytes, [](const fs::path& f) { read_raw_log(f); }},
       {"read_raw_log (HDF5)", ".h5", kMaxDataFileBytes, [](const fs::path& f) { read_raw_log(f); }},
@@ -154,7 +149,7 @@ TEST(CsvHeader, A200000ColumnHeaderGivesAShortMessage) {
   const fs::path dir = test::temporary_dir("hostile");
   const fs::path file = wide_csv(dir / "wide.csv", 200'000);
   try {
-    read_measurements(file, cartpole());
+    read_measurements(file, test::cartpole_signature());
     ADD_FAILURE() << "accepted";
   } catch (const DataError& e) {
     const std::string message = e.what();
@@ -171,7 +166,7 @@ TEST(CsvHeader, A200000ColumnHeaderGivesAShortMessage) {
   const std::string long_name(100'000, 'y');
   std::ofstream(dir / "long.csv") << "episode,t,x,x," << long_name << ",theta_dot,force\n0,0,0,0,0,0,0\n";
   try {
-    read_measurements(dir / "long.csv", cartpole());
+    read_measurements(dir / "long.csv", test::cartpole_signature());
     ADD_FAILURE() << "accepted";
   } catch (const DataError& e) {
     const std::string message = e.what();

@@ -25,11 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const SystemSignature& cartpole() {
-  static const SystemSignature signature = system_signature("cartpole");
-  return signature;
-}
-
 /// The what() of the DataError thrown by `read`, or a note that none (or another type) was thrown.
 std::string data_error_of(const std::function<void()>& read) {
   try {
@@ -55,7 +50,7 @@ TEST(MeasurementsCsv, ReadsEpisodesInFileOrder) {
                                                    "3,0.1,0.03,0.11,-0.22,-0.61,-10.5\n"
                                                    "1,1.5,1,2,3,4,5\n"
                                                    "1,1.6,1.1,2.1,3.1,4.1,5.1\n");
-  const MeasurementSet set = read_measurements(file, cartpole());
+  const MeasurementSet set = read_measurements(file, test::cartpole_signature());
   EXPECT_EQ(set.system.name, "cartpole");
   ASSERT_EQ(set.episodes.size(), 2u);
   EXPECT_EQ(set.sample_count(), 5);
@@ -84,7 +79,7 @@ TEST(MeasurementsCsv, AcceptsCrlfByteOrderMarkMissingFinalNewlineAndTrailingBlan
            {"no_final_newline.csv", header + rows},
            {"trailing_blank_lines.csv", header + rows + "\r\n\r\n  \n\n"}}) {
     SCOPED_TRACE(name);
-    const MeasurementSet set = read_measurements_csv(test::write_text(dir / name, text), cartpole());
+    const MeasurementSet set = read_measurements_csv(test::write_text(dir / name, text), test::cartpole_signature());
     ASSERT_EQ(set.episodes.size(), 1u);
     EXPECT_EQ(set.episodes[0].length(), 3);
     EXPECT_EQ(set.episodes[0].u(2, 0), 5.0);
@@ -97,7 +92,7 @@ TEST(MeasurementsCsv, HeaderWithoutEpisodeColumnIsOneEpisode) {
   const auto dir = test::temporary_dir("measurements");
   const MeasurementSet set = read_measurements(
       test::write_text(dir / "record.csv", "t,x,x_dot,theta,theta_dot,force\n0,1,2,3,4,5\n0.5,1.5,2,3,4,6\n1,2,2,3,4,7\n"),
-      cartpole());
+      test::cartpole_signature());
   ASSERT_EQ(set.episodes.size(), 1u);
   EXPECT_EQ(set.episodes[0].id, 0);
   EXPECT_EQ(set.episodes[0].length(), 3);
@@ -106,7 +101,7 @@ TEST(MeasurementsCsv, HeaderWithoutEpisodeColumnIsOneEpisode) {
   EXPECT_EQ(set.episodes[0].u(2, 0), 7.0);
   try {
     read_measurements(test::write_text(dir / "short_row.csv", "t,x,x_dot,theta,theta_dot,force\n0,1,2,3,4,5\n0.5,1,2,3,4\n"),
-                      cartpole());
+                      test::cartpole_signature());
     FAIL() << "a short row was accepted";
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("line 3: the row has 5 fields; expected 6 fields (t,x,x_dot,theta,theta_dot,force)"),
@@ -120,10 +115,10 @@ TEST(MeasurementsCsv, AcceptsDtWithinRelativeToleranceAndRejectsBeyond) {
   // 0.03331 differs by 3e-4 (rejected).
   const auto ok =
       test::write_text(dir / "ok.csv", kHeader + "0,0,0,0,0,0,0\n0,0.0333,0,0,0,0,0\n0,0.06660001,0,0,0,0,0\n");
-  EXPECT_NO_THROW(read_measurements(ok, cartpole()));
+  EXPECT_NO_THROW(read_measurements(ok, test::cartpole_signature()));
   const auto bad =
       test::write_text(dir / "bad.csv", kHeader + "0,0,0,0,0,0,0\n0,0.0333,0,0,0,0,0\n0,0.06661,0,0,0,0,0\n");
-  const std::string error = data_error_of([&] { read_measurements(bad, cartpole()); });
+  const std::string error = data_error_of([&] { read_measurements(bad, test::cartpole_signature()); });
   EXPECT_NE(error.find("bad.csv:line 4: "), std::string::npos) << error;
 }
 
@@ -225,7 +220,7 @@ class BadCsv : public ::testing::TestWithParam<BadCsvCase> {};
 TEST_P(BadCsv, IsRejectedWithFileLineAndExpectation) {
   const BadCsvCase& c = GetParam();
   const auto file = test::write_text(test::temporary_dir("measurements") / (c.name + ".csv"), c.text);
-  const std::string error = data_error_of([&] { read_measurements(file, cartpole()); });
+  const std::string error = data_error_of([&] { read_measurements(file, test::cartpole_signature()); });
   EXPECT_EQ(error.rfind(file.string() + ":line ", 0), 0u)
       << "the error should start with the file and line: " << error;
   EXPECT_NE(error.find("; expected "), std::string::npos) << error;
@@ -239,7 +234,7 @@ INSTANTIATE_TEST_SUITE_P(Measurements, BadCsv, ::testing::ValuesIn(kBadCsvCases)
 TEST(MeasurementsCsv, ErrorCarriesFileAndLocation) {
   const auto file = test::write_text(test::temporary_dir("measurements") / "fields.csv", kHeader + kRow0a + "0,1\n");
   try {
-    read_measurements_csv(file, cartpole());
+    read_measurements_csv(file, test::cartpole_signature());
     FAIL() << "no error";
   } catch (const DataError& e) {
     EXPECT_EQ(e.file(), file);
@@ -252,18 +247,18 @@ TEST(MeasurementsCsv, ErrorCarriesFileAndLocation) {
 
 TEST(Measurements, MissingFileAndUnknownExtensionAreDataErrors) {
   const auto dir = test::temporary_dir("measurements");
-  EXPECT_EQ(data_error_of([&] { read_measurements(dir / "absent.csv", cartpole()); }),
+  EXPECT_EQ(data_error_of([&] { read_measurements(dir / "absent.csv", test::cartpole_signature()); }),
             (dir / "absent.csv").string() + ": no such file; expected a measurement file");
-  EXPECT_EQ(data_error_of([&] { read_measurements(dir / "absent.h5", cartpole()); }),
+  EXPECT_EQ(data_error_of([&] { read_measurements(dir / "absent.h5", test::cartpole_signature()); }),
             (dir / "absent.h5").string() + ": no such file; expected a measurement file");
   const auto text = test::write_text(dir / "data.txt", kHeader + kRow0a + kRow0b);
-  const std::string error = data_error_of([&] { read_measurements(text, cartpole()); });
+  const std::string error = data_error_of([&] { read_measurements(text, test::cartpole_signature()); });
   EXPECT_NE(
       error.find("data.txt: unknown measurement file extension '.txt'; expected '.csv', '.h5' or '.hdf5'"),
       std::string::npos)
       << error;
   const auto not_hdf5 = test::write_text(dir / "data.h5", kHeader + kRow0a + kRow0b);
-  EXPECT_NE(data_error_of([&] { read_measurements(not_hdf5, cartpole()); }).find("data.h5: not an HDF5 file"),
+  EXPECT_NE(data_error_of([&] { read_measurements(not_hdf5, test::cartpole_signature()); }).find("data.h5: not an HDF5 file"),
             std::string::npos);
 }
 
@@ -272,7 +267,7 @@ TEST(Measurements, MissingFileAndUnknownExtensionAreDataErrors) {
 
 MeasurementSet awkward_set() {
   MeasurementSet set;
-  set.system = cartpole();
+  set.system = test::cartpole_signature();
   const std::vector<double> specials = {0.1,
                                         1.0 / 3.0,
                                         -0.0,
@@ -326,10 +321,10 @@ TEST(Measurements, RoundTripCsvHdf5CsvIsBitForBit) {
   const auto dir = test::temporary_dir("measurements");
   const MeasurementSet original = awkward_set();
   write_measurements(dir / "first.csv", original);
-  const MeasurementSet from_csv = read_measurements(dir / "first.csv", cartpole());
+  const MeasurementSet from_csv = read_measurements(dir / "first.csv", test::cartpole_signature());
   expect_same_set(original, from_csv);
   write_measurements(dir / "copy.h5", from_csv);
-  const MeasurementSet from_hdf5 = read_measurements(dir / "copy.h5", cartpole());
+  const MeasurementSet from_hdf5 = read_measurements(dir / "copy.h5", test::cartpole_signature());
   expect_same_set(original, from_hdf5);
   write_measurements(dir / "second.csv", from_hdf5);
   const std::string first = test::read_text(dir / "first.csv"), second = test::read_text(dir / "second.csv");
@@ -360,7 +355,7 @@ TEST(Measurements, WritersRefuseSetsTheReadersWouldReject) {
 
 MeasurementSet small_set() {
   MeasurementSet set;
-  set.system = cartpole();
+  set.system = test::cartpole_signature();
   for (long id : {10L, 2L}) {
     Episode e;
     e.id = id;
@@ -394,10 +389,10 @@ TEST(MeasurementsHdf5, OrdersEpisodesByNumberAndAcceptsFixedLengthStrings) {
     H5::H5File h5(file.c_str(), H5F_ACC_RDWR);
     H5::Group root = h5.openGroup("/");
     write_fixed_strings(root, "system", {"cartpole"}, H5T_STR_NULLTERM, true);
-    write_fixed_strings(root, "state_names", names_of(cartpole().states), H5T_STR_NULLPAD, false);
-    write_fixed_strings(root, "control_names", names_of(cartpole().controls), H5T_STR_SPACEPAD, false);
+    write_fixed_strings(root, "state_names", names_of(test::cartpole_signature().states), H5T_STR_NULLPAD, false);
+    write_fixed_strings(root, "control_names", names_of(test::cartpole_signature().controls), H5T_STR_SPACEPAD, false);
   }
-  const MeasurementSet set = read_measurements(file, cartpole());
+  const MeasurementSet set = read_measurements(file, test::cartpole_signature());
   ASSERT_EQ(set.episodes.size(), 2u);
   EXPECT_EQ(set.episodes[0].id, 2);  // "10" < "2" as names, but 2 < 10 as numbers
   EXPECT_EQ(set.episodes[1].id, 10);
@@ -539,7 +534,7 @@ TEST_P(BadHdf5, IsRejectedWithFileDatasetAndExpectation) {
     H5::H5File h5(file.c_str(), H5F_ACC_RDWR);
     c.mutate(h5);
   }
-  const std::string error = data_error_of([&] { read_measurements(file, cartpole()); });
+  const std::string error = data_error_of([&] { read_measurements(file, test::cartpole_signature()); });
   EXPECT_EQ(error.rfind(file.string() + ":", 0), 0u) << "the error should start with the file: " << error;
   EXPECT_NE(error.find("; expected "), std::string::npos) << error;
   for (const std::string& part : c.expected)
@@ -554,7 +549,7 @@ INSTANTIATE_TEST_SUITE_P(Measurements, BadHdf5, ::testing::ValuesIn(kBadHdf5Case
 
 TEST(Measurements, SummarizeMatchesHandComputedStatistics) {
   MeasurementSet set;
-  set.system = cartpole();
+  set.system = test::cartpole_signature();
   Episode a;  // dt 0.5, 3 samples
   a.id = 0;
   a.t = (Vector(3) << 0.0, 0.5, 1.0).finished();

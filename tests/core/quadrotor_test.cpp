@@ -23,13 +23,6 @@ namespace {
 using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 
-// Central differences with step h: truncation ~ h^2 |f'''| / 6, round-off ~ eps |f| / h. With
-// h = 1e-6 and |f|, |f'''| up to ~50 on these states (thrust / mass <= 40 m/s^2, |w| <= 3 rad/s) the
-// truncation is ~1e-11 and the round-off ~1e-8, so 1e-7 times the magnitude of f leaves a margin of
-// 10 while any wrong term (O(0.01) or larger) fails.
-constexpr double kStep = 1e-6;
-constexpr double kFdTolerance = 1e-7;
-
 // |r| below which quadrotor.cpp evaluates the rotation coefficients by their series.
 constexpr double kSeriesSwitch = 1.0;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
@@ -111,12 +104,12 @@ TEST(Quadrotor, AnalyticJacobiansMatchCentralDifferences) {
       DynamicsJacobians jac;
       Vector xdot(12);
       quad.evaluate(x, u, xdot, &jac);
-      const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return quad.f(xs, u); }, x, kStep);
-      const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return quad.f(x, us); }, u, kStep);
+      const Matrix fx = test::numeric_jacobian([&](const Vector& xs) { return quad.f(xs, u); }, x, test::kFdStep);
+      const Matrix fu = test::numeric_jacobian([&](const Vector& us) { return quad.f(x, us); }, u, test::kFdStep);
       const double scale = std::max(1.0, xdot.cwiseAbs().maxCoeff());
-      EXPECT_TRUE(test::matrices_near(jac.fx, fx, kFdTolerance * scale, kFdTolerance))
+      EXPECT_TRUE(test::matrices_near(jac.fx, fx, test::kFdTolerance * scale, test::kFdTolerance))
           << "|r| = " << x.segment<3>(kR).norm() << ", x = " << x.transpose();
-      EXPECT_TRUE(test::matrices_near(jac.fu, fu, kFdTolerance * scale, kFdTolerance))
+      EXPECT_TRUE(test::matrices_near(jac.fu, fu, test::kFdTolerance * scale, test::kFdTolerance))
           << "|r| = " << x.segment<3>(kR).norm() << ", x = " << x.transpose();
       EXPECT_MATRIX_NEAR(xdot, quad.f(x, u), 0.0);  // the Jacobian path does not change f
     }
@@ -159,9 +152,9 @@ TEST(Quadrotor, InputMatrixIsFuAndItsDerivativeMatchesCentralDifferences) {
             quad.evaluate(xs, u, f, &jj);
             return Vector(jj.fu.col(j));
           },
-          x, kStep);
+          x, test::kFdStep);
       // fu is O(1) (|R e3| / m, rho / J), so the round-off of the differences is ~eps / h.
-      EXPECT_MATRIX_NEAR(b.d_dx[static_cast<std::size_t>(j)], db, kFdTolerance);
+      EXPECT_MATRIX_NEAR(b.d_dx[static_cast<std::size_t>(j)], db, test::kFdTolerance);
       EXPECT_MATRIX_NEAR(b.d_du[static_cast<std::size_t>(j)], Matrix::Zero(12, 4), 0.0);
     }
   }

@@ -30,7 +30,7 @@ fs::path write_text(const fs::path& file, const std::string& text) {
   return file;
 }
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 
 TEST(Cli, HelpListsTheDataCommand) {
   const auto result = test::run_cli("--help");

@@ -26,11 +26,11 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 
 constexpr int kEpisodes = 7;
 constexpr int kSamples = 120;
-constexpr double kDt = 0.02;
+constexpr double kLogDt = 0.02;
 constexpr int kFine = 40;  ///< simulation steps per sample: 0.5 ms, so +-5% jitter is +-2 fine steps
 constexpr double kMu = 1.2;
 
@@ -51,7 +51,7 @@ std::vector<LoggedEpisode> simulate_logs(bool jitter, std::uint64_t seed) {
   ModelSpec spec;
   spec = spec.with(find_effect("cartpole", "cart_coulomb_friction"), Vector::Constant(1, kMu));
   const DynamicsPtr world = spec.build(test::actuator_noise(1, 0.02));
-  const double fine = kDt / kFine;
+  const double fine = kLogDt / kFine;
   const auto model = make_step_model(world, Integrator::RK4, fine, 1);
   std::mt19937_64 rng(seed), jitter_rng(seed + 1000);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
@@ -93,7 +93,7 @@ MeasurementSet as_measurements(const std::vector<LoggedEpisode>& logs) {
     Episode episode;
     episode.id = static_cast<long>(e);
     episode.t.resize(kSamples);
-    for (int k = 0; k < kSamples; ++k) episode.t(k) = k * kDt;
+    for (int k = 0; k < kSamples; ++k) episode.t(k) = k * kLogDt;
     episode.x = logs[e].x;
     episode.u = Eigen::Map<const Vector>(logs[e].u.data(), kSamples);
     set.episodes.push_back(std::move(episode));
@@ -166,7 +166,7 @@ struct Diagnosis {
   double value = 0.0;
 };
 
-Diagnosis diagnose(const fs::path& data) {
+Diagnosis diagnosis_of(const fs::path& data) {
   const auto result = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --json --gp-points 100 --gp-restarts 0");
   EXPECT_EQ(result.status, 0) << result.err;
   if (result.status != 0) return {};
@@ -192,12 +192,12 @@ class DataImportDefects : public ::testing::Test {
     dir = test::temporary_dir("data_import");
     clean_logs = simulate_logs(false, 5);
     write_measurements(dir / "clean.csv", as_measurements(clean_logs));
-    clean = diagnose(dir / "clean.csv");
+    clean = diagnosis_of(dir / "clean.csv");
   }
   /// The imported file's diagnosis names the clean data's effect, with mu within 20% of its value.
   void expect_same_diagnosis(const fs::path& imported, const std::string& defect) const {
     ASSERT_EQ(clean.effect, "cart_coulomb_friction") << "the clean data must show the hidden effect";
-    const Diagnosis d = diagnose(imported);
+    const Diagnosis d = diagnosis_of(imported);
     std::cout << "[ diagnosis ] " << defect << ": " << d.effect << " mu = " << d.value << " (clean: " << clean.value << ")\n";
     EXPECT_EQ(d.effect, clean.effect) << defect;
     EXPECT_NEAR(d.value, clean.value, 0.2 * clean.value) << defect;
@@ -230,8 +230,8 @@ TEST_F(DataImportDefects, TimestampJitterIsResampled) {
   EXPECT_EQ(report["rows"]["dropped"], 0);
   EXPECT_EQ(report["dt_source"], "map");
   EXPECT_EQ(report["controls"], "average");
-  EXPECT_GT(report["logged_step"]["max"].get<double>(), kDt);  // the jitter is there
-  EXPECT_LT(report["logged_step"]["min"].get<double>(), kDt);
+  EXPECT_GT(report["logged_step"]["max"].get<double>(), kLogDt);  // the jitter is there
+  EXPECT_LT(report["logged_step"]["min"].get<double>(), kLogDt);
   expect_same_diagnosis(dir / "jitter.h5", "jitter");
 }
 
@@ -258,7 +258,7 @@ TEST_F(DataImportDefects, ADroppedBlockSplitsAnEpisode) {
   EXPECT_EQ(report["rows"]["read"], kEpisodes * kSamples - 20);
   EXPECT_EQ(report["samples_written"], kEpisodes * kSamples - 20);
   EXPECT_EQ(report["dt_source"], "median step");
-  EXPECT_NEAR(report["dt"].get<double>(), kDt, 1e-12);
+  EXPECT_NEAR(report["dt"].get<double>(), kLogDt, 1e-12);
   expect_same_diagnosis(dir / "dropped.h5.out.h5", "dropped block");
 }
 
@@ -285,7 +285,7 @@ TEST_F(DataImportDefects, ExtraColumnsAreIgnoredAndListed) {
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["ignored_columns"], json({"battery_v", "motor_temp", "mode"}));
   EXPECT_EQ(report["rows"]["dropped"], 0);
-  EXPECT_NEAR(report["dt"].get<double>(), kDt, 1e-12);
+  EXPECT_NEAR(report["dt"].get<double>(), kLogDt, 1e-12);
   // The text report says the same.
   const auto text = test::run_cli("data import " + quote(log) + " --system cartpole --map " + quote(map) + " --out " +
                                   quote(dir / "extra.csv.out.csv"));
@@ -339,7 +339,7 @@ TEST_F(DataImportDefects, PositionsOnlyGetEstimatedVelocities) {
   ASSERT_FALSE(report.is_null());
   EXPECT_EQ(report["velocities"]["estimated"], json({{"x_dot", "x"}, {"theta_dot", "theta"}}));
   EXPECT_EQ(report["velocities"]["lag_s"], 0.0);
-  EXPECT_NEAR(report["velocities"]["noise_gain"].get<double>(), SavitzkyGolayDerivative(9, 4).noise_gain(kDt), 1e-9);
+  EXPECT_NEAR(report["velocities"]["noise_gain"].get<double>(), SavitzkyGolayDerivative(9, 4).noise_gain(kLogDt), 1e-9);
   std::cout << "[ estimator ] noise gain " << report["velocities"]["noise_gain"] << " /s\n";
   expect_same_diagnosis(dir / "positions.h5", "positions only");
 }

@@ -24,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 
 /// A small cart-pole set with hidden Coulomb friction, mu = 1.2 N.
 fs::path friction_csv(const fs::path& dir) {
@@ -35,7 +35,6 @@ fs::path friction_csv(const fs::path& dir) {
   return file;
 }
 
-const std::string kFast = " --gp-points 100 --gp-restarts 0";
 
 bool has_no_nan(const json& j) {
   if (j.is_number_float()) return std::isfinite(j.get<double>());
@@ -48,7 +47,7 @@ bool has_no_nan(const json& j) {
 TEST(DiagnoseCli, JsonHasTheFixedKeysAndNamesTheHiddenEffect) {
   const fs::path dir = test::temporary_dir("diagnose_json");
   const fs::path data = friction_csv(dir);
-  const auto result = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --json" + kFast);
+  const auto result = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --json" + test::kFastDiagnose);
   ASSERT_EQ(result.status, 0) << result.err;
   const json j = json::parse(result.out);  // one document and nothing else
   for (const char* key : {"system", "samples", "heldout_episodes", "consistent", "states", "relevance", "ranking", "verdict"})
@@ -72,7 +71,7 @@ TEST(DiagnoseCli, AddWriteModelAndStartTheNextRoundFromIt) {
   const fs::path data = friction_csv(dir);
   const fs::path model = dir / "model1.toml", report = dir / "report.h5";
   const auto added = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --add cart_coulomb_friction --write-model " +
-                                   quote(model) + " --out " + quote(report) + kFast);
+                                   quote(model) + " --out " + quote(report) + test::kFastDiagnose);
   ASSERT_EQ(added.status, 0) << added.err;
   EXPECT_NE(added.out.find("Add it and watch the error fall"), std::string::npos) << added.out;
   EXPECT_NE(added.out.find("sim+effect+GP"), std::string::npos) << added.out;
@@ -89,7 +88,7 @@ TEST(DiagnoseCli, AddWriteModelAndStartTheNextRoundFromIt) {
   const ModelSpec next = diagnosis::read_model_file(model, "cartpole");
   ASSERT_EQ(next.forces.size(), 1u);
   EXPECT_NEAR(next.forces[0].second(0), 1.2, 0.18);
-  const auto again = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --model " + quote(model) + " --json" + kFast);
+  const auto again = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --model " + quote(model) + " --json" + test::kFastDiagnose);
   ASSERT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(json::parse(again.out)["verdict"]["status"], "consistent") << again.out.substr(0, 2000);
 }
@@ -97,7 +96,7 @@ TEST(DiagnoseCli, AddWriteModelAndStartTheNextRoundFromIt) {
 TEST(DiagnoseCli, BadInputIsExitTwoNamingWhatIsWrong) {
   const fs::path dir = test::temporary_dir("diagnose_bad");
   const fs::path data = friction_csv(dir);
-  const std::string base = "diagnose --system cartpole --data " + quote(data) + kFast;
+  const std::string base = "diagnose --system cartpole --data " + quote(data) + test::kFastDiagnose;
   auto unknown = test::run_cli(base + " --add cart_friction");
   EXPECT_EQ(unknown.status, 2);
   EXPECT_EQ(unknown.err.rfind("error:", 0), 0u) << unknown.err;
@@ -150,7 +149,7 @@ TEST(DiagnoseCli, PlotsNeedMatplotlibAndSayWhenItIsMissing) {
   EXPECT_NE(err.find("cannot import matplotlib and h5py"), std::string::npos) << err;
   if (std::system("/usr/bin/python3 -c 'import matplotlib, h5py' >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "/usr/bin/python3 has no matplotlib/h5py: the PNG part is not checked here";
-  const auto ok = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --plots " + quote(dir / "p") + kFast);
+  const auto ok = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --plots " + quote(dir / "p") + test::kFastDiagnose);
   ASSERT_EQ(ok.status, 0) << ok.err;
   for (const char* png : {"measured_vs_predicted.png", "residual_gp_band.png", "ranking.png", "residual_vs_input.png",
                           "residual_whiteness.png", "free_run.png"})
@@ -160,7 +159,7 @@ TEST(DiagnoseCli, PlotsNeedMatplotlibAndSayWhenItIsMissing) {
 TEST(DiagnoseCli, HorizonsAndTheTestsOfSystemIdentificationAreInEveryReport) {
   const fs::path dir = test::temporary_dir("diagnose_sysid");
   const fs::path data = friction_csv(dir), report = dir / "report.h5";
-  const std::string base = "diagnose --system cartpole --data " + quote(data) + kFast;
+  const std::string base = "diagnose --system cartpole --data " + quote(data) + test::kFastDiagnose;
   const auto result = test::run_cli(base + " --horizons 1,5,20 --json --out " + quote(report));
   ASSERT_EQ(result.status, 0) << result.err;
   const json j = json::parse(result.out);
@@ -208,7 +207,7 @@ TEST(DiagnoseCli, HorizonsAndTheTestsOfSystemIdentificationAreInEveryReport) {
 TEST(DiagnoseCli, BadHorizonsAreExitTwoNamingTheOption) {
   const fs::path dir = test::temporary_dir("diagnose_bad_horizons");
   const fs::path data = friction_csv(dir);
-  const std::string base = "diagnose --system cartpole --data " + quote(data) + kFast + " --horizons ";
+  const std::string base = "diagnose --system cartpole --data " + quote(data) + test::kFastDiagnose + " --horizons ";
   for (const std::string value : {"0", "-1", "abc", "1,0", "5,x", "1.5", "2000000", "''"}) {
     const auto r = test::run_cli(base + value);
     EXPECT_EQ(r.status, 2) << value << ": " << r.out;
@@ -315,7 +314,7 @@ TEST(DiagnoseCli, AutoFindsTwoEffectsWritesTheFinalModelAndPlotsThePath) {
   const bool plots = std::system("/usr/bin/python3 -c 'import matplotlib, h5py' >/dev/null 2>&1") == 0;
   const auto result = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --auto --json --write-model " +
                                     quote(model) + " --out " + quote(report) +
-                                    (plots ? " --plots " + quote(dir / "p") : std::string()) + kFast);
+                                    (plots ? " --plots " + quote(dir / "p") : std::string()) + test::kFastDiagnose);
   ASSERT_EQ(result.status, 0) << result.err;
   const json j = json::parse(result.out);
   ASSERT_TRUE(j["selection"].is_object());

@@ -22,9 +22,8 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const std::string kFast = " --gp-points 100 --gp-restarts 0";
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 
 /// The cart-pole's "sim" preset with a little actuator noise: 7 episodes of 120 samples at 0.02 s.
 MeasurementSet plain_data() {
@@ -87,7 +86,7 @@ TEST(DiagnoseDivergence, StatesWhereTheModelBlowsUpAreNotConsistent) {
   const fs::path dir = test::temporary_dir("diagnose_diverging_states");
   MeasurementSet set = plain_data();
   for (Episode& e : set.episodes) e.x *= 1e6;
-  const json j = expect_model_diverges("diagnose --system cartpole --data " + quote(write_csv(dir, "big.csv", set)) + kFast, dir);
+  const json j = expect_model_diverges("diagnose --system cartpole --data " + quote(write_csv(dir, "big.csv", set)) + test::kFastDiagnose, dir);
   // Most windows diverge, and the counts are in the JSON and in the reason.
   const int diverged = j["divergence"]["k_step"]["diverged"], windows = j["divergence"]["k_step"]["windows"];
   EXPECT_GT(2 * diverged, windows) << j["divergence"].dump();
@@ -101,7 +100,7 @@ TEST(DiagnoseDivergence, AHugeTimeStepMakesTheModelDiverge) {
   MeasurementSet set = plain_data();
   for (Episode& e : set.episodes)
     for (Eigen::Index s = 0; s < e.t.size(); ++s) e.t(s) = 1e300 * static_cast<double>(s);
-  const json j = expect_model_diverges("diagnose --system cartpole --data " + quote(write_csv(dir, "dt.csv", set)) + kFast, dir);
+  const json j = expect_model_diverges("diagnose --system cartpole --data " + quote(write_csv(dir, "dt.csv", set)) + test::kFastDiagnose, dir);
   EXPECT_EQ(j["divergence"]["one_step"]["diverged"], j["samples"]);
 }
 
@@ -111,7 +110,7 @@ TEST(DiagnoseDivergence, AModelWithAnAbsurdParameterDiverges) {
   const fs::path data = write_csv(dir, "plain.csv", plain_data());
   const fs::path model = dir / "pole.toml";
   std::ofstream(model) << "[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n[parameters]\npole_length = 1e300\n";
-  const std::string base = "diagnose --system cartpole --data " + quote(data) + " --model " + quote(model) + kFast;
+  const std::string base = "diagnose --system cartpole --data " + quote(data) + " --model " + quote(model) + test::kFastDiagnose;
   expect_model_diverges(base, dir);
   // Adding an effect to it fits and scores the effect with finite numbers, and still says so.
   const auto added = test::run_cli(base + " --add cart_viscous_friction --json");
@@ -128,7 +127,7 @@ TEST(DiagnoseDivergence, MeasurementsBeyondTheBoundAreBadInput) {
   set.episodes[1].x(3, 1) = 1e308;
   set.episodes[1].x(4, 1) = -1e308;
   const fs::path data = write_csv(dir, "cells.csv", set);
-  const auto r = test::run_cli("diagnose --system cartpole --data " + quote(data) + kFast + " --json");
+  const auto r = test::run_cli("diagnose --system cartpole --data " + quote(data) + test::kFastDiagnose + " --json");
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_TRUE(r.out.empty()) << r.out;
   const std::string expected = fmt::format("error: {}: episode {} at t = {}: column 'x_dot' is 1e+308; expected |value| <= 1e+12",
@@ -137,7 +136,7 @@ TEST(DiagnoseDivergence, MeasurementsBeyondTheBoundAreBadInput) {
   // A control beyond the bound too.
   set = plain_data();
   set.episodes[0].u(2, 0) = -2e12;
-  const auto control = test::run_cli("diagnose --system cartpole --data " + quote(write_csv(dir, "u.csv", set)) + kFast);
+  const auto control = test::run_cli("diagnose --system cartpole --data " + quote(write_csv(dir, "u.csv", set)) + test::kFastDiagnose);
   EXPECT_EQ(control.status, 2);
   EXPECT_NE(control.err.find("column 'force' is -2e+12; expected |value| <= 1e+12"), std::string::npos) << control.err;
 }

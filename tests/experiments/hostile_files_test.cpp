@@ -275,7 +275,7 @@ std::vector<ModelCase> model_cases() {
   };
 }
 
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
+std::string replaced_everywhere(std::string text, const std::string& from, const std::string& to) {
   for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) text.replace(at, from.size(), to);
   return text;
 }
@@ -310,7 +310,7 @@ TEST(HostileFiles, EveryFileAMujocoModelNamesIsCheckedBeforeMujocoOpensIt) {
       std::rethrow_exception(*outcome);
     } catch (const std::exception& e) {
       const std::string expected =
-          (dir / c.bad).string() + ": " + replaced(replaced(c.problem, "MAIN", model.string()), "DIR", dir.string());
+          (dir / c.bad).string() + ": " + replaced_everywhere(replaced_everywhere(c.problem, "MAIN", model.string()), "DIR", dir.string());
       EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what() << "\nexpected\n" << expected;
     }
   }
@@ -373,7 +373,7 @@ TEST(HostileFiles, AnOutputThatIsAnInputIsExit2AndTheInputIsKept) {
       {"merge " + test::quote(policy) + " " + test::quote(part) + " --no-plots --out {out}", part, "PART " + part.string(), part},
   };
   for (const Case& c : cases) {
-    const std::string arguments = replaced(c.arguments, "{out}", test::quote(c.out));
+    const std::string arguments = replaced_everywhere(c.arguments, "{out}", test::quote(c.out));
     SCOPED_TRACE(arguments);
     const std::string kept = test::read_text(c.input_file);
     const auto r = run_cli(arguments);

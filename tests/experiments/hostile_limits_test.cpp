@@ -23,7 +23,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 
 /// The tiny run config with its first task's name line replaced.
 std::string with_first_task_name(const std::string& name_line) {

@@ -38,12 +38,7 @@ namespace fs = std::filesystem;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
-
-fs::path write(const fs::path& file, const std::string& text) {
-  std::ofstream(file, std::ios::binary) << text;
-  return file;
-}
+using test::quote;
 
 /// `text` with its first `from` replaced by `to`.
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
@@ -70,10 +65,10 @@ TEST(HostileValues, AnOutputNameMustCarryItsFormatsExtension) {
 /// Every output option of a fixed format, with a name of another format: exit 2 before any work.
 TEST(HostileValues, EveryCommandRefusesAnOutputNameOfAnotherFormat) {
   const fs::path dir = test::temporary_dir("hostile_extensions");
-  const std::string plan = quote(write(dir / "plan.toml", test::kTinyPlan));
-  write(dir / "run.toml", test::kTinyRun);
+  const std::string plan = quote(test::write_text(dir / "plan.toml", test::kTinyPlan));
+  test::write_text(dir / "run.toml", test::kTinyRun);
   const std::string sweep =
-      quote(write(dir / "sweep.toml", "system = \"cartpole\"\nconfig = \"run.toml\"\n[grid]\n\"loop.rollouts\" = [1, 2]\n"));
+      quote(test::write_text(dir / "sweep.toml", "system = \"cartpole\"\nconfig = \"run.toml\"\n[grid]\n\"loop.rollouts\" = [1, 2]\n"));
   struct Case {
     std::string arguments, message;
   };
@@ -105,7 +100,7 @@ TEST(HostileValues, EveryCommandRefusesAnOutputNameOfAnotherFormat) {
 
 TEST(HostileValues, AnEmptyBackendListIsRefusedNamingTheOption) {
   const fs::path dir = test::temporary_dir("hostile_backends");
-  const std::string run = "run cartpole --no-plots --config " + quote(write(dir / "run.toml", test::kTinyRun));
+  const std::string run = "run cartpole --no-plots --config " + quote(test::write_text(dir / "run.toml", test::kTinyRun));
   for (const char* list : {"''", "','", "'exact,'"}) {
     const auto r = test::run_cli(fmt::format("{} --backends {} --out {}", run, list, quote(dir / "never.h5")));
     EXPECT_EQ(r.status, 2) << list << "\n" << r.err;
@@ -232,7 +227,7 @@ TEST(HostileValues, RolloutAndPlanRefuseABadPolicyWithExit2) {
   set_attribute(crossed, "u_min", {30.0});
   write_policy_file(other, small_policy(), nullptr);
   set_string_attribute(other, "system", "quadrotor");
-  const std::string plan = quote(write(dir / "plan.toml", replaced(test::kTinyPlan, "horizon = 15", "horizon = 2")));
+  const std::string plan = quote(test::write_text(dir / "plan.toml", replaced(test::kTinyPlan, "horizon = 15", "horizon = 2")));
   struct Case {
     std::string arguments, message;
   };
@@ -323,7 +318,7 @@ Q = [1e150, 1.0, 1.0, 1.0]
 R = [0.1]
 Qf = [10.0, 10.0, 10.0, 10.0]
 )";
-  const auto r = test::run_cli("solve " + quote(write(dir / "overflow.toml", text)));
+  const auto r = test::run_cli("solve " + quote(test::write_text(dir / "overflow.toml", text)));
   EXPECT_NE(r.err.find("warning: not converged: the initial controls keep every state within the divergence bound "
                        "(|x| <= 1e+12), but their cost overflowed"),
             std::string::npos)
@@ -375,7 +370,7 @@ TEST(HostileValues, ModelNamesThatACsvCannotHoldAreRefusedOnLoading) {
   EXPECT_EQ(column_name_problem("a b\"c "), std::nullopt);  // read back as written: fields are not trimmed
   const fs::path dir = test::temporary_dir("hostile_names");
   const auto model = [&](const std::string& file, const std::string& joint, const std::string& actuator) {
-    return write(dir / file, fmt::format(R"(<mujoco model="m">
+    return test::write_text(dir / file, fmt::format(R"(<mujoco model="m">
   <worldbody><body name="b"><joint name="{}" type="slide" axis="1 0 0"/><geom type="box" size="0.1 0.1 0.1" mass="1"/></body></worldbody>
   <actuator><motor name="{}" joint="{}"/></actuator>
 </mujoco>)",

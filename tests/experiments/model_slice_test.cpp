@@ -22,7 +22,7 @@
 namespace gpilqg {
 namespace {
 
-constexpr double kDt = 0.1;
+constexpr double kSliceDt = 0.1;
 
 /// x' = x + dt (A x + B u) with two states and one control; the real world adds
 /// dt 0.8 sin(2 x_0) to x'_1.
@@ -31,11 +31,11 @@ class TwoStateSystem final : public StepModel {
   explicit TwoStateSystem(bool real) : real_(real) {}
   int state_dim() const override { return 2; }
   int control_dim() const override { return 1; }
-  double dt() const override { return kDt; }
+  double dt() const override { return kSliceDt; }
   void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians*) const override {
-    x_next(0) = x(0) + kDt * x(1);
-    x_next(1) = x(1) + kDt * (-0.5 * x(1) + u(0));
-    if (real_) x_next(1) += kDt * residual(x(0));
+    x_next(0) = x(0) + kSliceDt * x(1);
+    x_next(1) = x(1) + kSliceDt * (-0.5 * x(1) + u(0));
+    if (real_) x_next(1) += kSliceDt * residual(x(0));
   }
   static double residual(double x0) { return 0.8 * std::sin(2.0 * x0); }
 
@@ -143,7 +143,7 @@ TEST_F(KnownSlice, DrawsOnlyMeasurementsWithinOneLengthScaleWithTheirResiduals) 
     EXPECT_EQ(slice_.data_z(i), data_.x(r, 0));
     EXPECT_EQ(slice_.data_y(i), data_.x_next(r, 1));
     // The measured residual is the known one plus the measurement noise (std 0.005).
-    EXPECT_NEAR(slice_.data_residual(i), kDt * TwoStateSystem::residual(data_.x(r, 0)), 0.025);
+    EXPECT_NEAR(slice_.data_residual(i), kSliceDt * TwoStateSystem::residual(data_.x(r, 0)), 0.025);
   }
   EXPECT_EQ(matched, slice_.data_z.size());
 }

@@ -24,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 std::string arm() { return quote(test::source_dir() / "data" / "two_link_arm.xml"); }
 
 /// `gpilqg simulate` of the arm with `world` (e.g. "--param elbow.damping=0.35"): 8 episodes of 200

@@ -22,15 +22,15 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
-fs::path pendulum() { return test::source_dir() / "data" / "pendulum_passive.xml"; }
+using test::quote;
+fs::path pendulum_model() { return test::source_dir() / "data" / "pendulum_passive.xml"; }
 fs::path urdf_arm() { return test::source_dir() / "data" / "two_link_arm.urdf"; }
 
 /// Free swings of the pendulum with `world` (e.g. "--param swing.damping=0.3"): 6 episodes of 150
 /// samples at 0.02 s, sensor noise 0.001.
 fs::path simulate_pendulum(const fs::path& dir, const std::string& world) {
   const fs::path file = dir / "swing.csv";
-  const auto r = test::run_cli("simulate --system " + quote(pendulum()) + " " + world +
+  const auto r = test::run_cli("simulate --system " + quote(pendulum_model()) + " " + world +
                                " --episodes 6 --steps 150 --observation-noise 0.001 --seed 2 --out " + quote(file));
   EXPECT_EQ(r.status, 0) << r.err;
   return file;
@@ -43,20 +43,20 @@ TEST(PassiveCli, SimulateWritesStatesOnlyAndDataInfoReadsThem) {
   std::string header;
   std::getline(in, header);
   EXPECT_EQ(header, "episode,t,swing,swing_dot");
-  const auto info = test::run_cli("data info " + quote(data) + " --system " + quote(pendulum()) + " --json");
+  const auto info = test::run_cli("data info " + quote(data) + " --system " + quote(pendulum_model()) + " --json");
   ASSERT_EQ(info.status, 0) << info.err;
   const json j = json::parse(info.out);
   EXPECT_EQ(j["system"], "pendulum_passive");
   EXPECT_EQ(j["episodes"], 6) << info.out;
-  const auto text = test::run_cli("data info " + quote(data) + " --system " + quote(pendulum()));
+  const auto text = test::run_cli("data info " + quote(data) + " --system " + quote(pendulum_model()));
   EXPECT_EQ(text.status, 0) << text.err;
   // The free swings span the angle: the initial states are spread, there is no other excitation.
-  const auto h5 = test::run_cli("simulate --system " + quote(pendulum()) + " --episodes 2 --steps 20 --out " +
+  const auto h5 = test::run_cli("simulate --system " + quote(pendulum_model()) + " --episodes 2 --steps 20 --out " +
                                 quote(dir / "swing.h5"));
   ASSERT_EQ(h5.status, 0) << h5.err;
-  EXPECT_EQ(test::run_cli("data info " + quote(dir / "swing.h5") + " --system " + quote(pendulum())).status, 0);
+  EXPECT_EQ(test::run_cli("data info " + quote(dir / "swing.h5") + " --system " + quote(pendulum_model())).status, 0);
   // No actuators, no actuator noise.
-  const auto noisy = test::run_cli("simulate --system " + quote(pendulum()) + " --actuator-noise 0.1 --out " +
+  const auto noisy = test::run_cli("simulate --system " + quote(pendulum_model()) + " --actuator-noise 0.1 --out " +
                                    quote(dir / "noisy.csv"));
   EXPECT_EQ(noisy.status, 2);
   EXPECT_NE(noisy.err.find("--actuator-noise"), std::string::npos) << noisy.err;
@@ -70,7 +70,7 @@ TEST(PassiveCli, DiagnoseFindsAHiddenJointDamping) {
   // One run: the text report on stdout, the JSON document inside the HDF5 report, and the plots
   // (when /usr/bin/python3 has matplotlib and h5py).
   const bool plots = std::system("/usr/bin/python3 -c 'import matplotlib, h5py' >/dev/null 2>&1") == 0;
-  const auto r = test::run_cli("diagnose --system " + quote(pendulum()) + " --data " + quote(data) +
+  const auto r = test::run_cli("diagnose --system " + quote(pendulum_model()) + " --data " + quote(data) +
                                " --gp-points 100 --out " + quote(report) +
                                (plots ? " --plots " + quote(dir / "p") : std::string()));
   ASSERT_EQ(r.status, 0) << r.err;
@@ -117,7 +117,7 @@ TEST(PassiveCli, DiagnoseFindsAHiddenJointDamping) {
 
 TEST(PassiveCli, SolvePlanRolloutAndRunRefuseAPassiveSystem) {
   const fs::path dir = test::temporary_dir("passive_refusals");
-  fs::copy_file(pendulum(), dir / "pendulum.xml");
+  fs::copy_file(pendulum_model(), dir / "pendulum.xml");
   std::ofstream(dir / "solve.toml") << "[system]\nname = \"pendulum.xml\"\ndt = 0.02\n"
                                        "[problem]\nhorizon = 10\nx0 = [0, 0]\ngoal = [0, 0]\nQ = [1, 1]\nR = []\n"
                                        "Qf = [1, 1]\n";

@@ -20,10 +20,10 @@
 namespace gpilqg {
 namespace {
 
-constexpr double kDt = 0.05;
+constexpr double kPendulumDt = 0.05;
 constexpr int kT = 40;
 
-std::shared_ptr<const Dynamics> pendulum() {
+std::shared_ptr<const Dynamics> pendulum_dynamics() {
   return std::make_shared<FiniteDifferenceDynamics>(
       "pendulum", std::vector<Quantity>{{"theta", "rad"}, {"omega", "rad/s"}}, std::vector<Quantity>{{"torque", "N m"}},
       std::vector<Parameter>{}, [](const Vector& x, const Vector& u, Vector& xdot) {
@@ -40,10 +40,10 @@ double true_cost(const StepModel& model, const Cost& cost, const Matrix& u) {
 }
 
 TEST(PddpWithGp, WithAbundantDataItApproachesIlqrOnTheTrueSystem) {
-  IntegratedStepModel truth(pendulum(), Integrator::RK4, kDt);
+  IntegratedStepModel truth(pendulum_dynamics(), Integrator::RK4, kPendulumDt);
   Vector goal(2);
   goal << 1.0, 0.0;
-  const QuadraticCost cost(kDt, Vector(Eigen::Vector2d(1.0, 0.1)).asDiagonal(), Matrix::Constant(1, 1, 0.1),
+  const QuadraticCost cost(kPendulumDt, Vector(Eigen::Vector2d(1.0, 0.1)).asDiagonal(), Matrix::Constant(1, 1, 0.1),
                            Vector(Eigen::Vector2d(100.0, 10.0)).asDiagonal(), goal);
 
   // 300 measured transitions spread over the region the task visits, with measurement noise 1e-3
@@ -65,7 +65,7 @@ TEST(PddpWithGp, WithAbundantDataItApproachesIlqrOnTheTrueSystem) {
   fit.restarts = 1;
   const gp::ExactGpBackend backend;
   std::vector<gp::FitSummary> summaries;
-  const auto dynamics = gp::GpBeliefDynamics::fit(2, 1, kDt, inputs, increments, backend, fit, &summaries);
+  const auto dynamics = gp::GpBeliefDynamics::fit(2, 1, kPendulumDt, inputs, increments, backend, fit, &summaries);
   for (const auto& s : summaries) std::printf("%s\n", s.one_line().c_str());
 
   PddpProblem pddp{&dynamics, &cost, Vector::Zero(2), Matrix::Zero(2, 2), kT, {}, {}};

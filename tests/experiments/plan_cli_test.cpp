@@ -24,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 
 /// One cart-pole task and the loop of the run below, as a `gpilqg run` override ...
 constexpr const char* kRunConfig = R"(
@@ -64,11 +64,6 @@ transfer = false
 constexpr const char* kRolloutOptions =
     " --multiplicative-noise 0.02 --observation-noise 0.001 --exploration 2 --episodes 2";
 
-fs::path write(const fs::path& file, const std::string& text) {
-  std::ofstream(file) << text;
-  return file;
-}
-
 /// test::kTinyPlan with its first `from` replaced by `to`.
 std::string tiny_plan_with(const std::string& from, const std::string& to) {
   std::string text = test::kTinyPlan;
@@ -100,10 +95,10 @@ TEST(PlanCli, AScriptedLoopOfPlanAndRolloutGivesRunsGpIlqgPolicies) {
   // One code path: `gpilqg run`'s gp_ilqg and a loop of plan (fit, solve) and rollout (the world, its
   // noise and the exploration) with the same seed draw the same numbers and solve the same problems.
   const fs::path dir = test::temporary_dir("plan_loop");
-  const auto run = test::run_cli("run cartpole --config " + quote(write(dir / "run.toml", kRunConfig)) +
+  const auto run = test::run_cli("run cartpole --config " + quote(test::write_text(dir / "run.toml", kRunConfig)) +
                                  " --seeds 1 --first-seed 7 --out " + quote(dir / "run.h5"));
   ASSERT_EQ(run.status, 0) << run.err;
-  scripted_loop(dir, write(dir / "plan.toml", test::kTinyPlan), 3, 7);
+  scripted_loop(dir, test::write_text(dir / "plan.toml", test::kTinyPlan), 3, 7);
   const Hdf5Reader results(dir / "run.h5");
   for (int k = 0; k <= 3; ++k) {
     SCOPED_TRACE(fmt::format("round {}", k));
@@ -128,7 +123,7 @@ TEST(PlanCli, AScriptedLoopOfPlanAndRolloutGivesRunsGpIlqgPolicies) {
 
 TEST(PlanCli, ThePolicyFileHasTheContractsLayoutAndJsonTheSameContent) {
   const fs::path dir = test::temporary_dir("plan_layout");
-  const fs::path config = write(dir / "plan.toml", test::kTinyPlan);
+  const fs::path config = test::write_text(dir / "plan.toml", test::kTinyPlan);
   scripted_loop(dir, config, 1, 3);
   const auto r = plan(config, "--seed 3 --data " + quote(dir / "d0.h5") + " --previous " + quote(dir / "p0.h5") +
                                   " --out " + quote(dir / "p1_json.h5") + " --json");
@@ -173,7 +168,7 @@ TEST(PlanCli, ThePolicyFileHasTheContractsLayoutAndJsonTheSameContent) {
 
 TEST(PlanCli, RolloutLogsTheMeasuredStatesAndAppliedControlsInCsvOrHdf5) {
   const fs::path dir = test::temporary_dir("rollout_log");
-  ASSERT_EQ(plan(write(dir / "plan.toml", test::kTinyPlan), "--out " + quote(dir / "p.h5")).status, 0);
+  ASSERT_EQ(plan(test::write_text(dir / "plan.toml", test::kTinyPlan), "--out " + quote(dir / "p.h5")).status, 0);
   const std::string common = " --system cartpole --policy " + quote(dir / "p.h5") + " --seed 5" + kRolloutOptions;
   for (const char* out : {"log.csv", "log.h5"}) {
     const auto r = test::run_cli("rollout" + common + " --out " + quote(dir / out));
@@ -211,7 +206,7 @@ TEST(PlanCli, ARoundOnAMujocoModelWithItsWorldGivenAsAFile) {
   // The arm of data/: plan on the model, roll out on a heavier arm given as a second file (the same
   // log as the parameter overrides), plan again on that log.
   const fs::path dir = test::temporary_dir("plan_mujoco");
-  const fs::path config = write(dir / "arm_plan.toml", fmt::format(R"([system]
+  const fs::path config = test::write_text(dir / "arm_plan.toml", fmt::format(R"([system]
 name = {}
 dt = 0.05
 [noise]
@@ -264,7 +259,7 @@ void expect_bad_input(const test::CommandResult& r, const std::vector<std::strin
 
 TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   const fs::path dir = test::temporary_dir("plan_errors");
-  const fs::path config = write(dir / "plan.toml", test::kTinyPlan);
+  const fs::path config = test::write_text(dir / "plan.toml", test::kTinyPlan);
   ASSERT_EQ(plan(config, "--out " + quote(dir / "p0.h5")).status, 0);
   const std::string p0 = quote(dir / "p0.h5");
 
@@ -273,23 +268,23 @@ TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   ASSERT_EQ(test::run_cli("simulate --system cartpole --episodes 1 --steps 20 --dt 0.02 --out " + quote(dir / "fast.csv")).status, 0);
   expect_bad_input(plan(config, "--data " + quote(dir / "fast.csv") + " --out " + quote(dir / "x.h5")),
                    {"fast.csv", "episode 0", "0.05"});
-  expect_bad_input(plan(write(dir / "ilqr.toml", tiny_plan_with("max_iterations = 30", "max_iterations = 30\nalgorithm = \"ilqr\"")),
+  expect_bad_input(plan(test::write_text(dir / "ilqr.toml", tiny_plan_with("max_iterations = 30", "max_iterations = 30\nalgorithm = \"ilqr\"")),
                         "--out " + quote(dir / "x.h5")),
                    {"ilqr.toml:line 22", "solver.algorithm"});
-  expect_bad_input(plan(write(dir / "gp.toml", std::string(test::kTinyPlan) + "points = 3\n"), "--out " + quote(dir / "x.h5")),
+  expect_bad_input(plan(test::write_text(dir / "gp.toml", std::string(test::kTinyPlan) + "points = 3\n"), "--out " + quote(dir / "x.h5")),
                    {"gp.toml:line 28", "gp.points"});
   // Sensor noise of the wrong size, and negative; a start beyond the divergence bound (the loader of
   // `gpilqg solve`, shared).
-  expect_bad_input(plan(write(dir / "sensors.toml", tiny_plan_with("observation = [0.001, ", "observation = [")),
+  expect_bad_input(plan(test::write_text(dir / "sensors.toml", tiny_plan_with("observation = [0.001, ", "observation = [")),
                         "--out " + quote(dir / "x.h5")),
                    {"sensors.toml:line 9", "noise.observation"});
-  expect_bad_input(plan(write(dir / "negative.toml", tiny_plan_with("observation = [0.001", "observation = [-0.001")),
+  expect_bad_input(plan(test::write_text(dir / "negative.toml", tiny_plan_with("observation = [0.001", "observation = [-0.001")),
                         "--out " + quote(dir / "x.h5")),
                    {"negative.toml:line 9", "noise.observation", "negative"});
-  expect_bad_input(plan(write(dir / "far.toml", tiny_plan_with("x0 = [0.0", "x0 = [1e300")), "--out " + quote(dir / "x.h5")),
+  expect_bad_input(plan(test::write_text(dir / "far.toml", tiny_plan_with("x0 = [0.0", "x0 = [1e300")), "--out " + quote(dir / "x.h5")),
                    {"far.toml:line", "field 'problem.x0': entry 0 is 1e+300; expected |value| <= 1e+12"});
   // A previous round of another horizon.
-  expect_bad_input(plan(write(dir / "short.toml", tiny_plan_with("horizon = 15", "horizon = 12")), "--previous " + p0 + " --out " + quote(dir / "x.h5")),
+  expect_bad_input(plan(test::write_text(dir / "short.toml", tiny_plan_with("horizon = 15", "horizon = 12")), "--previous " + p0 + " --out " + quote(dir / "x.h5")),
                    {"p0.h5", "horizon", "15", "12"});
   // A measurement file is no policy file.
   ASSERT_EQ(test::run_cli("simulate --system cartpole --episodes 1 --steps 20 --dt 0.05 --out " + quote(dir / "log.h5")).status, 0);

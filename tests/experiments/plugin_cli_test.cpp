@@ -19,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 
 const fs::path kAcrobot = GPILQG_ACROBOT_PLUGIN;
 const fs::path kPlugins = GPILQG_TEST_PLUGIN_DIR;

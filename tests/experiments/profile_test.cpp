@@ -25,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 
 void write(H5::Group& group, const std::string& name, const RowMajor& values, bool vector) {
   const hsize_t dims[2] = {static_cast<hsize_t>(vector ? values.size() : values.rows()), static_cast<hsize_t>(values.cols())};

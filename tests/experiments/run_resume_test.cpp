@@ -37,8 +37,6 @@ std::string read_file_bytes(const std::filesystem::path& file) {
   return bytes.str();
 }
 
-RunConfig tiny_config() { return parse_run_config("cartpole", test::kTinyRun, "tiny.toml"); }
-
 RunOptions two_seeds() {
   RunOptions options;
   options.seeds = {3, 4};
@@ -46,7 +44,7 @@ RunOptions two_seeds() {
 }
 
 TEST(RunResume, StoppedAfterAnyIterationAndResumedEqualsAnUninterruptedRun) {
-  const RunConfig config = tiny_config();
+  const RunConfig config = test::tiny_run_config();
   const RunResults reference = run_experiment(config, two_seeds());
 
   // Count the saves of a whole run, then stop after a spread of them: fixed-model runs, the middle
@@ -85,7 +83,7 @@ TEST(RunResume, StoppedAfterAnyIterationAndResumedEqualsAnUninterruptedRun) {
 TEST(RunResume, ACheckpointServesOnlyTheRunItWasMadeFor) {
   const auto dir = test::temporary_dir("run_resume_identity");
   const auto folder = dir / "r.h5.checkpoint";
-  const RunConfig config = tiny_config();
+  const RunConfig config = test::tiny_run_config();
   const auto message_of = [&](const RunConfig& c, const RunOptions& o) {
     try {
       RunCheckpoint::resume(folder, c, o);
@@ -121,7 +119,7 @@ TEST(RunResume, ACheckpointServesOnlyTheRunItWasMadeFor) {
 TEST(RunResume, ADamagedManifestIsReportedAsADamagedCheckpointWithTheWayToStartOver) {
   const auto dir = test::temporary_dir("run_resume_damaged");
   const auto folder = dir / "r.h5.checkpoint";
-  const RunConfig config = tiny_config();
+  const RunConfig config = test::tiny_run_config();
   RunCheckpoint::create(folder, config, two_seeds());
   const auto manifest = folder / "manifest.h5";
   const std::string whole = read_file_bytes(manifest);

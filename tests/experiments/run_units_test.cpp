@@ -16,8 +16,6 @@
 namespace gpilqg {
 namespace {
 
-RunConfig tiny_config() { return parse_run_config("cartpole", test::kTinyRun, "tiny.toml"); }
-
 int find_unit(const std::vector<RunUnit>& units, std::uint64_t seed, int task, const std::string& algorithm) {
   for (std::size_t i = 0; i < units.size(); ++i)
     if (units[i].seed == seed && units[i].task == task && units[i].algorithm == algorithm) return static_cast<int>(i);
@@ -25,7 +23,7 @@ int find_unit(const std::vector<RunUnit>& units, std::uint64_t seed, int task, c
 }
 
 TEST(RunUnits, EveryAlgorithmTaskAndSeedIsOneUnitWithTheDependenciesOfThePaperProtocol) {
-  const RunConfig config = tiny_config();  // two tasks, the second a transfer task; pddp and pddp_own on
+  const RunConfig config = test::tiny_run_config();  // two tasks, the second a transfer task; pddp and pddp_own on
   RunOptions options;
   options.seeds = {7, 8};
   const auto units = plan_run_units(config, options);
@@ -54,7 +52,7 @@ TEST(RunUnits, ComparedBackendsAreSeparateUnitsAndPddpLearnsFromTheFirst) {
   RunOptions options;
   options.seeds = {1};
   options.backends = {"fitc", "exact"};
-  const auto units = plan_run_units(tiny_config(), options);
+  const auto units = plan_run_units(test::tiny_run_config(), options);
   const int first = find_unit(units, 1, 0, "gp_ilqg_fitc");
   ASSERT_GE(first, 0);
   ASSERT_GE(find_unit(units, 1, 0, "gp_ilqg_exact"), 0);
@@ -96,7 +94,7 @@ TEST(UnitScheduler, RefusesDependenciesThatDoNotComeFirstAndWeightsThatAreNotPos
 /// Three workers take units in the scheduler's order and finish them in a shuffled order: every
 /// interleaving a distributed run can produce. The assembled result equals the single-process run's.
 TEST(RunUnits, AnyOrderTheDependenciesAllowGivesTheSingleProcessResult) {
-  const RunConfig config = tiny_config();
+  const RunConfig config = test::tiny_run_config();
   RunOptions options;
   options.seeds = {3, 4};
   const RunResults reference = run_experiment(config, options);

@@ -4,6 +4,8 @@
 /// (run_experiment_test.cpp, run_resume_test.cpp, hostile_cli_test.cpp): cart-pole, every algorithm,
 /// a transfer task, in well under a second; and a `gpilqg plan` configuration.
 
+#include "gpilqg/experiments/run_config.hpp"
+
 namespace gpilqg::test {
 
 /// Two 15-step tasks, one data round, small GPs and short PDDP solves: seconds, not minutes.
@@ -46,6 +48,9 @@ Qf = [10.0, 10.0, 10.0, 10.0]
 track_line = false
 transfer = true
 )";
+
+/// kTinyRun for the cart-pole.
+inline RunConfig tiny_run_config() { return parse_run_config("cartpole", kTinyRun, "tiny.toml"); }
 
 /// One cart-pole task as a `gpilqg plan` config (the cart-pole run defaults made explicit): the
 /// problem of plan_cli_test.cpp's run, solved in well under a second.

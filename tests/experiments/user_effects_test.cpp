@@ -47,7 +47,7 @@ MeasurementSet spring_data(std::uint64_t seed) {
   return test::hidden_effect_data(world.build(test::actuator_noise(1, 0.02)), seed);
 }
 
-std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+using test::quote;
 
 TEST(UserEffects, ADeclaredCubicSpringIsRankedFirstAndFitted) {
   for (std::uint64_t seed : {11u, 22u, 33u}) {

@@ -24,13 +24,13 @@ namespace {
 
 using ::gpilqg::test::matrices_near;
 
-constexpr int kD = 3;
+constexpr int kFitcInputs = 3;
 
 TEST(FitcMomentMatching, ServesThroughPerOutputCentres) {
   const FittedOutputs pair = fitc_outputs();
   const auto* se = dynamic_cast<const SeArdMomentMatcher*>(pair.matcher.get());
   ASSERT_NE(se, nullptr);
-  EXPECT_EQ(se->input_dim(), kD);
+  EXPECT_EQ(se->input_dim(), kFitcInputs);
   EXPECT_EQ(se->output_dim(), 2);
   EXPECT_EQ(se->training_size(0), 8);
   EXPECT_EQ(se->training_size(1), 11);
@@ -90,7 +90,7 @@ void fitc_centres(const FittedOutputs& pair, std::vector<Matrix>& centres, std::
     ASSERT_NE(p, nullptr);
     const Vector& h = model->parameters();
     centres.push_back(p->inducing_inputs());
-    outputs.push_back(SeArdOutput{h.head(kD), h(kD), p->beta(), -p->variance_matrix()});
+    outputs.push_back(SeArdOutput{h.head(kFitcInputs), h(kFitcInputs), p->beta(), -p->variance_matrix()});
   }
 }
 
@@ -100,11 +100,11 @@ TEST(FitcMomentMatching, PerOutputCentresEqualTheStackedSharedForm) {
   std::vector<SeArdOutput> outputs;
   fitc_centres(pair, centres, outputs);
   const SeArdMomentMatcher shared = stacked(centres, outputs);
-  Vector mu(kD);
+  Vector mu(kFitcInputs);
   mu << 0.1, 0.3, -0.4;
-  expect_same_moments(*pair.matcher, shared, mu, make_sigma(kD, 0.4, 11), 1e-10);
-  expect_same_moments(*pair.matcher, shared, mu, make_sigma(kD, 0.4, 12, /*zero_index=*/0), 1e-10);
-  expect_same_moments(*pair.matcher, shared, mu, Matrix::Zero(kD, kD), 1e-10);
+  expect_same_moments(*pair.matcher, shared, mu, make_sigma(kFitcInputs, 0.4, 11), 1e-10);
+  expect_same_moments(*pair.matcher, shared, mu, make_sigma(kFitcInputs, 0.4, 12, /*zero_index=*/0), 1e-10);
+  expect_same_moments(*pair.matcher, shared, mu, Matrix::Zero(kFitcInputs, kFitcInputs), 1e-10);
 }
 
 TEST(SeArdMomentMatching, LargePerOutputCentreSetsEqualTheStackedSharedForm) {
@@ -113,18 +113,18 @@ TEST(SeArdMomentMatching, LargePerOutputCentreSetsEqualTheStackedSharedForm) {
   std::vector<SeArdOutput> outputs;
   for (int a = 0; a < 2; ++a) {
     const int n = a == 0 ? 140 : 133;
-    const Matrix x = ::gpilqg::test::random_vector(n * kD, -3.0, 3.0, 50 + a).reshaped(n, kD);
+    const Matrix x = ::gpilqg::test::random_vector(n * kFitcInputs, -3.0, 3.0, 50 + a).reshaped(n, kFitcInputs);
     Vector y(n);
     for (int i = 0; i < n; ++i) y(i) = std::sin(x(i, 0) + a) + 0.2 * x(i, 1) * x(i, 2);
-    outputs.push_back(condition_se_ard_output(x, y, Vector::Constant(kD, std::log(1.0 + 0.2 * a)), 0.1 * a,
+    outputs.push_back(condition_se_ard_output(x, y, Vector::Constant(kFitcInputs, std::log(1.0 + 0.2 * a)), 0.1 * a,
                                               std::log(0.1)));
     centres.push_back(x);
   }
   const SeArdMomentMatcher native(centres, outputs);
   const SeArdMomentMatcher shared = stacked(centres, outputs);
-  Vector mu(kD);
+  Vector mu(kFitcInputs);
   mu << 0.2, -0.1, 0.3;
-  expect_same_moments(native, shared, mu, make_sigma(kD, 0.3, 13, /*zero_index=*/2), 1e-10);
+  expect_same_moments(native, shared, mu, make_sigma(kFitcInputs, 0.3, 13, /*zero_index=*/2), 1e-10);
 }
 
 TEST(SeArdMomentMatching, EqualPerOutputCentresEqualTheSharedPath) {
@@ -137,9 +137,9 @@ TEST(SeArdMomentMatching, EqualPerOutputCentresEqualTheSharedPath) {
   outputs[1].Kinv = outputs[1].Kinv.topLeftCorner(8, 8).eval();
   const SeArdMomentMatcher per_output(std::vector<Matrix>{centres[0], centres[0]}, outputs);
   const SeArdMomentMatcher shared(centres[0], outputs);
-  Vector mu(kD);
+  Vector mu(kFitcInputs);
   mu << -0.2, 0.1, 0.4;
-  expect_same_moments(per_output, shared, mu, make_sigma(kD, 0.4, 14), 1e-10);
+  expect_same_moments(per_output, shared, mu, make_sigma(kFitcInputs, 0.4, 14), 1e-10);
 }
 
 TEST(SeArdMomentMatching, PerOutputConstructionValidatesTheCentres) {

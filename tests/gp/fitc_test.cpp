@@ -22,27 +22,9 @@
 namespace gpilqg::gp::test {
 namespace {
 
-/// |a - e| <= tol * (|e| + max|e|): relative to each entry and to the largest one.
-::testing::AssertionResult near_relative(const Matrix& actual, const Matrix& expected, double tol) {
-  return matrices_near(actual, expected, tol * expected.cwiseAbs().maxCoeff(), tol);
-}
-
-Matrix scalar(double v) { return Matrix::Constant(1, 1, v); }
-
-/// Analytic against central-difference gradient: each entry within 1e-6 relative plus 1e-7 of the
-/// largest entry (the differences' rounding error scales with the NLML's magnitude).
-::testing::AssertionResult gradient_near(const Vector& analytic, const Vector& numeric) {
-  return matrices_near(analytic, numeric, 1e-7 * numeric.cwiseAbs().maxCoeff(), 1e-6);
-}
-
 Matrix oracle_inducing() { return read_numeric_csv(oracle_dir() / "data" / "Xu.csv"); }
 
-Vector oracle_theta(const OracleData& o) { return FitcLayout{3, 7}.pack(o.hyp.pack(), oracle_inducing()); }
-
-struct Predictions {
-  Vector mean, variance;
-  Matrix dmean, dvariance;  // one row per test point
-};
+Vector fitc_oracle_theta(const OracleData& o) { return FitcLayout{3, 7}.pack(o.hyp.pack(), oracle_inducing()); }
 
 /// Predictions of a predictor with the oracle's prior mean m(x) = sum sin(x_d) added.
 Predictions predict_with_prior_mean(const FitcPredictor& p, const Matrix& Xs) {
@@ -61,13 +43,6 @@ Predictions predict_with_prior_mean(const FitcPredictor& p, const Matrix& Xs) {
   return out;
 }
 
-/// Central-difference gradient of the NLML.
-Vector numeric_gradient(const FitcLikelihood& lik, const Vector& theta, double h = 1e-5) {
-  return ::gpilqg::test::numeric_jacobian(
-             [&](const Vector& t) { return Vector::Constant(1, lik.evaluate(t).value); }, theta, h)
-      .transpose();
-}
-
 // ---------------------------------------------------------------------------------------------------
 // Oracle agreement (values to 1e-10 relative, prediction gradients to 1e-9)
 
@@ -77,14 +52,14 @@ TEST(FitcOracle, DefaultJitterMatchesGpmlAndNumpy) {
   const auto numpy = load_oracle_json("python")["numpy_fitc_default"];
   const FitcLikelihood lik(o.train.inputs, o.train.targets, 7, FitcJitter::gpml());
   Vector grad;
-  const NlmlEvaluation e = lik.evaluate(oracle_theta(o), &grad);
+  const NlmlEvaluation e = lik.evaluate(fitc_oracle_theta(o), &grad);
   EXPECT_EQ(e.status, FactorStatus::Ok);
   EXPECT_TRUE(near_relative(scalar(e.value), scalar(ref["nlZ"].get<double>()), 1e-10));
   Vector dhyp(5);
   dhyp << json_matrix(ref["dnlZ_cov"]), ref["dnlZ_lik"].get<double>();
   EXPECT_TRUE(near_relative(grad.head(5), dhyp, 1e-10));
 
-  const Predictions p = predict_with_prior_mean(lik.predictor(oracle_theta(o)), o.test_inputs);
+  const Predictions p = predict_with_prior_mean(lik.predictor(fitc_oracle_theta(o)), o.test_inputs);
   EXPECT_TRUE(near_relative(p.mean, json_matrix(ref["fmu"]), 1e-10));
   EXPECT_TRUE(near_relative(p.variance, json_matrix(ref["fs2"]), 1e-10));
   EXPECT_TRUE(near_relative(p.mean, json_matrix(numpy["fmu"]), 1e-10));
@@ -101,7 +76,7 @@ TEST(FitcOracle, PseudoInputGradientMatchesGpml) {
   const auto ref = load_oracle_json("gpml")["fitc_xu"];
   const FitcLikelihood lik(o.train.inputs, o.train.targets, 7, FitcJitter::gpml());
   Vector grad;
-  const NlmlEvaluation e = lik.evaluate(oracle_theta(o), &grad);
+  const NlmlEvaluation e = lik.evaluate(fitc_oracle_theta(o), &grad);
   EXPECT_TRUE(near_relative(scalar(e.value), scalar(ref["nlZ"].get<double>()), 1e-10));
   Vector dhyp(5);
   dhyp << json_matrix(ref["dnlZ_cov"]), ref["dnlZ_lik"].get<double>();
@@ -116,13 +91,13 @@ TEST(FitcOracle, FixedJitterMatchesGpmlAndNumpy) {
   const auto numpy = load_oracle_json("python")["numpy_fitc_snu2_1e-10"];
   const FitcLikelihood lik(o.train.inputs, o.train.targets, 7, FitcJitter::fixed(1e-10));
   Vector grad;
-  const NlmlEvaluation e = lik.evaluate(oracle_theta(o), &grad);
+  const NlmlEvaluation e = lik.evaluate(fitc_oracle_theta(o), &grad);
   EXPECT_TRUE(near_relative(scalar(e.value), scalar(ref["nlZ"].get<double>()), 1e-10));
   EXPECT_TRUE(near_relative(scalar(e.value), scalar(numpy["nlZ"].get<double>()), 1e-10));
   Vector dhyp(5);
   dhyp << json_matrix(ref["dnlZ_cov"]), ref["dnlZ_lik"].get<double>();
   EXPECT_TRUE(near_relative(grad.head(5), dhyp, 1e-10));
-  const Predictions p = predict_with_prior_mean(lik.predictor(oracle_theta(o)), o.test_inputs);
+  const Predictions p = predict_with_prior_mean(lik.predictor(fitc_oracle_theta(o)), o.test_inputs);
   EXPECT_TRUE(near_relative(p.mean, json_matrix(ref["fmu"]), 1e-10));
   EXPECT_TRUE(near_relative(p.variance, json_matrix(ref["fs2"]), 1e-10));
   EXPECT_TRUE(matrices_near(p.dmean, json_matrix(numpy["dfmu_dxs"]), 1e-9, 1e-9));
@@ -133,7 +108,7 @@ TEST(FitcOracle, TheJitterRuleMatters) {
   // The two rules differ by 2.8e-5 in nlZ (README): GPML's relative rule is really applied.
   const OracleData o = load_oracle();
   const auto run = [&](FitcJitter j) {
-    return FitcLikelihood(o.train.inputs, o.train.targets, 7, j).evaluate(oracle_theta(o)).value;
+    return FitcLikelihood(o.train.inputs, o.train.targets, 7, j).evaluate(fitc_oracle_theta(o)).value;
   };
   EXPECT_NEAR(run(FitcJitter::fixed(1e-10)) - run(FitcJitter::gpml()), 2.8283178266974573e-05, 1e-9);
 }
@@ -142,7 +117,7 @@ TEST(FitcOracle, TheBackendPredictsTheOracleThroughTheInterface) {
   const OracleData o = load_oracle();
   const auto ref = load_oracle_json("gpml")["fitc_default"];
   const auto numpy = load_oracle_json("python")["numpy_fitc_default"];
-  const auto model = FitcBackend().condition(o.train, oracle_theta(o));
+  const auto model = FitcBackend().condition(o.train, fitc_oracle_theta(o));
   EXPECT_EQ(model->backend_name(), "fitc");
   EXPECT_EQ(model->conditioning().status, FactorStatus::Ok);
   EXPECT_TRUE(near_relative(scalar(model->negative_log_marginal_likelihood()),
@@ -166,7 +141,7 @@ TEST(FitcOracle, TheBackendPredictsTheOracleThroughTheInterface) {
 
 TEST(FitcGradient, EveryParameterMatchesCentralDifferencesForBothJitterRules) {
   const OracleData o = load_oracle();
-  Vector theta = oracle_theta(o);
+  Vector theta = fitc_oracle_theta(o);
   theta.head(5) += Vector::LinSpaced(5, -0.4, 0.3);                     // away from the reference values
   theta.tail(21) += 0.3 * ::gpilqg::test::random_vector(21, -1, 1, 5);  // and other pseudo-inputs
   for (const FitcJitter& rule :
@@ -226,7 +201,7 @@ TEST(FitcGradient, TwoThreadsGiveTheSameValueAndGradient) {
 
 TEST(FitcGradient, PredictionGradientsMatchCentralDifferencesFarAndNear) {
   const OracleData o = load_oracle();
-  const FitcPredictor p = FitcLikelihood(o.train.inputs, o.train.targets, 7).predictor(oracle_theta(o));
+  const FitcPredictor p = FitcLikelihood(o.train.inputs, o.train.targets, 7).predictor(fitc_oracle_theta(o));
   Vector k(7), c(7), xs(3), dm(3), dv(3);
   for (const Vector& x : {Vector(o.test_inputs.row(2).transpose()),
                           Vector(oracle_inducing().row(3).transpose()), Vector(Vector::Constant(3, 2.5))}) {
@@ -433,7 +408,7 @@ TEST(FitcBackendTest, AWarmStartWithFewerPseudoInputsContributesItsKernelHyperpa
 
 TEST(FitcBackendTest, PredictionRequestsComputeOnlyWhatIsAsked) {
   const OracleData o = load_oracle();
-  const auto model = FitcBackend().condition(o.train, oracle_theta(o));
+  const auto model = FitcBackend().condition(o.train, fitc_oracle_theta(o));
   const Vector z = o.test_inputs.row(1).transpose();
   Prediction full, mean_only, no_gradient;
   model->predict(z, full, PredictionRequest{true, true});
@@ -453,7 +428,7 @@ TEST(FitcBackendTest, PredictionRequestsComputeOnlyWhatIsAsked) {
 TEST(FitcFailure, BadParametersGiveAFailedStatusNeverNaN) {
   const OracleData o = load_oracle();
   const FitcLikelihood lik(o.train.inputs, o.train.targets, 7);
-  Vector theta = oracle_theta(o);
+  Vector theta = fitc_oracle_theta(o);
   Vector grad;
   for (const double bad :
        {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
@@ -503,7 +478,7 @@ TEST(FitcFailure, SizesAndOptionsAreCheckedWithTheValuesInTheMessage) {
   // 5 + 7 entries cannot hold whole pseudo-inputs in 3 dimensions.
   EXPECT_NE(message([&] { (void)FitcBackend().condition(o.train, Vector::Zero(12)); }).find("12 entries"),
             std::string::npos);
-  Vector nan_theta = oracle_theta(o);
+  Vector nan_theta = fitc_oracle_theta(o);
   nan_theta(0) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW((void)FitcBackend().condition(o.train, nan_theta), std::invalid_argument);
 }

@@ -23,7 +23,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::shared_ptr<const StepModel> cartpole_simulator() {
+std::shared_ptr<const StepModel> cartpole_step_model() {
   return make_step_model(make_system("cartpole"), Integrator::RK4, 0.05);
 }
 
@@ -34,7 +34,7 @@ TEST(GpIoHostileInputs, TheLoadersRefuseThemWithDataError) {
       "load_fitted_gp", [&](const fs::path& f) { (void)load_fitted_gp(f, "/gp", backend); },
       ::gpilqg::test::make_hostile_inputs(dir / "fitted", ".h5", kMaxDataFileBytes));
   ::gpilqg::test::expect_refuses_hostile_inputs<DataError>(
-      "load_residual_model", [&](const fs::path& f) { (void)load_residual_model(f, "/model", cartpole_simulator(), backend); },
+      "load_residual_model", [&](const fs::path& f) { (void)load_residual_model(f, "/model", cartpole_step_model(), backend); },
       ::gpilqg::test::make_hostile_inputs(dir / "residual", ".h5", kMaxDataFileBytes));
   fs::remove_all(dir);
 }

@@ -133,4 +133,32 @@ inline Vector parameters_for(const GpBackend& backend, const TrainingSet& data, 
   return theta;
 }
 
+/// |a - e| <= tol * (|e| + max|e|): relative to each entry and to the largest one.
+inline ::testing::AssertionResult near_relative(const Matrix& actual, const Matrix& expected, double tol) {
+  return matrices_near(actual, expected, tol * expected.cwiseAbs().maxCoeff(), tol);
+}
+
+/// The 1 x 1 matrix holding v.
+inline Matrix scalar(double v) { return Matrix::Constant(1, 1, v); }
+
+/// Analytic against central-difference gradient: each entry within 1e-6 relative plus 1e-7 of the
+/// largest entry (the differences' rounding error scales with the NLML's magnitude).
+inline ::testing::AssertionResult gradient_near(const Vector& analytic, const Vector& numeric) {
+  return matrices_near(analytic, numeric, 1e-7 * numeric.cwiseAbs().maxCoeff(), 1e-6);
+}
+
+/// Central-difference gradient of a sparse GP's NLML (FitcLikelihood, SsgpLikelihood) at theta.
+template <class Likelihood>
+Vector numeric_gradient(const Likelihood& lik, const Vector& theta, double h = 1e-5) {
+  return ::gpilqg::test::numeric_jacobian(
+             [&](const Vector& t) { return Vector::Constant(1, lik.evaluate(t).value); }, theta, h)
+      .transpose();
+}
+
+/// Predictions at test points, one row of the gradients per point.
+struct Predictions {
+  Vector mean, variance;
+  Matrix dmean, dvariance;
+};
+
 }  // namespace gpilqg::gp::test

@@ -16,15 +16,15 @@
 namespace gpilqg::gp::test {
 namespace {
 
-constexpr double kDt = 0.1;
+constexpr double kNoiseFloorDt = 0.1;
 
 /// A damped oscillator x' = A x + B u with a constant process-noise column on each state, so the
 /// residual noise of sensor_noise_floor is the same at every input and the floor is its exact std.
 std::shared_ptr<gpilqg::test::LinearStepModel> oscillator(double process_std) {
   Matrix A(2, 2), B(2, 1);
-  A << 1.0, kDt, -0.4 * kDt, 1.0 - 0.2 * kDt;
-  B << 0.0, kDt;
-  auto model = std::make_shared<gpilqg::test::LinearStepModel>(A, B, kDt);
+  A << 1.0, kNoiseFloorDt, -0.4 * kNoiseFloorDt, 1.0 - 0.2 * kNoiseFloorDt;
+  B << 0.0, kNoiseFloorDt;
+  auto model = std::make_shared<gpilqg::test::LinearStepModel>(A, B, kNoiseFloorDt);
   model->additive_std = process_std;
   return model;
 }
@@ -67,10 +67,10 @@ TEST(SensorNoiseFloor, EqualsTheMonteCarloStdOfResidualsWhenTheSimulatorIsRight)
   const ResidualData data = make_residual_data(*model, t.x, t.u, t.x_next);
   const Vector floor = sensor_noise_floor(*model, data, sensor);
   // Closed form: sigma_i^2 + sum_j A_ij^2 sigma_j^2 + dt process^2.
-  const Matrix A = (Matrix(2, 2) << 1.0, kDt, -0.4 * kDt, 1.0 - 0.2 * kDt).finished();
+  const Matrix A = (Matrix(2, 2) << 1.0, kNoiseFloorDt, -0.4 * kNoiseFloorDt, 1.0 - 0.2 * kNoiseFloorDt).finished();
   for (int i = 0; i < 2; ++i) {
     const double expected = std::sqrt(sensor(i) * sensor(i) + A.row(i).cwiseAbs2().dot(sensor.cwiseAbs2()) +
-                                      kDt * 0.05 * 0.05);
+                                      kNoiseFloorDt * 0.05 * 0.05);
     EXPECT_NEAR(floor(i), expected, 1e-12 * expected) << "state " << i;
     EXPECT_NEAR(sample_std(data.residuals.col(i)), floor(i), 0.015 * floor(i)) << "state " << i;
   }
@@ -86,7 +86,7 @@ TEST(SensorNoiseFloor, IsTheSmallestOverTheInputsWhenTheNoiseDependsOnTheControl
   const Vector floor = sensor_noise_floor(*model, data, Vector());
   // b = B / dt = (0, 1): velocity only, std = sqrt(dt) * 0.3 * 0.5 at u = -0.5.
   EXPECT_DOUBLE_EQ(floor(0), 0.0);
-  EXPECT_NEAR(floor(1), std::sqrt(kDt) * 0.3 * 0.5, 1e-15);
+  EXPECT_NEAR(floor(1), std::sqrt(kNoiseFloorDt) * 0.3 * 0.5, 1e-15);
 }
 
 TEST(SensorNoiseFloor, NamesWhatIsWrongWithItsInputs) {

@@ -16,17 +16,17 @@
 namespace gpilqg::gp::test {
 namespace {
 
-constexpr double kDt = 0.05;
+constexpr double kResidualDt = 0.05;
 
 std::shared_ptr<const IntegratedStepModel> cartpole_simulator(const ActuatorNoise& noise = {}) {
   return std::make_shared<IntegratedStepModel>(make_system("cartpole", Preset::Simulator, {}, noise), Integrator::RK4,
-                                               kDt);
+                                               kResidualDt);
 }
 
 /// Episodes of the real cart-pole (RK4 with 10 sub-steps) under random piecewise-constant forces,
 /// observed with Gaussian noise of std `observation_noise` on every state.
 MeasurementSet real_measurements(int episodes, int steps, unsigned seed, double observation_noise = 1e-4) {
-  const IntegratedStepModel real(make_system("cartpole", Preset::RealWorld), Integrator::RK4, kDt, 10);
+  const IntegratedStepModel real(make_system("cartpole", Preset::RealWorld), Integrator::RK4, kResidualDt, 10);
   std::mt19937 gen(seed);
   std::uniform_real_distribution<double> force(-6.0, 6.0), start(-0.5, 0.5);
   std::normal_distribution<double> noise(0.0, observation_noise);
@@ -43,7 +43,7 @@ MeasurementSet real_measurements(int episodes, int steps, unsigned seed, double 
     double u = 0.0;
     for (int t = 0; t < steps; ++t) {
       if (t % 5 == 0) u = force(gen);
-      ep.t(t) = t * kDt;
+      ep.t(t) = t * kResidualDt;
       for (int i = 0; i < 4; ++i) ep.x(t, i) = x(i) + noise(gen);
       ep.u(t, 0) = u;
       x = real.next(x, Vector::Constant(1, u));
@@ -119,13 +119,13 @@ TEST_F(CartPoleResidual, FarFromDataItIsTheSimulatorWithPriorUncertainty) {
   model_->uncertainty(x, u, g, true);
   ASSERT_EQ(g.count(), 4);
   for (int i = 0; i < 4; ++i) {
-    const double prior_sigma = std::sqrt(model_->output(i).prior_variance() / kDt);
+    const double prior_sigma = std::sqrt(model_->output(i).prior_variance() / kResidualDt);
     EXPECT_NEAR(g.columns(i, i), prior_sigma, 1e-12 * prior_sigma);
     EXPECT_TRUE(matrices_near(g.d_dx[static_cast<std::size_t>(i)], Matrix::Zero(4, 4), 1e-12));
   }
   // Near the data the uncertainty is far below the prior.
   model_->uncertainty(data_->inputs.row(10).head(4).transpose(), data_->inputs.row(10).tail(1).transpose(), g, false);
-  for (int i = 0; i < 4; ++i) EXPECT_LT(g.columns(i, i), 0.2 * std::sqrt(model_->output(i).prior_variance() / kDt));
+  for (int i = 0; i < 4; ++i) EXPECT_LT(g.columns(i, i), 0.2 * std::sqrt(model_->output(i).prior_variance() / kResidualDt));
 }
 
 TEST_F(CartPoleResidual, UncertaintyIsTheGpVarianceInContinuousTimeUnits) {
@@ -136,7 +136,7 @@ TEST_F(CartPoleResidual, UncertaintyIsTheGpVarianceInContinuousTimeUnits) {
   Prediction p;
   for (int i = 0; i < 4; ++i) {
     model_->output(i).predict(data_->inputs.row(3).transpose(), p);
-    EXPECT_NEAR(g.columns(i, i) * g.columns(i, i) * kDt, p.variance, 1e-15 + 1e-12 * p.variance);  // G^2 dt = var
+    EXPECT_NEAR(g.columns(i, i) * g.columns(i, i) * kResidualDt, p.variance, 1e-15 + 1e-12 * p.variance);  // G^2 dt = var
     for (int j = 0; j < 4; ++j)
       if (j != i) {
         EXPECT_EQ(g.columns(j, i), 0.0);

@@ -24,7 +24,7 @@
 namespace gpilqg::gp::test {
 namespace {
 
-constexpr int kD = 3;
+constexpr int kSsgpInputs = 3;
 
 const SsgpPredictor& predictor(const FittedOutputs& pair, int a) {
   return *ssgp_posterior(*pair.models[static_cast<std::size_t>(a)]);
@@ -33,7 +33,7 @@ const SsgpPredictor& predictor(const FittedOutputs& pair, int a) {
 TEST(SsgpMomentMatching, ServesThroughTrigonometricFeatures) {
   const FittedOutputs pair = ssgp_outputs();
   ASSERT_NE(dynamic_cast<const SsgpMomentMatcher*>(pair.matcher.get()), nullptr);
-  EXPECT_EQ(pair.matcher->input_dim(), kD);
+  EXPECT_EQ(pair.matcher->input_dim(), kSsgpInputs);
   EXPECT_EQ(pair.matcher->output_dim(), 2);
 }
 
@@ -49,9 +49,9 @@ TEST(SsgpMomentMatching, DerivativesMatchCentralDifferencesForAWideInput) {
   // s' Sigma s up to ~20: Ch and Sh far from their small-kappa regime, p from exp() (|kappa| >= 1).
   // (Regression: p = e_r e_q / (1 + x) for every kappa left ~3e-10 of rounding in S here, as 1 + x
   // cancels for large |kappa|.)
-  Vector mu(kD);
+  Vector mu(kSsgpInputs);
   mu << 0.3, -0.2, 0.5;
-  check_derivatives(*ssgp_outputs().matcher, mu, make_sigma(kD, 2.0, 5), "SSGP wide Sigma");
+  check_derivatives(*ssgp_outputs().matcher, mu, make_sigma(kSsgpInputs, 2.0, 5), "SSGP wide Sigma");
 }
 
 TEST(SsgpMomentMatching, AVeryWideInputAveragesEveryFeatureOut) {
@@ -60,7 +60,7 @@ TEST(SsgpMomentMatching, AVeryWideInputAveragesEveryFeatureOut) {
   // M = 0, C = 0, S_ab = 0 (a != b) and S_aa = 1/2 |alpha_a|^2 + 1/2 tr(C_a) (no two frequencies coincide).
   const FittedOutputs pair = ssgp_outputs();
   MomentMatch m;
-  pair.matcher->propagate(Vector::Constant(kD, 0.3), 1e4 * Matrix::Identity(kD, kD), m, MomentDerivatives::All);
+  pair.matcher->propagate(Vector::Constant(kSsgpInputs, 0.3), 1e4 * Matrix::Identity(kSsgpInputs, kSsgpInputs), m, MomentDerivatives::All);
   EXPECT_TRUE(m.dcovariance_dsigma.allFinite());
   EXPECT_LT(m.mean.cwiseAbs().maxCoeff(), 1e-100);
   EXPECT_LT(m.cross_covariance.cwiseAbs().maxCoeff(), 1e-90);
@@ -75,10 +75,10 @@ TEST(SsgpMomentMatching, AVeryWideInputAveragesEveryFeatureOut) {
 TEST(SsgpMomentMatching, ACovarianceFarFromPositiveSemidefiniteThrowsInsteadOfNaN) {
   const FittedOutputs pair = ssgp_outputs();
   MomentMatch m;
-  expect_invalid([&] { pair.matcher->propagate(Vector::Zero(kD), -1e4 * Matrix::Identity(kD, kD), m); },
+  expect_invalid([&] { pair.matcher->propagate(Vector::Zero(kSsgpInputs), -1e4 * Matrix::Identity(kSsgpInputs, kSsgpInputs), m); },
                  "overflowed");
   EXPECT_FALSE(m.has_derivatives);
-  pair.matcher->propagate(Vector::Zero(kD), 0.1 * Matrix::Identity(kD, kD), m, MomentDerivatives::All);
+  pair.matcher->propagate(Vector::Zero(kSsgpInputs), 0.1 * Matrix::Identity(kSsgpInputs, kSsgpInputs), m, MomentDerivatives::All);
   EXPECT_TRUE(m.has_derivatives);
 }
 
@@ -112,13 +112,13 @@ TEST(SsgpMomentMatching, ConstructionValidatesSizesAndValues) {
   }
   {
     auto bad = outputs;
-    bad[0].frequencies.resize(0, kD);
+    bad[0].frequencies.resize(0, kSsgpInputs);
     expect_invalid([&] { SsgpMomentMatcher{bad}; }, "outputs[0].frequencies is 0 x 3");
   }
   const SsgpMomentMatcher matcher(outputs);
   MomentMatch m;
-  expect_invalid([&] { matcher.propagate(Vector::Zero(2), Matrix::Zero(kD, kD), m); }, "mu has 2 entries");
-  expect_invalid([&] { matcher.propagate(Vector::Zero(kD), Matrix::Zero(kD, 2), m); }, "Sigma is 3 x 2");
+  expect_invalid([&] { matcher.propagate(Vector::Zero(2), Matrix::Zero(kSsgpInputs, kSsgpInputs), m); }, "mu has 2 entries");
+  expect_invalid([&] { matcher.propagate(Vector::Zero(kSsgpInputs), Matrix::Zero(kSsgpInputs, 2), m); }, "Sigma is 3 x 2");
 }
 
 }  // namespace

@@ -18,19 +18,7 @@
 namespace gpilqg::gp::test {
 namespace {
 
-::testing::AssertionResult near_relative(const Matrix& actual, const Matrix& expected, double tol) {
-  return matrices_near(actual, expected, tol * expected.cwiseAbs().maxCoeff(), tol);
-}
-
-Matrix scalar(double v) { return Matrix::Constant(1, 1, v); }
-
-/// Analytic against central-difference gradient: each entry within 1e-6 relative plus 1e-7 of the
-/// largest entry (the differences' rounding error scales with the NLML's magnitude).
-::testing::AssertionResult gradient_near(const Vector& analytic, const Vector& numeric) {
-  return matrices_near(analytic, numeric, 1e-7 * numeric.cwiseAbs().maxCoeff(), 1e-6);
-}
-
-Vector oracle_theta(const OracleData& o) {
+Vector ssgp_oracle_theta(const OracleData& o) {
   return SsgpLayout{3, 10}.pack(o.hyp.pack(), read_numeric_csv(oracle_dir() / "data" / "W.csv"));
 }
 
@@ -41,11 +29,6 @@ Matrix standard_normal(int rows, int cols, std::uint64_t seed) {
   for (Eigen::Index i = 0; i < W.size(); ++i) W.data()[i] = normal(rng);
   return W;
 }
-
-struct Predictions {
-  Vector mean, variance;
-  Matrix dmean, dvariance;
-};
 
 /// Predictions with the oracle's prior mean added (fmu includes m(Xs), dfmu includes cos(xs)).
 Predictions predict_with_prior_mean(const SsgpPredictor& p, const Matrix& Xs) {
@@ -64,12 +47,6 @@ Predictions predict_with_prior_mean(const SsgpPredictor& p, const Matrix& Xs) {
   return out;
 }
 
-Vector numeric_gradient(const SsgpLikelihood& lik, const Vector& theta, double h = 1e-5) {
-  return ::gpilqg::test::numeric_jacobian(
-             [&](const Vector& t) { return Vector::Constant(1, lik.evaluate(t).value); }, theta, h)
-      .transpose();
-}
-
 // ---------------------------------------------------------------------------------------------------
 // Oracle agreement
 
@@ -79,7 +56,7 @@ TEST(SsgpOracle, MatchesSsgprAndNumpy) {
   const auto numpy = load_oracle_json("python")["numpy_ssgp"];
   const SsgpLikelihood lik(o.train.inputs, o.train.targets, 10);
   Vector grad;
-  const NlmlEvaluation e = lik.evaluate(oracle_theta(o), &grad);
+  const NlmlEvaluation e = lik.evaluate(ssgp_oracle_theta(o), &grad);
   EXPECT_EQ(e.status, FactorStatus::Ok);
   EXPECT_TRUE(near_relative(scalar(e.value), scalar(ref["nlml"].get<double>()), 1e-10));
   EXPECT_TRUE(near_relative(scalar(e.value), scalar(numpy["nlml"].get<double>()), 1e-10));
@@ -89,7 +66,7 @@ TEST(SsgpOracle, MatchesSsgprAndNumpy) {
   EXPECT_TRUE(near_relative(grad.head(5), dhyp, 1e-10));
   EXPECT_TRUE(near_relative(grad.tail(30).reshaped(10, 3), json_matrix(ref["dnlml_W"]), 1e-10));
 
-  const Predictions p = predict_with_prior_mean(lik.predictor(oracle_theta(o)), o.test_inputs);
+  const Predictions p = predict_with_prior_mean(lik.predictor(ssgp_oracle_theta(o)), o.test_inputs);
   EXPECT_TRUE(near_relative(p.mean, json_matrix(ref["fmu"]), 1e-10));
   EXPECT_TRUE(near_relative(p.variance, json_matrix(ref["fs2"]), 1e-10));
   EXPECT_TRUE(near_relative(p.mean, json_matrix(numpy["fmu"]), 1e-10));
@@ -105,7 +82,7 @@ TEST(SsgpOracle, TheBackendPredictsTheOracleThroughTheInterface) {
   const OracleData o = load_oracle();
   const auto ref = load_oracle_json("ssgp");
   const auto numpy = load_oracle_json("python")["numpy_ssgp"];
-  const auto model = SsgpBackend().condition(o.train, oracle_theta(o));
+  const auto model = SsgpBackend().condition(o.train, ssgp_oracle_theta(o));
   EXPECT_EQ(model->backend_name(), "ssgp");
   EXPECT_EQ(model->conditioning().status, FactorStatus::Ok);
   EXPECT_TRUE(near_relative(scalar(model->negative_log_marginal_likelihood()),
@@ -129,7 +106,7 @@ TEST(SsgpOracle, TheBackendPredictsTheOracleThroughTheInterface) {
 
 TEST(SsgpGradient, EveryParameterMatchesCentralDifferences) {
   const OracleData o = load_oracle();
-  Vector theta = oracle_theta(o);
+  Vector theta = ssgp_oracle_theta(o);
   theta.head(5) += Vector::LinSpaced(5, 0.3, -0.2);
   theta.tail(30) += 0.5 * ::gpilqg::test::random_vector(30, -1, 1, 11);
   const SsgpLikelihood lik(o.train.inputs, o.train.targets, 10);
@@ -189,7 +166,7 @@ TEST(SsgpGradient, TwoThreadsGiveTheSameValueAndGradient) {
 
 TEST(SsgpGradient, PredictionGradientsMatchCentralDifferences) {
   const OracleData o = load_oracle();
-  const SsgpPredictor p = SsgpLikelihood(o.train.inputs, o.train.targets, 10).predictor(oracle_theta(o));
+  const SsgpPredictor p = SsgpLikelihood(o.train.inputs, o.train.targets, 10).predictor(ssgp_oracle_theta(o));
   Vector phi(20), c(20), dm(3), dv(3);
   for (const Vector& x : {Vector(o.test_inputs.row(0).transpose()), Vector(Vector::Constant(3, 4.0))}) {
     double mean = 0, var = 0;
@@ -325,7 +302,7 @@ TEST(SsgpBackendTest, FitMovesTheSpectralPointsAndLowersTheNlml) {
 
 TEST(SsgpBackendTest, PredictionRequestsComputeOnlyWhatIsAsked) {
   const OracleData o = load_oracle();
-  const auto model = SsgpBackend().condition(o.train, oracle_theta(o));
+  const auto model = SsgpBackend().condition(o.train, ssgp_oracle_theta(o));
   const Vector z = o.test_inputs.row(3).transpose();
   Prediction full, mean_only, no_gradient;
   model->predict(z, full, PredictionRequest{true, true});
@@ -345,7 +322,7 @@ TEST(SsgpBackendTest, PredictionRequestsComputeOnlyWhatIsAsked) {
 TEST(SsgpFailure, BadParametersGiveAFailedStatusNeverNaN) {
   const OracleData o = load_oracle();
   const SsgpLikelihood lik(o.train.inputs, o.train.targets, 10);
-  const Vector theta = oracle_theta(o);
+  const Vector theta = ssgp_oracle_theta(o);
   Vector grad;
   for (const double bad :
        {std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::infinity()}) {

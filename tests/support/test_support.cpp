@@ -9,6 +9,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "gpilqg/core/systems.hpp"
+
 namespace gpilqg::test {
 
 std::filesystem::path reference_dir() { return source_dir() / "tests" / "reference"; }
@@ -134,6 +136,11 @@ CommandResult run_cli(const std::string& arguments) {
   result.out = read_file(out);
   result.err = read_file(err);
   return result;
+}
+
+const SystemSignature& cartpole_signature() {
+  static const SystemSignature signature = system_signature("cartpole");
+  return signature;
 }
 
 std::string quote(const std::filesystem::path& path) { return "'" + path.string() + "'"; }

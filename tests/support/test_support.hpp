@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gpilqg/core/quantity.hpp"
 #include "gpilqg/core/types.hpp"
 
 namespace gpilqg::test {
@@ -35,8 +36,21 @@ Matrix read_numeric_csv(const std::filesystem::path& file);
 /// library's finite_difference.hpp so the two check each other).
 Matrix numeric_jacobian(const std::function<Vector(const Vector&)>& g, const Vector& x, double h);
 
+/// Step and tolerance of the central-difference checks of analytic derivatives. With h = 1e-6 the
+/// truncation error ~ h^2 |f'''| / 6 and the round-off ~ eps |f| / h stay below 1e-8 for |f|, |f'''|
+/// up to ~100: a tolerance of 1e-7 leaves a margin of 10 and still catches any wrong term (those are
+/// O(0.01) or larger).
+inline constexpr double kFdStep = 1e-6;
+inline constexpr double kFdTolerance = 1e-7;
+
+/// The built-in cart-pole's signature (its states, controls and measurement names).
+const SystemSignature& cartpole_signature();
+
 /// Random vector with entries uniform in [lo, hi], from a fixed-seed generator per call site.
 Vector random_vector(int size, double lo, double hi, unsigned seed);
+
+/// Options of `gpilqg diagnose` that keep a test of it fast: a small GP without restarts.
+inline const std::string kFastDiagnose = " --gp-points 100 --gp-restarts 0";
 
 /// Runs the gpilqg program with `arguments` (shell-quoted by the caller), capturing stdout and
 /// stderr separately; returns the exit status.
