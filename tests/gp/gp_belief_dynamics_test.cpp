@@ -31,7 +31,7 @@ constexpr int kN = 2, kM = 1, kD = 3;
 /// differences of it lose ~1e-7 to round-off (eps |Kinv| / h).
 GpBeliefDynamics make_dynamics() {
   const int N = 60;
-  const Matrix Z = test::random_vector(N * kD, -1.5, 1.5, 1).reshaped(N, kD);
+  const Matrix Z = gpilqg::test::random_vector(N * kD, -1.5, 1.5, 1).reshaped(N, kD);
   Matrix dX(N, kN);
   for (int i = 0; i < N; ++i) {
     dX(i, 0) = 0.1 * Z(i, 1) + 0.05 * std::sin(2.0 * Z(i, 0));
@@ -54,7 +54,7 @@ Vector belief(const Vector& mu, const Matrix& Sigma) {
 /// rounding of the model's evaluation, divided by h, stays small; that part grows by a factor of 3.
 template <class F>
 Matrix extrapolated_jacobian(const F& f, const Vector& at, double h) {
-  return (4.0 * test::numeric_jacobian(f, at, 0.5 * h) - test::numeric_jacobian(f, at, h)) / 3.0;
+  return (4.0 * gpilqg::test::numeric_jacobian(f, at, 0.5 * h) - gpilqg::test::numeric_jacobian(f, at, h)) / 3.0;
 }
 
 /// dv'/dv and dv'/du at a fixed belief (mu, Sigma) and control against central differences with step h
@@ -69,8 +69,8 @@ void expect_jacobians_match_central_differences(const GpBeliefDynamics& model, d
   model.propagate(v, u, next, &jac);
   auto step_v = [&](const Vector& vs) { Vector out(5); model.propagate(vs, u, out); return out; };
   auto step_u = [&](const Vector& us) { Vector out(5); model.propagate(v, us, out); return out; };
-  EXPECT_TRUE(test::matrices_near(jac.dv, extrapolated_jacobian(step_v, v, h), 1e-7, 1e-6)) << label;
-  EXPECT_TRUE(test::matrices_near(jac.du, extrapolated_jacobian(step_u, u, h), 1e-7, 1e-6)) << label;
+  EXPECT_TRUE(gpilqg::test::matrices_near(jac.dv, extrapolated_jacobian(step_v, v, h), 1e-7, 1e-6)) << label;
+  EXPECT_TRUE(gpilqg::test::matrices_near(jac.du, extrapolated_jacobian(step_u, u, h), 1e-7, 1e-6)) << label;
 }
 
 TEST(GpBeliefDynamics, JacobiansMatchCentralDifferences) {
@@ -141,7 +141,7 @@ struct PendulumData {
 PendulumData pendulum_data() {
   const int N = 80;
   PendulumData d;
-  d.inputs = test::random_vector(N * kD, -1.5, 1.5, 11).reshaped(N, kD);
+  d.inputs = gpilqg::test::random_vector(N * kD, -1.5, 1.5, 11).reshaped(N, kD);
   d.increments.resize(N, kN);
   std::mt19937_64 rng(5);
   std::normal_distribution<double> noise(0.0, 1e-3);
@@ -172,8 +172,8 @@ void expect_belief_step_is_the_prediction(const GpBackend& backend) {
   Vector next(5), mu_next;
   Matrix Sigma_next;
   for (unsigned trial = 0; trial < 3; ++trial) {
-    const Vector mu = test::random_vector(kN, -1.0, 1.0, 40 + trial);
-    const Vector u = test::random_vector(kM, -1.0, 1.0, 50 + trial);
+    const Vector mu = gpilqg::test::random_vector(kN, -1.0, 1.0, 40 + trial);
+    const Vector u = gpilqg::test::random_vector(kM, -1.0, 1.0, 50 + trial);
     model.propagate(belief(mu, Matrix::Zero(kN, kN)), u, next);
     unpack_belief(next, kN, mu_next, Sigma_next);
     Vector z(kD);

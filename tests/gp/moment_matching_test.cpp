@@ -128,8 +128,8 @@ TEST(MomentMatching, DeterministicInputIsTheGpPosterior) {
 // 2. Monte Carlo
 
 /// The Monte Carlo check with the GP posterior computed here from the kernel as the integrand.
-MonteCarloCheck check_against_monte_carlo(const TestGp& gp, const Vector& mu, const Matrix& sigma, int samples,
-                                          const std::string& label) {
+MonteCarloCheck check_gp_against_monte_carlo(const TestGp& gp, const Vector& mu, const Matrix& sigma, int samples,
+                                             const std::string& label) {
   const auto posterior = [&gp](const Vector& z, Vector& mean, Vector& variance) {
     for (int a = 0; a < static_cast<int>(gp.outputs.size()); ++a) {
       mean(a) = gp.posterior_mean(a, z);
@@ -144,7 +144,7 @@ TEST(MomentMatching, AgreesWithMonteCarlo) {
   Vector mu(3);
   mu << 0.2, -0.3, 0.1;
   const Matrix sigma = make_sigma(3, 0.45, 7);
-  check_against_monte_carlo(gp, mu, sigma, 100000, "full Sigma");
+  check_gp_against_monte_carlo(gp, mu, sigma, 100000, "full Sigma");
 }
 
 TEST(MomentMatching, AgreesWithMonteCarloWithADeterministicInput) {
@@ -152,7 +152,7 @@ TEST(MomentMatching, AgreesWithMonteCarloWithADeterministicInput) {
   Vector mu(3);
   mu << -0.1, 0.4, 0.3;
   const Matrix sigma = make_sigma(3, 0.5, 8, /*zero_index=*/2);
-  check_against_monte_carlo(gp, mu, sigma, 100000, "zero row 2");
+  check_gp_against_monte_carlo(gp, mu, sigma, 100000, "zero row 2");
   MomentMatch m;
   gp.matcher().propagate(mu, sigma, m);
   EXPECT_TRUE(m.cross_covariance.row(2).isZero(1e-15));
@@ -161,7 +161,7 @@ TEST(MomentMatching, AgreesWithMonteCarloWithADeterministicInput) {
 // ------------------------------------------------------------------------------------------------
 // 3. Derivatives against central differences
 
-void check_derivatives(const TestGp& gp, const Vector& mu, const Matrix& sigma, const std::string& label) {
+void check_gp_derivatives(const TestGp& gp, const Vector& mu, const Matrix& sigma, const std::string& label) {
   test::check_derivatives(gp.matcher(), mu, sigma, label);
 }
 
@@ -169,26 +169,26 @@ TEST(MomentMatching, DerivativesMatchCentralDifferences) {
   const TestGp gp = make_gp(15, 4, 3, 21);
   Vector mu(4);
   mu << 0.3, -0.2, 0.5, 0.1;
-  check_derivatives(gp, mu, make_sigma(4, 0.4, 3), "full Sigma");
+  check_gp_derivatives(gp, mu, make_sigma(4, 0.4, 3), "full Sigma");
 }
 
 TEST(MomentMatching, DerivativesMatchCentralDifferencesWithADeterministicInput) {
   const TestGp gp = make_gp(15, 4, 3, 22);
   Vector mu(4);
   mu << -0.4, 0.1, 0.2, 0.6;
-  check_derivatives(gp, mu, make_sigma(4, 0.4, 4, /*zero_index=*/3), "zero row 3");
+  check_gp_derivatives(gp, mu, make_sigma(4, 0.4, 4, /*zero_index=*/3), "zero row 3");
 }
 
 TEST(MomentMatching, DerivativesMatchCentralDifferencesAtSigmaZero) {
   const TestGp gp = make_gp(12, 3, 2, 23);
   Vector mu(3);
   mu << 0.1, 0.2, -0.3;
-  check_derivatives(gp, mu, Matrix::Zero(3, 3), "Sigma = 0");
+  check_gp_derivatives(gp, mu, Matrix::Zero(3, 3), "Sigma = 0");
 }
 
 TEST(MomentMatching, DerivativesMatchCentralDifferencesOneInputOneOutput) {
   const TestGp gp = make_gp(10, 1, 1, 24);
-  check_derivatives(gp, Vector::Constant(1, 0.2), Matrix::Constant(1, 1, 0.3), "D = E = 1");
+  check_gp_derivatives(gp, Vector::Constant(1, 0.2), Matrix::Constant(1, 1, 0.3), "D = E = 1");
 }
 
 TEST(MomentMatching, LargeTrainingSetsGoThroughTheTiledProducts) {
@@ -199,7 +199,7 @@ TEST(MomentMatching, LargeTrainingSetsGoThroughTheTiledProducts) {
   const TestGp gp = make_gp(300, 3, 2, 25, /*spread=*/3.0);
   Vector mu(3);
   mu << 0.2, 0.1, -0.1;
-  check_derivatives(gp, mu, make_sigma(3, 0.3, 6, /*zero_index=*/2), "N = 300");
+  check_gp_derivatives(gp, mu, make_sigma(3, 0.3, 6, /*zero_index=*/2), "N = 300");
   MomentMatch m;
   gp.matcher().propagate(mu, Matrix::Zero(3, 3), m);
   for (int a = 0; a < 2; ++a) {
@@ -358,7 +358,7 @@ TEST(MomentMatching, ANegativeExpectedVarianceIsClampedWithZeroDerivatives) {
   gp.matcher().propagate(mu, Matrix::Zero(3, 3), m);
   EXPECT_EQ(m.covariance(0, 0), 0.0);
   EXPECT_NEAR(m.covariance(1, 1), gp.posterior_variance(1, mu), 1e-12);
-  check_derivatives(gp, mu, make_sigma(3, 0.3, 9), "clamped V_0");
+  check_gp_derivatives(gp, mu, make_sigma(3, 0.3, 9), "clamped V_0");
 }
 
 // ------------------------------------------------------------------------------------------------
