@@ -141,7 +141,7 @@ TEST(DiagnoseCli, PlotsNeedMatplotlibAndSayWhenItIsMissing) {
   const fs::path dir = test::temporary_dir("diagnose_plots");
   const fs::path data = friction_csv(dir);
   // An interpreter without matplotlib (/bin/false fails every import) gives a clear error before any work.
-  const std::string command = "GPILQG_PYTHON=/bin/false '" + std::string(GPILQG_CLI_PATH) + "' diagnose --system cartpole --data " +
+  const std::string command = "GPILQG_PYTHON=/bin/false '" + test::program_path() + "' diagnose --system cartpole --data " +
                               quote(data) + " --plots " + quote(dir / "p") + " 2>" + quote(dir / "err.txt");
   const int status = std::system(command.c_str());
   EXPECT_EQ(WEXITSTATUS(status), 2);

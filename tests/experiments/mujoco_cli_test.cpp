@@ -50,9 +50,9 @@ struct HiddenField {
   double tolerance;      ///< relative
 };
 
-class MujocoDiagnosis : public ::testing::TestWithParam<HiddenField> {};
+class MujocoDiagnosisCli : public ::testing::TestWithParam<HiddenField> {};
 
-TEST_P(MujocoDiagnosis, NamesTheChangedFieldWithItsValue) {
+TEST_P(MujocoDiagnosisCli, NamesTheChangedFieldWithItsValue) {
   const HiddenField& c = GetParam();
   const fs::path dir = test::temporary_dir("mujoco_diagnosis");
   const json report = diagnose(simulate(dir, "--param " + c.field + "=" + std::to_string(c.value)));
@@ -75,7 +75,7 @@ TEST_P(MujocoDiagnosis, NamesTheChangedFieldWithItsValue) {
 }
 
 // Friction loss within 30%: MuJoCo's is a constraint, the library's Coulomb friction a tanh.
-INSTANTIATE_TEST_SUITE_P(TwoLinkArm, MujocoDiagnosis,
+INSTANTIATE_TEST_SUITE_P(TwoLinkArm, MujocoDiagnosisCli,
                          ::testing::Values(HiddenField{"elbow.damping", 0.35, 0.15},
                                            HiddenField{"forearm.mass", 0.75, 0.15},
                                            HiddenField{"elbow_motor.gear", 1.25, 0.15},

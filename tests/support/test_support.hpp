@@ -38,6 +38,11 @@ Matrix numeric_jacobian(const std::function<Vector(const Vector&)>& g, const Vec
 /// Random vector with entries uniform in [lo, hi], from a fixed-seed generator per call site.
 Vector random_vector(int size, double lo, double hi, unsigned seed);
 
+/// The gpilqg program, for a test that runs it. Such a test belongs to a test suite whose name ends in
+/// `Cli`: tests/CMakeLists.txt labels those tests `cli` by that name (docs/testing.md says what runs
+/// where). A test of another suite that asks for the program fails, naming the rule.
+std::string program_path();
+
 /// Runs the gpilqg program with `arguments` (shell-quoted by the caller), capturing stdout and
 /// stderr separately; returns the exit status.
 struct CommandResult {
