@@ -1,6 +1,6 @@
 /// `gpilqg rollout --system NAME --policy POLICY.h5 --out LOG.csv|LOG.h5 [...]`: run a policy file on a
-/// simulated world and log what a robot would log (DESIGN.md sections 4 and 11), so that the loop of
-/// plan, run, log, plan again can be tried without hardware.
+/// simulated world and log what a robot would log (docs/real-robot.md#without-hardware-gpilqg-rollout),
+/// so that the loop of plan, run, log, plan again can be tried without hardware.
 
 #include <cmath>
 #include <iostream>
@@ -177,7 +177,9 @@ void add_rollout_command(CLI::App& app, CommandAction& action) {
   auto o = std::make_shared<RolloutOptions>();
   auto* cmd = app.add_subcommand("rollout", "Run a policy file on a simulated world and log it in the data format");
   add_world_options(*cmd, o->world);
-  cmd->add_option("--policy", o->policy, "Policy file of `gpilqg plan` (DESIGN.md section 11)")->required();
+  cmd->add_option("--policy", o->policy,
+                  "Policy file of `gpilqg plan` (docs/formats.md#policy-file-gpilqg-plan---out-policyh5)")
+      ->required();
   cmd->add_option("--out", o->out, "Log to write: .csv, or .h5 / .hdf5")->required();
   o->integrator_option = cmd->add_option("--integrator", o->integrator, "euler or rk4 (not for MuJoCo models)")
                              ->capture_default_str();
