@@ -1,7 +1,8 @@
-// `gpilqg diagnose` end to end: JSON with the fixed keys of DESIGN.md section 6 on stdout and nothing
-// else, the HDF5 report, plots, the add -> write-model -> model loop, and bad input (exit 2, "error:",
-// the file and line or the option, and the valid choices). Plus the pieces of the analysis with
-// closed-form answers: fit percent, the episode split, the cross-correlation band, the model file.
+// `gpilqg diagnose` end to end: JSON with the fixed keys of
+// docs/formats.md#diagnosis-json-gpilqg-diagnose---json on stdout and nothing else, the HDF5 report,
+// plots, the add -> write-model -> model loop, and bad input (exit 2, "error:", the file and line or
+// the option, and the valid choices). Plus the pieces of the analysis with closed-form answers: fit
+// percent, the episode split, the cross-correlation band, the model file.
 
 #include <gtest/gtest.h>
 

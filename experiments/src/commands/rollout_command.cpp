@@ -1,8 +1,8 @@
 /// `gpilqg rollout --system NAME --policy POLICY.h5 --out LOG.csv|LOG.h5 [...]`: run a policy file on a
-/// simulated world and log what a robot would log (docs/real-robot.md, "Without hardware"; the log in
-/// the measurement format of docs/formats.md), so that the loop of plan, run, log, plan again can be
-/// tried without hardware. The rollouts are policy_rollout.hpp's; this file reads the options, checks
-/// them and reports.
+/// simulated world and log what a robot would log (docs/real-robot.md#without-hardware-gpilqg-rollout;
+/// the log in the measurement format of docs/formats.md), so that the loop of plan, run, log, plan
+/// again can be tried without hardware. The rollouts are policy_rollout.hpp's; this file reads the
+/// options, checks them and reports.
 
 #include <cmath>
 #include <iostream>
@@ -160,7 +160,9 @@ void add_rollout_command(CLI::App& app, CommandAction& action) {
   auto o = std::make_shared<RolloutOptions>();
   auto* cmd = app.add_subcommand("rollout", "Run a policy file on a simulated world and log it in the data format");
   add_world_options(*cmd, o->world);
-  cmd->add_option("--policy", o->policy, "Policy file of `gpilqg plan` (DESIGN.md section 11)")->required();
+  cmd->add_option("--policy", o->policy,
+                  "Policy file of `gpilqg plan` (docs/formats.md#policy-file-gpilqg-plan---out-policyh5)")
+      ->required();
   cmd->add_option("--out", o->out, "Log to write: .csv, or .h5 / .hdf5")->required();
   o->integrator_option = cmd->add_option("--integrator", o->integrator, "euler or rk4 (not for MuJoCo models)")
                              ->capture_default_str();

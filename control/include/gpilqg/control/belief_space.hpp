@@ -6,9 +6,9 @@
 ///
 ///   E[l(x, u)] = l(mu, u) + 0.5 tr(l_xx Sigma)      for x ~ N(mu, Sigma)
 ///
-/// exact for quadratic costs (the paper's and DESIGN.md's), a second-order approximation otherwise
-/// (l_xx is then taken as constant in the derivatives). Its derivative with respect to the packed
-/// entry (i, j) of Sigma is 0.5 l_xx,ii on the diagonal and l_xx,ij off it.
+/// exact for quadratic costs (the paper's and core/cost.hpp's QuadraticCost), a second-order
+/// approximation otherwise (l_xx is then taken as constant in the derivatives). Its derivative with
+/// respect to the packed entry (i, j) of Sigma is 0.5 l_xx,ii on the diagonal and l_xx,ij off it.
 
 #include "gpilqg/control/ddp_solver.hpp"
 #include "gpilqg/core/belief.hpp"

@@ -3,8 +3,8 @@
 /// Stage and terminal costs with their first and second derivatives (paper eq. for J(x_0): the total
 /// cost l_T(x_T) + sum_t l(x_t, u_t)).
 ///
-/// QuadraticCost is the cost of DESIGN.md section 8 and of the reference problem, with an optional
-/// time-varying reference (tracking):
+/// QuadraticCost is the cost of docs/formats.md#problem-config-gpilqg-solve-and-gpilqg-plan and of the
+/// reference problem, with an optional time-varying reference (tracking):
 ///
 ///   l_t(x, u) = dt (0.5 e' Q e + 0.5 d' R d),   e = x - x_ref(t),  d = u - u_ref(t)
 ///   l_T(x)    = 0.5 e' Qf e,                    e = x - x_ref(T)

@@ -1,6 +1,6 @@
 #pragma once
 /// @file step_model.hpp
-/// Discrete-time models, the interface every controller works against (DESIGN.md section 2).
+/// Discrete-time models, the interface every controller works against (docs/architecture.md#layers).
 ///
 /// The paper's discrete stochastic step (its eq. for x' in the Robust-ILQG section):
 ///
@@ -90,7 +90,7 @@ class StepModel {
 };
 
 /// A system whose simulator is its own discrete-time integrator rather than one of integrator.hpp's:
-/// a MuJoCo model steps with its own integrator and timestep (DESIGN.md section 10).
+/// a MuJoCo model steps with its own integrator and timestep (docs/own-system.md#5-how-it-works).
 /// make_step_model (integrator.hpp) asks for it.
 class OwnIntegrator {
  public:
