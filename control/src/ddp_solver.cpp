@@ -112,7 +112,7 @@ class Engine {
  public:
   Engine(const DdpProblem& problem, const DdpOptions& options, DdpWorkspace& ws)
       : pb_(problem), opt_(options), ws_(ws), model_(*problem.model), cost_(*problem.cost),
-        model_ws_(problem.model->make_workspace()) {}
+        model_ws_(problem.model->make_workspace()), cost_ws_(problem.cost->make_workspace()) {}
 
   DdpResult run(const Matrix& initial_controls);
 
@@ -210,6 +210,7 @@ class Engine {
   const StepModel& model_;
   const Cost& cost_;
   std::unique_ptr<StepWorkspace> model_ws_;  ///< the model's scratch for this solve (model/data split)
+  std::unique_ptr<CostWorkspace> cost_ws_;   ///< the cost's scratch for this solve
 
   double lambda_ = 0.0;
   double dlambda_ = 1.0;
@@ -242,7 +243,7 @@ double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
   double merit = 0.0;
   for (int t = 0; t < T; ++t) {
     ws_.policy.control(t, x_out.col(t), u_out.col(t), alpha);
-    merit += cost_.stage(t, x_out.col(t), u_out.col(t));
+    merit += cost_.stage(t, x_out.col(t), u_out.col(t), nullptr, *cost_ws_);
     if (uses_noise()) {
       const auto& S_next = ws_.S[static_cast<std::size_t>(t + 1)];
       model_.noise(x_out.col(t), u_out.col(t), ws_.candidate_columns, false, *model_ws_);
@@ -265,7 +266,7 @@ double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
       return std::numeric_limits<double>::infinity();
     }
   }
-  merit += cost_.terminal(x_out.col(T));
+  merit += cost_.terminal(x_out.col(T), nullptr, *cost_ws_);
   return std::isfinite(merit) ? merit : std::numeric_limits<double>::infinity();
 }
 
@@ -278,7 +279,7 @@ void Engine::differentiate() {
   for (int t = 0; t < T; ++t) {
     const auto ts = static_cast<std::size_t>(t);
     if (!model_jacobians_current_) model_.step(x.col(t), u.col(t), ws_.x_new.col(t + 1), &ws_.jac[ts], *model_ws_);
-    cost_.stage(t, x.col(t), u.col(t), &ws_.cost[ts]);
+    cost_.stage(t, x.col(t), u.col(t), &ws_.cost[ts], *cost_ws_);
     if (uses_noise()) {
       model_.noise(x.col(t), u.col(t), ws_.noise[ts], true, *model_ws_);
       scale_columns(ws_.noise[ts], sqrt_dt);
@@ -288,7 +289,7 @@ void Engine::differentiate() {
       scale_columns(ws_.uncertainty[ts], sqrt_dt);
     }
   }
-  cost_.terminal(x.col(T), &ws_.cost[static_cast<std::size_t>(T)]);
+  cost_.terminal(x.col(T), &ws_.cost[static_cast<std::size_t>(T)], *cost_ws_);
   model_jacobians_current_ = true;
   derivatives_current_ = true;
 }
@@ -633,8 +634,8 @@ void Engine::open_loop_fallback(double merit, DdpSummary& summary) {
   for (auto& K : w.policy.K) K.setZero();
   for (auto& S : w.S) S.setZero();
   w.gradient.setZero();
-  nominal_cost_ = cost_.terminal(w.policy.x_bar.col(T));
-  for (int t = 0; t < T; ++t) nominal_cost_ += cost_.stage(t, w.policy.x_bar.col(t), w.policy.u_bar.col(t));
+  nominal_cost_ = cost_.terminal(w.policy.x_bar.col(T), nullptr, *cost_ws_);
+  for (int t = 0; t < T; ++t) nominal_cost_ += cost_.stage(t, w.policy.x_bar.col(t), w.policy.u_bar.col(t), nullptr, *cost_ws_);
   merit_at_nominal_ = std::max(merit, nominal_cost_);
   gradient_norm_ = summary.trace.empty() ? 0.0 : summary.trace.back().gradient_norm;
   summary.final_backward_failed = true;

@@ -44,9 +44,15 @@ class BeliefCost final : public Cost {
   explicit BeliefCost(const Cost& cost);
   int state_dim() const override { return belief_dim(n_); }
   int control_dim() const override { return cost_.control_dim(); }
-  double stage(int t, const VectorCRef& v, const VectorCRef& u, CostDerivatives* d = nullptr) const override;
-  double terminal(const VectorCRef& v, CostDerivatives* d = nullptr) const override;
-  double terminal_at(int t, const VectorCRef& v, CostDerivatives* d = nullptr) const override;
+  /// Holds the state cost's workspace and the state-space derivatives that the belief ones lift.
+  std::unique_ptr<CostWorkspace> make_workspace() const override;
+  using Cost::stage;
+  using Cost::terminal;
+  using Cost::terminal_at;
+  double stage(int t, const VectorCRef& v, const VectorCRef& u, CostDerivatives* d,
+               CostWorkspace& workspace) const override;
+  double terminal(const VectorCRef& v, CostDerivatives* d, CostWorkspace& workspace) const override;
+  double terminal_at(int t, const VectorCRef& v, CostDerivatives* d, CostWorkspace& workspace) const override;
 
  private:
   /// Adds 0.5 tr(l_xx Sigma) to the value and writes the belief-space derivatives from the state ones.

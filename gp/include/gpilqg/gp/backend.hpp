@@ -132,6 +132,17 @@ struct NlmlEvaluation {
   double jitter = 0.0;  ///< absolute jitter that was needed
 };
 
+/// The scratch space of one caller of a likelihood class (FitcLikelihood, SsgpLikelihood; Crocoddyl's
+/// model/data split, as StepWorkspace is for a StepModel): made by the likelihood's make_workspace(),
+/// owned by the caller (the objective that the optimiser evaluates), used by one thread at a time and
+/// reused from evaluation to evaluation. The likelihood itself is immutable and shareable.
+struct LikelihoodWorkspace {
+  virtual ~LikelihoodWorkspace() = default;
+};
+
+/// The objective an optimiser evaluates. It owns the scratch of its evaluations (the exact GP's
+/// matrices, a sparse likelihood's LikelihoodWorkspace), hence the non-const evaluate(); one objective
+/// serves one thread.
 class MarginalLikelihoodObjective {
  public:
   virtual ~MarginalLikelihoodObjective() = default;
