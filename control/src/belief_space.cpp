@@ -25,12 +25,6 @@ std::unique_ptr<StepWorkspace> BeliefSpaceModel::make_workspace() const {
   return ws;
 }
 
-void BeliefSpaceModel::step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
-                            StepJacobians* jacobians) const {
-  const auto workspace = make_workspace();
-  step(v, u, v_next, jacobians, *workspace);
-}
-
 void BeliefSpaceModel::step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next, StepJacobians* jacobians,
                             StepWorkspace& workspace) const {
   auto& ws = workspace_as<BeliefSpaceWorkspace>(workspace);

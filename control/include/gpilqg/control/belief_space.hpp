@@ -26,8 +26,7 @@ class BeliefSpaceModel final : public StepModel {
   double dt() const override { return belief_.dt(); }
   /// Holds the belief model's workspace and its Jacobians.
   std::unique_ptr<StepWorkspace> make_workspace() const override;
-  void step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
-            StepJacobians* jacobians = nullptr) const override;
+  using StepModel::step;
   void step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next, StepJacobians* jacobians,
             StepWorkspace& workspace) const override;
   /// The moment match dominates a belief step; its derivatives add little (docs/results/pddp.md).
