@@ -26,15 +26,19 @@ class WithUncertainty final : public StepModel {
   int state_dim() const override { return base_.state_dim(); }
   int control_dim() const override { return base_.control_dim(); }
   double dt() const override { return base_.dt(); }
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef next, StepJacobians* j) const override {
-    base_.step(x, u, next, j);
+  std::unique_ptr<StepWorkspace> make_workspace() const override { return base_.make_workspace(); }
+  using StepModel::step;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef next, StepJacobians* j, StepWorkspace& workspace) const override {
+    base_.step(x, u, next, j, workspace);
   }
   int noise_dim() const override { return base_.noise_dim(); }
-  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool d) const override {
-    base_.noise(x, u, out, d);
+  using StepModel::noise;
+  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool d, StepWorkspace& workspace) const override {
+    base_.noise(x, u, out, d, workspace);
   }
   int uncertainty_dim() const override { return base_.state_dim(); }
-  void uncertainty(const VectorCRef&, const VectorCRef&, DiffusionColumns& out, bool) const override {
+  using StepModel::uncertainty;
+  void uncertainty(const VectorCRef&, const VectorCRef&, DiffusionColumns& out, bool, StepWorkspace&) const override {
     const int n = state_dim();
     if (out.count() != n) out.resize(n, control_dim(), n);
     out.columns = 0.01 * Matrix::Identity(n, n);

@@ -80,8 +80,9 @@ void BM_FitcNlmlGradient(benchmark::State& state) {
   const gp::FitcLikelihood likelihood(data.inputs, data.targets, M, gp::FitcJitter::gpml(), {}, threads);
   const Vector theta = fitc_theta(data, M);
   Vector gradient;
+  const auto workspace = likelihood.make_workspace();
   for (auto _ : state) {
-    const gp::NlmlEvaluation e = likelihood.evaluate(theta, &gradient);
+    const gp::NlmlEvaluation e = likelihood.evaluate(theta, &gradient, *workspace);
     benchmark::DoNotOptimize(e.value);
     benchmark::DoNotOptimize(gradient.data());
   }
@@ -94,7 +95,8 @@ void BM_FitcNlmlOnly(benchmark::State& state) {
   const gp::TrainingSet data = make_data(N);
   const gp::FitcLikelihood likelihood(data.inputs, data.targets, M);
   const Vector theta = fitc_theta(data, M);
-  for (auto _ : state) benchmark::DoNotOptimize(likelihood.evaluate(theta).value);
+  const auto workspace = likelihood.make_workspace();
+  for (auto _ : state) benchmark::DoNotOptimize(likelihood.evaluate(theta, nullptr, *workspace).value);
 }
 
 void BM_SsgpNlmlGradient(benchmark::State& state) {
@@ -105,8 +107,9 @@ void BM_SsgpNlmlGradient(benchmark::State& state) {
   const gp::SsgpLikelihood likelihood(data.inputs, data.targets, m, {}, threads);
   const Vector theta = ssgp_theta(m);
   Vector gradient;
+  const auto workspace = likelihood.make_workspace();
   for (auto _ : state) {
-    const gp::NlmlEvaluation e = likelihood.evaluate(theta, &gradient);
+    const gp::NlmlEvaluation e = likelihood.evaluate(theta, &gradient, *workspace);
     benchmark::DoNotOptimize(e.value);
     benchmark::DoNotOptimize(gradient.data());
   }

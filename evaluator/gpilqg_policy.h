@@ -1,7 +1,8 @@
 /* gpilqg_policy.h: run a gpilqg policy file on a robot's controller, in plain C (C89 and later).
  *
- * No dependencies, no allocation, no global state: the caller owns the arrays. They are the
- * datasets of the policy file (DESIGN.md section 11) in the order HDF5 stores them (row-major):
+ * No dependencies, no allocation, no global state: the caller owns the arrays. They are the datasets of
+ * the policy file (docs/formats.md#policy-file-gpilqg-plan---out-policyh5) in the order HDF5 stores
+ * them (row-major):
  *
  *   x_bar  (T+1) x n   the planned nominal states            x_bar[t*n + i]
  *   u_bar  T x m       the nominal controls                  u_bar[t*m + j]

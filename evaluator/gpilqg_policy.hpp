@@ -1,10 +1,10 @@
 // gpilqg_policy.hpp: run a gpilqg policy file on a robot's controller, in C++17 with the standard
 // library only (header-only; no Eigen, no HDF5, no gpilqg library).
 //
-// The arrays are the datasets of the policy file (DESIGN.md section 11) in the order HDF5 stores
-// them (row-major): x_bar (T+1) x n, u_bar T x m, K T x m x n, and the attributes u_min and u_max
-// (m entries each, or empty when the file has none). The control law at step t with the measured
-// state x is
+// The arrays are the datasets of the policy file
+// (docs/formats.md#policy-file-gpilqg-plan---out-policyh5) in the order HDF5 stores them (row-major):
+// x_bar (T+1) x n, u_bar T x m, K T x m x n, and the attributes u_min and u_max (m entries each, or
+// empty when the file has none). The control law at step t with the measured state x is
 //     u = clamp(u_bar_t + K_t (x - x_bar_t), u_min, u_max).
 // Construction checks the sizes once (and may allocate); control() never allocates or throws.
 #pragma once

@@ -12,18 +12,17 @@ struct BeliefSpaceWorkspace final : StepWorkspace {
   BeliefJacobians jacobians;
 };
 
+struct BeliefCostWorkspace final : CostWorkspace {
+  std::unique_ptr<CostWorkspace> cost;  ///< the state cost's workspace
+  CostDerivatives state;                ///< the state cost's derivatives at the mean
+};
+
 }  // namespace
 
 std::unique_ptr<StepWorkspace> BeliefSpaceModel::make_workspace() const {
   auto ws = std::make_unique<BeliefSpaceWorkspace>();
   ws->belief = belief_.make_workspace();
   return ws;
-}
-
-void BeliefSpaceModel::step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
-                            StepJacobians* jacobians) const {
-  const auto workspace = make_workspace();
-  step(v, u, v_next, jacobians, *workspace);
 }
 
 void BeliefSpaceModel::step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next, StepJacobians* jacobians,
@@ -69,22 +68,29 @@ double BeliefCost::lift(double value, const CostDerivatives& state, const Vector
   return value + trace;
 }
 
-double BeliefCost::stage(int t, const VectorCRef& v, const VectorCRef& u, CostDerivatives* d) const {
-  thread_local CostDerivatives state;
-  const double value = cost_.stage(t, v.head(n_), u, &state);
-  return lift(value, state, v, d, true);
+std::unique_ptr<CostWorkspace> BeliefCost::make_workspace() const {
+  auto ws = std::make_unique<BeliefCostWorkspace>();
+  ws->cost = cost_.make_workspace();
+  return ws;
 }
 
-double BeliefCost::terminal(const VectorCRef& v, CostDerivatives* d) const {
-  thread_local CostDerivatives state;
-  const double value = cost_.terminal(v.head(n_), &state);
-  return lift(value, state, v, d, false);
+double BeliefCost::stage(int t, const VectorCRef& v, const VectorCRef& u, CostDerivatives* d,
+                         CostWorkspace& workspace) const {
+  auto& ws = workspace_as<BeliefCostWorkspace>(workspace);
+  const double value = cost_.stage(t, v.head(n_), u, &ws.state, *ws.cost);
+  return lift(value, ws.state, v, d, true);
 }
 
-double BeliefCost::terminal_at(int t, const VectorCRef& v, CostDerivatives* d) const {
-  thread_local CostDerivatives state;
-  const double value = cost_.terminal_at(t, v.head(n_), &state);
-  return lift(value, state, v, d, false);
+double BeliefCost::terminal(const VectorCRef& v, CostDerivatives* d, CostWorkspace& workspace) const {
+  auto& ws = workspace_as<BeliefCostWorkspace>(workspace);
+  const double value = cost_.terminal(v.head(n_), &ws.state, *ws.cost);
+  return lift(value, ws.state, v, d, false);
+}
+
+double BeliefCost::terminal_at(int t, const VectorCRef& v, CostDerivatives* d, CostWorkspace& workspace) const {
+  auto& ws = workspace_as<BeliefCostWorkspace>(workspace);
+  const double value = cost_.terminal_at(t, v.head(n_), &ws.state, *ws.cost);
+  return lift(value, ws.state, v, d, false);
 }
 
 PddpResult solve_pddp(const PddpProblem& problem, const Matrix& initial_controls, DdpOptions options) {

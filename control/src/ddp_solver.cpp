@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -19,6 +20,14 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Runs `stage` and adds its wall time to `seconds`.
+template <class Stage>
+void timed(double& seconds, Stage&& stage) {
+  const auto start = Clock::now();
+  stage();
+  seconds += seconds_since(start);
 }
 
 /// Columns c_i = sqrt(dt) F^(i) (and G^(j)) with their derivatives, as the Q-expansion uses them.
@@ -103,7 +112,7 @@ class Engine {
  public:
   Engine(const DdpProblem& problem, const DdpOptions& options, DdpWorkspace& ws)
       : pb_(problem), opt_(options), ws_(ws), model_(*problem.model), cost_(*problem.cost),
-        model_ws_(problem.model->make_workspace()) {}
+        model_ws_(problem.model->make_workspace()), cost_ws_(problem.cost->make_workspace()) {}
 
   DdpResult run(const Matrix& initial_controls);
 
@@ -122,10 +131,78 @@ class Engine {
   void accept_candidate();
   /// One backward pass with regularisation lambda. False when a Q_uu block is not positive definite.
   bool backward(double lambda);
+  /// The regularisation schedule of Tassa, Erez and Todorov (IROS 2012, sec. II-F), with
+  /// lambda_0 = DdpOptions::lambda_factor: after a failure
+  ///   dlambda <- max(dlambda lambda_0, lambda_0),   lambda <- max(lambda dlambda, lambda_min).
   void increase_lambda();
+  /// After a success: dlambda <- min(dlambda / lambda_0, 1 / lambda_0), lambda <- lambda dlambda,
+  /// and lambda <- 0 once it falls below lambda_min (no regularisation at all).
   void decrease_lambda();
   /// sum_i 0.5 c_i' S c_i for the columns at one step.
   static double trace_term(const DiffusionColumns& d, const Matrix& S, Vector& Sc);
+
+  // The stages of run(), in the order the algorithm takes them.
+
+  /// Sizes the workspace for the problem, sets the control bounds (infinite where the problem has
+  /// none), zeros the policy and the stored S = V_xx, and resets the schedule to
+  /// lambda = lambda_initial, dlambda = 1.
+  void prepare();
+  /// The initial rollout: the initial controls clamped to [u_min, u_max], open loop (K = 0, k = 0,
+  /// u_bar = the controls), into the candidate (x_new, u_new). Returns its cost (S = 0, so no trace
+  /// terms), +inf when it diverges.
+  double initial_rollout(const Matrix& initial_controls);
+  /// The result of a diverged initial rollout: costs +inf (DdpResult's contract); the states reached
+  /// (the last one repeated) and the clamped initial controls, open loop; no value Hessians.
+  DdpResult diverged_result(double merit, Clock::time_point start) const;
+  /// The regularised backward pass: backward(lambda) at the current lambda, raising lambda
+  /// (increase_lambda) after each failure until every Q_uu block is positive definite or
+  /// lambda > lambda_max. Records lambda, the failures and the projected gradient norm; false when
+  /// the limit was passed.
+  bool regularised_backward(DdpIteration& record);
+  /// Termination after the backward pass: RegularizationLimit when it failed at lambda_max,
+  /// GradientNorm when the projected gradient is small, |g|_inf < gradient_tolerance.
+  std::optional<DdpTermination> backward_termination(bool backward_ok) const;
+
+  struct LineSearchOutcome {
+    bool accepted = false;
+    double merit = 0.0;  ///< the accepted candidate's merit (the last one tried when none was)
+  };
+  /// The line search over the feed-forward scale alpha (Tassa, Erez and Todorov 2012). The steps are
+  /// alpha_s = 10^(-3 s / (S - 1)), s = 0..S-1 (S = line_search_steps; alpha = 1 when S = 1). For
+  /// each, with dV1 = sum_t k_t' Q_u and dV2 = sum_t 0.5 k_t' Q_uu k_t from the backward pass, the
+  /// quadratic model expects the reduction
+  ///   expected(alpha) = -(alpha dV1 + alpha^2 dV2),
+  /// and the candidate is accepted, Armijo-like, when its merit is finite and the ratio
+  ///   z = (J - J(alpha)) / expected(alpha)  >  min_reduction_ratio
+  /// (z = +1 or -1 by the sign of the actual reduction when expected <= 0). Records the trials and,
+  /// for an accepted step, alpha and both reductions. The accepted candidate is left in
+  /// (x_new, u_new).
+  LineSearchOutcome line_search(double merit, DdpIteration& record);
+  /// Termination after an accepted step: the cost changed by at most
+  /// cost_tolerance max(|J|, 1e-12) (J the merit before the step). CostChange when the trajectory is
+  /// stationary (ddp_summary.hpp's stationary()), else Stalled: a tiny accepted step with a huge or
+  /// non-finite gradient is a stall of the line search, not a minimum.
+  std::optional<DdpTermination> cost_change_termination(double merit, double new_merit,
+                                                        double actual_reduction) const;
+  /// Termination after a rejected line search (lambda already raised): lambda > lambda_max.
+  std::optional<DdpTermination> rejection_termination() const;
+  /// Termination by the budgets, checked in this order after every iteration: the wall time
+  /// (elapsed > max_seconds), the caller (on_iteration(last) returns false), the iteration count
+  /// (iteration == max_iterations).
+  std::optional<DdpTermination> budget_termination(Clock::time_point start, const DdpIteration& last,
+                                                   int iteration) const;
+  /// Derivatives and one more backward pass at the returned trajectory, for its gains, value
+  /// Hessians and expected cost: lambda = 0 first, then lambda <- max(10 lambda, lambda_min) while
+  /// the pass fails and lambda <= lambda_max. False when none worked.
+  bool final_backward(DdpTimings& timings);
+  /// When no final backward pass works (non-finite or hopelessly indefinite derivatives at the
+  /// returned trajectory), what the failed pass left is partial: an open-loop policy, the nominal
+  /// cost summed directly, the larger of it and `merit` (the last accepted iterate's) as the expected
+  /// cost, no value Hessians and the last recorded gradient norm.
+  void open_loop_fallback(double merit, DdpSummary& summary);
+  /// The returned trajectory, policy (gains of the final backward pass, k = 0), costs, value Hessians
+  /// and gradient, and the summary's final values.
+  void finish(double merit, Clock::time_point start, DdpResult& result);
 
   const DdpProblem& pb_;
   const DdpOptions& opt_;
@@ -133,6 +210,7 @@ class Engine {
   const StepModel& model_;
   const Cost& cost_;
   std::unique_ptr<StepWorkspace> model_ws_;  ///< the model's scratch for this solve (model/data split)
+  std::unique_ptr<CostWorkspace> cost_ws_;   ///< the cost's scratch for this solve
 
   double lambda_ = 0.0;
   double dlambda_ = 1.0;
@@ -165,7 +243,7 @@ double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
   double merit = 0.0;
   for (int t = 0; t < T; ++t) {
     ws_.policy.control(t, x_out.col(t), u_out.col(t), alpha);
-    merit += cost_.stage(t, x_out.col(t), u_out.col(t));
+    merit += cost_.stage(t, x_out.col(t), u_out.col(t), nullptr, *cost_ws_);
     if (uses_noise()) {
       const auto& S_next = ws_.S[static_cast<std::size_t>(t + 1)];
       model_.noise(x_out.col(t), u_out.col(t), ws_.candidate_columns, false, *model_ws_);
@@ -188,7 +266,7 @@ double Engine::forward(double alpha, Matrix& x_out, Matrix& u_out) {
       return std::numeric_limits<double>::infinity();
     }
   }
-  merit += cost_.terminal(x_out.col(T));
+  merit += cost_.terminal(x_out.col(T), nullptr, *cost_ws_);
   return std::isfinite(merit) ? merit : std::numeric_limits<double>::infinity();
 }
 
@@ -201,7 +279,7 @@ void Engine::differentiate() {
   for (int t = 0; t < T; ++t) {
     const auto ts = static_cast<std::size_t>(t);
     if (!model_jacobians_current_) model_.step(x.col(t), u.col(t), ws_.x_new.col(t + 1), &ws_.jac[ts], *model_ws_);
-    cost_.stage(t, x.col(t), u.col(t), &ws_.cost[ts]);
+    cost_.stage(t, x.col(t), u.col(t), &ws_.cost[ts], *cost_ws_);
     if (uses_noise()) {
       model_.noise(x.col(t), u.col(t), ws_.noise[ts], true, *model_ws_);
       scale_columns(ws_.noise[ts], sqrt_dt);
@@ -211,7 +289,7 @@ void Engine::differentiate() {
       scale_columns(ws_.uncertainty[ts], sqrt_dt);
     }
   }
-  cost_.terminal(x.col(T), &ws_.cost[static_cast<std::size_t>(T)]);
+  cost_.terminal(x.col(T), &ws_.cost[static_cast<std::size_t>(T)], *cost_ws_);
   model_jacobians_current_ = true;
   derivatives_current_ = true;
 }
@@ -375,11 +453,65 @@ void Engine::decrease_lambda() {
   if (lambda_ < opt_.lambda_min) lambda_ = 0.0;
 }
 
+/// The algorithm: the initial rollout, then iterations of derivatives, regularised backward pass and
+/// line search until a termination test holds, then the final backward pass at the returned
+/// trajectory.
 DdpResult Engine::run(const Matrix& initial_controls) {
   const auto start = Clock::now();
+  prepare();
+  double merit = initial_rollout(initial_controls);
+  if (!std::isfinite(merit)) return diverged_result(merit, start);
+  accept_candidate();  // u_bar: the initial controls, as the rollout applied them
+
+  DdpResult result;
+  DdpSummary& summary = result.summary;
+  summary.initial_cost = merit;
+  for (int iter = 1; iter <= opt_.max_iterations; ++iter) {
+    DdpIteration record;
+    record.iteration = iter;
+    timed(summary.timings.derivatives_s, [&] { differentiate(); });
+    bool backward_ok = false;
+    timed(summary.timings.backward_s, [&] { backward_ok = regularised_backward(record); });
+    merit = merit_at_nominal_;  // the current trajectory's merit under the new S
+    if (iter == 1) summary.initial_cost = merit;
+    if (const auto termination = backward_termination(backward_ok)) {
+      record.cost = merit;
+      summary.trace.push_back(record);
+      summary.termination = *termination;
+      break;
+    }
+
+    LineSearchOutcome step;
+    timed(summary.timings.forward_s, [&] { step = line_search(merit, record); });
+    std::optional<DdpTermination> termination;
+    if (step.accepted) {
+      accept_candidate();
+      decrease_lambda();
+      record.accepted = true;
+      record.cost = step.merit;
+      termination = cost_change_termination(merit, step.merit, record.actual_reduction);
+      merit = step.merit;
+    } else {
+      increase_lambda();
+      record.cost = merit;
+      termination = rejection_termination();
+    }
+    summary.trace.push_back(record);
+    if (!termination) termination = budget_termination(start, summary.trace.back(), iter);
+    if (termination) {
+      summary.termination = *termination;
+      break;
+    }
+  }
+  summary.iterations = static_cast<int>(summary.trace.size());
+  finish(merit, start, result);
+  return result;
+}
+
+void Engine::prepare() {
   auto& w = ws_;
-  const int n = model_.state_dim(), m = model_.control_dim(), T = pb_.horizon;
-  w.resize(n, m, T);
+  const int m = model_.control_dim(), T = pb_.horizon;
+  w.resize(model_.state_dim(), m, T);
   w.lower = pb_.u_min.size() ? pb_.u_min : Vector::Constant(m, -std::numeric_limits<double>::infinity());
   w.upper = pb_.u_max.size() ? pb_.u_max : Vector::Constant(m, std::numeric_limits<double>::infinity());
   w.policy.u_min = pb_.u_min.size() ? w.lower : Vector();
@@ -387,173 +519,143 @@ DdpResult Engine::run(const Matrix& initial_controls) {
   for (auto& S : w.S) S.setZero();
   for (auto& K : w.policy.K) K.setZero();
   w.policy.k.setZero();
-
-  DdpResult result;
-  DdpSummary& summary = result.summary;
   jacobians_in_forward_ = model_.jacobians_nearly_free();
   model_jacobians_current_ = derivatives_current_ = false;
   lambda_ = opt_.lambda_initial;
   dlambda_ = 1.0;
+}
 
-  // Initial rollout: the initial controls, clamped, open loop (K = 0, k = 0, u_bar = controls).
-  w.policy.u_bar = initial_controls.cwiseMax(w.lower.replicate(1, T)).cwiseMin(w.upper.replicate(1, T));
-  w.policy.x_bar.setZero();
-  double merit = forward(0.0, w.x_new, w.u_new);
-  if (!std::isfinite(merit)) {
-    // The costs of a diverging rollout are +infinity (documented in DdpResult); everything else is
-    // finite: the states reached (the last one repeated) and the clamped initial controls, open loop.
-    summary.termination = DdpTermination::InitialRolloutDiverged;
-    summary.initial_cost = summary.final_cost = merit;
-    summary.timings.total_s = seconds_since(start);
-    result.trajectory.x = w.x_new;
-    result.trajectory.u = w.u_new;
-    result.policy = w.policy;
-    result.policy.x_bar = w.x_new;
-    result.nominal_cost = result.expected_cost = merit;
-    result.value_hessians.assign(static_cast<std::size_t>(T) + 1, Matrix::Zero(n, n));
-    result.gradient = Matrix::Zero(m, T);
-    return result;
-  }
-  accept_candidate();  // u_bar: the initial controls, as the rollout applied them
-  summary.initial_cost = merit;
+double Engine::initial_rollout(const Matrix& initial_controls) {
+  const int T = ws_.T;
+  ws_.policy.u_bar = initial_controls.cwiseMax(ws_.lower.replicate(1, T)).cwiseMin(ws_.upper.replicate(1, T));
+  ws_.policy.x_bar.setZero();
+  return forward(0.0, ws_.x_new, ws_.u_new);
+}
 
-  const double log_first = 0.0, log_last = -3.0;
-  bool stop = false;
-  for (int iter = 1; iter <= opt_.max_iterations && !stop; ++iter) {
-    DdpIteration record;
-    record.iteration = iter;
+DdpResult Engine::diverged_result(double merit, Clock::time_point start) const {
+  const auto& w = ws_;
+  DdpResult result;
+  DdpSummary& summary = result.summary;
+  summary.termination = DdpTermination::InitialRolloutDiverged;
+  summary.initial_cost = summary.final_cost = merit;
+  summary.timings.total_s = seconds_since(start);
+  result.trajectory.x = w.x_new;
+  result.trajectory.u = w.u_new;
+  result.policy = w.policy;
+  result.policy.x_bar = w.x_new;
+  result.nominal_cost = result.expected_cost = merit;
+  result.value_hessians.assign(static_cast<std::size_t>(w.T) + 1, Matrix::Zero(w.n, w.n));
+  result.gradient = Matrix::Zero(w.m, w.T);
+  return result;
+}
 
-    auto t0 = Clock::now();
-    differentiate();
-    summary.timings.derivatives_s += seconds_since(t0);
-
-    // Backward pass, raising the regularisation until every Q_uu block is positive definite.
-    t0 = Clock::now();
-    bool backward_ok = false;
-    while (!backward_ok) {
-      backward_ok = backward(lambda_);
-      if (!backward_ok) {
-        ++record.backward_failures;
-        increase_lambda();
-        if (lambda_ > opt_.lambda_max) break;
-      }
-    }
-    summary.timings.backward_s += seconds_since(t0);
-    record.lambda = lambda_;
-    record.gradient_norm = gradient_norm_;
-    merit = merit_at_nominal_;  // the current trajectory's merit under the new S
-    if (iter == 1) summary.initial_cost = merit;
-    if (!backward_ok) {
-      record.cost = merit;
-      summary.trace.push_back(record);
-      summary.termination = DdpTermination::RegularizationLimit;
-      break;
-    }
-    if (gradient_norm_ < opt_.gradient_tolerance) {
-      record.cost = merit;
-      summary.trace.push_back(record);
-      summary.termination = DdpTermination::GradientNorm;
-      break;
-    }
-
-    // Line search on the ratio of actual to expected reduction.
-    t0 = Clock::now();
-    bool accepted = false;
-    double new_merit = merit;
-    for (int s = 0; s < opt_.line_search_steps && !accepted; ++s) {
-      const double exponent =
-          opt_.line_search_steps == 1 ? log_first
-                                      : log_first + (log_last - log_first) * s / (opt_.line_search_steps - 1);
-      const double alpha = std::pow(10.0, exponent);
-      new_merit = forward(alpha, w.x_new, w.u_new);
-      ++record.line_search_trials;
-      const double expected = -(alpha * dV1_ + alpha * alpha * dV2_);
-      const double actual = merit - new_merit;
-      if (!std::isfinite(new_merit)) continue;
-      const double ratio = expected > 0.0 ? actual / expected : (actual > 0.0 ? 1.0 : -1.0);
-      if (ratio > opt_.min_reduction_ratio) {
-        accepted = true;
-        record.step = alpha;
-        record.expected_reduction = expected;
-        record.actual_reduction = actual;
-      }
-    }
-    summary.timings.forward_s += seconds_since(t0);
-
-    if (accepted) {
-      accept_candidate();
-      decrease_lambda();
-      record.accepted = true;
-      record.cost = new_merit;
-      summary.trace.push_back(record);
-      if (record.actual_reduction <= opt_.cost_tolerance * std::max(std::abs(merit), 1e-12)) {
-        // Converged only at a stationary point (ddp_summary.hpp): a tiny accepted step with a huge
-        // or non-finite gradient is a stall of the line search, not a minimum.
-        const bool at_minimum = stationary(gradient_norm_, w.policy.u_bar.cwiseAbs().maxCoeff(), new_merit);
-        summary.termination = at_minimum ? DdpTermination::CostChange : DdpTermination::Stalled;
-        stop = true;
-      }
-      merit = new_merit;
-    } else {
+bool Engine::regularised_backward(DdpIteration& record) {
+  bool ok = false;
+  while (!ok) {
+    ok = backward(lambda_);
+    if (!ok) {
+      ++record.backward_failures;
       increase_lambda();
-      record.cost = merit;
-      summary.trace.push_back(record);
-      if (lambda_ > opt_.lambda_max) {
-        summary.termination = DdpTermination::RegularizationLimit;
-        stop = true;
-      }
+      if (lambda_ > opt_.lambda_max) break;
     }
-    if (!stop && seconds_since(start) > opt_.max_seconds) {
-      summary.termination = DdpTermination::WallTime;
-      stop = true;
-    }
-    if (!stop && opt_.on_iteration && !opt_.on_iteration(summary.trace.back())) {
-      summary.termination = DdpTermination::Cancelled;
-      stop = true;
-    }
-    if (!stop && iter == opt_.max_iterations) summary.termination = DdpTermination::MaxIterations;
   }
-  summary.iterations = static_cast<int>(summary.trace.size());
+  record.lambda = lambda_;
+  record.gradient_norm = gradient_norm_;
+  return ok;
+}
 
-  // Gains, value Hessians and expected cost at the returned trajectory: one more backward pass there
-  // (with the smallest regularisation that works, starting from none).
-  auto t0 = Clock::now();
-  differentiate();
-  summary.timings.derivatives_s += seconds_since(t0);
-  t0 = Clock::now();
-  double final_lambda = 0.0;
-  bool final_ok = backward(final_lambda);
-  while (!final_ok && final_lambda <= opt_.lambda_max) {
-    final_lambda = std::max(final_lambda * 10.0, opt_.lambda_min);
-    final_ok = backward(final_lambda);
+std::optional<DdpTermination> Engine::backward_termination(bool backward_ok) const {
+  if (!backward_ok) return DdpTermination::RegularizationLimit;
+  if (gradient_norm_ < opt_.gradient_tolerance) return DdpTermination::GradientNorm;
+  return std::nullopt;
+}
+
+Engine::LineSearchOutcome Engine::line_search(double merit, DdpIteration& record) {
+  const double log_first = 0.0, log_last = -3.0;
+  LineSearchOutcome outcome{false, merit};
+  for (int s = 0; s < opt_.line_search_steps && !outcome.accepted; ++s) {
+    const double exponent =
+        opt_.line_search_steps == 1 ? log_first
+                                    : log_first + (log_last - log_first) * s / (opt_.line_search_steps - 1);
+    const double alpha = std::pow(10.0, exponent);
+    outcome.merit = forward(alpha, ws_.x_new, ws_.u_new);
+    ++record.line_search_trials;
+    const double expected = -(alpha * dV1_ + alpha * alpha * dV2_);
+    const double actual = merit - outcome.merit;
+    if (!std::isfinite(outcome.merit)) continue;
+    const double ratio = expected > 0.0 ? actual / expected : (actual > 0.0 ? 1.0 : -1.0);
+    if (ratio > opt_.min_reduction_ratio) {
+      outcome.accepted = true;
+      record.step = alpha;
+      record.expected_reduction = expected;
+      record.actual_reduction = actual;
+    }
   }
-  summary.timings.backward_s += seconds_since(t0);
-  if (!final_ok) {
-    // No backward pass works at the returned trajectory (non-finite or hopelessly indefinite
-    // derivatives there): what the failed pass left is partial, so return an open-loop policy, the
-    // nominal cost summed directly, the merit of the last accepted iterate and no value Hessians.
-    for (auto& K : w.policy.K) K.setZero();
-    for (auto& S : w.S) S.setZero();
-    w.gradient.setZero();
-    nominal_cost_ = cost_.terminal(w.policy.x_bar.col(T));
-    for (int t = 0; t < T; ++t) nominal_cost_ += cost_.stage(t, w.policy.x_bar.col(t), w.policy.u_bar.col(t));
-    merit_at_nominal_ = std::max(merit, nominal_cost_);
-    gradient_norm_ = summary.trace.empty() ? 0.0 : summary.trace.back().gradient_norm;
-    summary.final_backward_failed = true;
-  }
+  return outcome;
+}
+
+std::optional<DdpTermination> Engine::cost_change_termination(double merit, double new_merit,
+                                                              double actual_reduction) const {
+  if (actual_reduction > opt_.cost_tolerance * std::max(std::abs(merit), 1e-12)) return std::nullopt;
+  const bool at_minimum = stationary(gradient_norm_, ws_.policy.u_bar.cwiseAbs().maxCoeff(), new_merit);
+  return at_minimum ? DdpTermination::CostChange : DdpTermination::Stalled;
+}
+
+std::optional<DdpTermination> Engine::rejection_termination() const {
+  if (lambda_ > opt_.lambda_max) return DdpTermination::RegularizationLimit;
+  return std::nullopt;
+}
+
+std::optional<DdpTermination> Engine::budget_termination(Clock::time_point start, const DdpIteration& last,
+                                                         int iteration) const {
+  if (seconds_since(start) > opt_.max_seconds) return DdpTermination::WallTime;
+  if (opt_.on_iteration && !opt_.on_iteration(last)) return DdpTermination::Cancelled;
+  if (iteration == opt_.max_iterations) return DdpTermination::MaxIterations;
+  return std::nullopt;
+}
+
+bool Engine::final_backward(DdpTimings& timings) {
+  timed(timings.derivatives_s, [&] { differentiate(); });
+  bool ok = false;
+  timed(timings.backward_s, [&] {
+    double lambda = 0.0;
+    ok = backward(lambda);
+    while (!ok && lambda <= opt_.lambda_max) {
+      lambda = std::max(lambda * 10.0, opt_.lambda_min);
+      ok = backward(lambda);
+    }
+  });
+  return ok;
+}
+
+void Engine::open_loop_fallback(double merit, DdpSummary& summary) {
+  auto& w = ws_;
+  const int T = w.T;
+  for (auto& K : w.policy.K) K.setZero();
+  for (auto& S : w.S) S.setZero();
+  w.gradient.setZero();
+  nominal_cost_ = cost_.terminal(w.policy.x_bar.col(T), nullptr, *cost_ws_);
+  for (int t = 0; t < T; ++t) nominal_cost_ += cost_.stage(t, w.policy.x_bar.col(t), w.policy.u_bar.col(t), nullptr, *cost_ws_);
+  merit_at_nominal_ = std::max(merit, nominal_cost_);
+  gradient_norm_ = summary.trace.empty() ? 0.0 : summary.trace.back().gradient_norm;
+  summary.final_backward_failed = true;
+}
+
+void Engine::finish(double merit, Clock::time_point start, DdpResult& result) {
+  DdpSummary& summary = result.summary;
+  if (!final_backward(summary.timings)) open_loop_fallback(merit, summary);
   summary.final_gradient_norm = gradient_norm_;
   summary.final_cost = merit_at_nominal_;
 
-  result.trajectory.x = w.policy.x_bar;
-  result.trajectory.u = w.policy.u_bar;
-  result.policy = w.policy;
+  result.trajectory.x = ws_.policy.x_bar;
+  result.trajectory.u = ws_.policy.u_bar;
+  result.policy = ws_.policy;
   result.policy.k.setZero();
   result.nominal_cost = nominal_cost_;
   result.expected_cost = merit_at_nominal_;
-  result.value_hessians = w.S;
-  result.gradient = w.gradient;
+  result.value_hessians = ws_.S;
+  result.gradient = ws_.gradient;
   summary.timings.total_s = seconds_since(start);
-  return result;
 }
 
 }  // namespace

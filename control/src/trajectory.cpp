@@ -15,8 +15,9 @@ Trajectory::Trajectory(int state_dim, int control_dim, int horizon)
 
 double trajectory_cost(const Cost& cost, const Trajectory& trajectory) {
   const int T = trajectory.horizon();
-  double J = cost.terminal_at(T, trajectory.x.col(T));
-  for (int t = 0; t < T; ++t) J += cost.stage(t, trajectory.x.col(t), trajectory.u.col(t));
+  const auto workspace = cost.make_workspace();
+  double J = cost.terminal_at(T, trajectory.x.col(T), nullptr, *workspace);
+  for (int t = 0; t < T; ++t) J += cost.stage(t, trajectory.x.col(t), trajectory.u.col(t), nullptr, *workspace);
   return J;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-/// The registry entries of the built-in systems (DESIGN.md section 3): cart-pole and quadrotor.
+/// The registry entries of the built-in systems (docs/formats.md#systems-and-their-names): cart-pole
+/// and quadrotor.
 
 #include <vector>
 

@@ -110,8 +110,23 @@ double half_quadratic_form(const Matrix& W, const VectorCRef& a, const VectorCRe
 
 }  // namespace
 
-double QuadraticCost::stage(int t, const VectorCRef& x, const VectorCRef& u,
-                            CostDerivatives* derivatives) const {
+double Cost::stage(int t, const VectorCRef& x, const VectorCRef& u, CostDerivatives* derivatives) const {
+  const auto workspace = make_workspace();
+  return stage(t, x, u, derivatives, *workspace);
+}
+
+double Cost::terminal(const VectorCRef& x, CostDerivatives* derivatives) const {
+  const auto workspace = make_workspace();
+  return terminal(x, derivatives, *workspace);
+}
+
+double Cost::terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives) const {
+  const auto workspace = make_workspace();
+  return terminal_at(t, x, derivatives, *workspace);
+}
+
+double QuadraticCost::stage(int t, const VectorCRef& x, const VectorCRef& u, CostDerivatives* derivatives,
+                            CostWorkspace&) const {
   const double value =
       dt_ * (half_quadratic_form(Q_, x, state_reference(t), derivatives ? &derivatives->lx : nullptr) +
              half_quadratic_form(R_, u, control_reference(t), derivatives ? &derivatives->lu : nullptr));
@@ -127,11 +142,11 @@ double QuadraticCost::stage(int t, const VectorCRef& x, const VectorCRef& u,
   return value;
 }
 
-double QuadraticCost::terminal(const VectorCRef& x, CostDerivatives* derivatives) const {
-  return terminal_at(tracking_ ? static_cast<int>(x_ref_.cols()) - 1 : 0, x, derivatives);
+double QuadraticCost::terminal(const VectorCRef& x, CostDerivatives* derivatives, CostWorkspace& workspace) const {
+  return terminal_at(tracking_ ? static_cast<int>(x_ref_.cols()) - 1 : 0, x, derivatives, workspace);
 }
 
-double QuadraticCost::terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives) const {
+double QuadraticCost::terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives, CostWorkspace&) const {
   const double value = half_quadratic_form(Qf_, x, state_reference(t), derivatives ? &derivatives->lx : nullptr);
   if (derivatives) {
     derivatives->resize(state_dim(), 0);

@@ -81,7 +81,7 @@ FiniteDifferenceStepModel::FiniteDifferenceStepModel(int state_dim, int control_
 }
 
 void FiniteDifferenceStepModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
-                                     StepJacobians* jacobians) const {
+                                     StepJacobians* jacobians, StepWorkspace&) const {
   Vector xv = x, uv = u, out(n_);
   simulator_(xv, uv, out);
   x_next = out;

@@ -118,12 +118,6 @@ void IntegratedStepModel::substep(Vector& x, const VectorCRef& u, double h, Step
   x += (h / 6.0) * (ws.k1 + 2.0 * ws.k2 + 2.0 * ws.k3 + ws.k4);
 }
 
-void IntegratedStepModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
-                               StepJacobians* jacobians) const {
-  const auto workspace = make_workspace();
-  step(x, u, x_next, jacobians, *workspace);
-}
-
 void IntegratedStepModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
                                StepWorkspace& workspace) const {
   const int n = state_dim();
@@ -159,11 +153,6 @@ void IntegratedStepModel::step(const VectorCRef& x, const VectorCRef& u, VectorR
     }
   }
   x_next = state;
-}
-
-void IntegratedStepModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
-                                bool derivatives) const {
-  dynamics_->noise(x, u, out, derivatives);
 }
 
 void IntegratedStepModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,

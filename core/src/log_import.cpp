@@ -130,33 +130,36 @@ std::vector<RowGroup> group_rows(const RawLog& log, const LogMap& map, long rows
   return groups;
 }
 
-}  // namespace
+/// The mapped columns of a log, in SI: the time, and the states and controls in the system's order
+/// (empty for a state without a column: an estimated velocity).
+struct MappedColumns {
+  Vector t;
+  std::vector<Vector> states, controls;
+  long rows() const { return t.size(); }
+};
 
-ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignature& system) {
-  ImportResult result;
-  ImportReport& report = result.report;
-  report.log = log.file;
-  report.map = map.file;
-  report.format = format_name(log.format);
-  report.system = system.name;
-  report.estimated = check_targets(map, system);
-  report.estimator = report.estimated.empty() ? std::nullopt : map.velocities;
-
-  // 1. Columns, in SI.
-  const Vector t_all = mapped_values(log, map.time, -1, map.time.column);
-  const long rows = t_all.size();
+/// 1. The mapped columns, read and scaled to SI; at least 2 samples, and as many values in every
+/// column as in the time column.
+MappedColumns read_columns(const RawLog& log, const LogMap& map, const SystemSignature& system, ImportReport& report) {
+  MappedColumns columns;
+  columns.t = mapped_values(log, map.time, -1, map.time.column);
+  const long rows = columns.rows();
   report.rows_read = rows;
   if (rows < 2)
     throw DataError(log.file, log.location(map.time.column), fmt::format("{} sample{}", rows, rows == 1 ? "" : "s"),
                     "at least 2 samples");
-  const int n = static_cast<int>(system.states.size()), m = static_cast<int>(system.controls.size());
-  std::vector<Vector> state_columns(n), control_columns(m);
+  columns.states.resize(system.states.size());
+  columns.controls.resize(system.controls.size());
   for (const ColumnMapping& c : map.states)
-    state_columns[index_of(system.states, c.target)] = mapped_values(log, c, rows, map.time.column);
+    columns.states[index_of(system.states, c.target)] = mapped_values(log, c, rows, map.time.column);
   for (const ColumnMapping& c : map.controls)
-    control_columns[index_of(system.controls, c.target)] = mapped_values(log, c, rows, map.time.column);
-  std::vector<RowGroup> groups = group_rows(log, map, rows);
+    columns.controls[index_of(system.controls, c.target)] = mapped_values(log, c, rows, map.time.column);
+  return columns;
+}
 
+/// The report's used columns (time, episode, states and controls in the system's order) and the
+/// log's columns no mapping uses.
+void list_columns(const RawLog& log, const LogMap& map, const SystemSignature& system, ImportReport& report) {
   report.columns.push_back(map.time);
   if (map.episode) report.columns.push_back(*map.episode);
   for (const Quantity& q : system.states)
@@ -167,8 +170,11 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
                                   [&](const ColumnMapping& c) { return log.find(c.column) == &column; });
     if (!used) report.ignored_columns.push_back(column.name);
   }
+}
 
-  // 2. Time strictly increasing within each episode.
+/// 2. The times of every episode, checked to increase strictly within it.
+std::vector<Vector> episode_times(const RawLog& log, const LogMap& map, const std::vector<RowGroup>& groups,
+                                  const Vector& t_all) {
   std::vector<Vector> group_times;
   for (const RowGroup& g : groups) {
     Vector t(static_cast<Eigen::Index>(g.rows.size()));
@@ -184,30 +190,37 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
     }
     group_times.push_back(std::move(t));
   }
+  return group_times;
+}
 
-  // 3. dt and the gap limit; split at gaps.
-  std::vector<std::vector<SampleRange>> pieces;
-  std::vector<SampleRange> whole;
-  for (const Vector& t : group_times) whole.push_back({0, static_cast<long>(t.size())});
+/// 3a. The resampling step dt: the map's, or the median of the log's steps within episodes.
+void choose_dt(const RawLog& log, const LogMap& map, const std::vector<Vector>& group_times, ImportReport& report) {
   if (map.dt) {
     report.dt = *map.dt;
     report.dt_from_map = true;
-  } else {
-    std::vector<double> steps;
-    for (const Vector& t : group_times)
-      for (Eigen::Index i = 1; i < t.size(); ++i) steps.push_back(t(i) - t(i - 1));
-    if (steps.empty())
-      throw DataError(log.file, log.location(map.time.column), "no episode has 2 samples", "at least 2 samples in an episode");
-    std::sort(steps.begin(), steps.end());
-    const std::size_t mid = steps.size() / 2;
-    report.dt = steps.size() % 2 == 1 ? steps[mid] : 0.5 * (steps[mid - 1] + steps[mid]);
+    return;
   }
+  std::vector<double> steps;
+  for (const Vector& t : group_times)
+    for (Eigen::Index i = 1; i < t.size(); ++i) steps.push_back(t(i) - t(i - 1));
+  if (steps.empty())
+    throw DataError(log.file, log.location(map.time.column), "no episode has 2 samples", "at least 2 samples in an episode");
+  std::sort(steps.begin(), steps.end());
+  const std::size_t mid = steps.size() / 2;
+  report.dt = steps.size() % 2 == 1 ? steps[mid] : 0.5 * (steps[mid - 1] + steps[mid]);
+}
+
+/// 3b. The gap limit (the map's max_gap, else 3 dt; at least dt) and every episode split at the steps
+/// longer than it (split_at_gaps), with the smallest and largest step left within the pieces.
+std::vector<std::vector<SampleRange>> split_episodes(const LogMap& map, const std::vector<Vector>& group_times,
+                                                     ImportReport& report) {
   report.max_gap_from_map = map.max_gap.has_value();
   report.average_controls = map.average_controls;
   report.max_gap = map.max_gap.value_or(3.0 * report.dt);
   if (report.max_gap < report.dt)
     map_error(map.resample_section,
               fmt::format("max_gap {} s is shorter than dt {} s", report.max_gap, report.dt), "max_gap >= dt");
+  std::vector<std::vector<SampleRange>> pieces;
   report.step_min = INFINITY;
   report.step_max = 0.0;
   for (const Vector& t : group_times) {
@@ -220,11 +233,15 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
       }
   }
   if (!std::isfinite(report.step_min)) report.step_min = 0.0;
+  return pieces;
+}
 
-  // The resampled length, checked against the sample limit before any grid is allocated (a step
-  // of 1e-7 s over a few seconds of log would be gigabytes).
+/// 3c. The resampled length, checked against the sample limit before any grid is allocated (a step
+/// of 1e-7 s over a few seconds of log would be gigabytes).
+void check_resampled_size(const LogMap& map, const std::vector<Vector>& group_times,
+                          const std::vector<std::vector<SampleRange>>& pieces, long rows, const ImportReport& report) {
   double grid_samples = 0.0;
-  for (std::size_t g = 0; g < groups.size(); ++g)
+  for (std::size_t g = 0; g < group_times.size(); ++g)
     for (const SampleRange& r : pieces[g])
       grid_samples += uniform_grid_size(group_times[g].segment(r.begin, r.size()), report.dt);
   if (grid_samples > static_cast<double>(limits::kMaxSamples)) {
@@ -235,57 +252,93 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
                           map.dt ? "" : " (the log's median step)", rows, grid_samples),
               fmt::format("at most {} samples (the sample limit); a larger step", limits::kMaxSamples));
   }
+}
 
-  // 4-6. Resample each piece, estimate velocities, keep or drop.
+/// 4. The velocity estimator of the map's [velocities] section (none when no velocity is estimated),
+/// with its noise gains and lag at dt in the report.
+std::optional<SavitzkyGolayDerivative> velocity_estimator(ImportReport& report) {
   std::optional<SavitzkyGolayDerivative> differentiator;
-  if (report.estimator) {
-    try {
-      differentiator.emplace(report.estimator->window, report.estimator->order);
-    } catch (const std::invalid_argument& e) {
-      map_error(report.estimator->origin, e.what(), "an odd window >= 3 and 1 <= order < window");
-    }
-    report.estimator_noise_gain = differentiator->noise_gain(report.dt);
-    report.estimator_end_noise_gain = differentiator->end_noise_gain(report.dt);
-    report.estimator_lag = SavitzkyGolayDerivative::lag();
+  if (!report.estimator) return differentiator;
+  try {
+    differentiator.emplace(report.estimator->window, report.estimator->order);
+  } catch (const std::invalid_argument& e) {
+    map_error(report.estimator->origin, e.what(), "an odd window >= 3 and 1 <= order < window");
   }
+  report.estimator_noise_gain = differentiator->noise_gain(report.dt);
+  report.estimator_end_noise_gain = differentiator->end_noise_gain(report.dt);
+  report.estimator_lag = SavitzkyGolayDerivative::lag();
+  return differentiator;
+}
+
+/// 5-6. One piece (rows `r` of episode `group`, times `t_group`) resampled onto the grid of step dt:
+/// states interpolated linearly, estimated velocities differentiated from their positions, controls
+/// held (zero order, or averaged over each step with average_controls). Appended as the next episode
+/// when the grid has at least `min_samples` samples, else reported as dropped.
+void resample_piece(const RowGroup& group, const Vector& t_group, const SampleRange& r, const MappedColumns& columns,
+                    const LogMap& map, const SystemSignature& system,
+                    const std::optional<SavitzkyGolayDerivative>& differentiator, long min_samples, ImportResult& result) {
+  ImportReport& report = result.report;
+  const int n = static_cast<int>(system.states.size()), m = static_cast<int>(system.controls.size());
+  const Vector t = t_group.segment(r.begin, r.size());
+  const Vector tau = uniform_grid(t, report.dt);
+  if (tau.size() < min_samples) {
+    report.dropped.push_back({group.episode, t(0), t(t.size() - 1), r.size(),
+                              fmt::format("{} sample{} at dt = {} s; expected at least {}{}", tau.size(),
+                                          tau.size() == 1 ? "" : "s", report.dt, min_samples,
+                                          differentiator ? " (the velocity estimator's window)" : "")});
+    report.rows_dropped += r.size();
+    return;
+  }
+  auto gather = [&](const Vector& column) {
+    Vector v(r.size());
+    for (long i = 0; i < r.size(); ++i) v(i) = column(group.rows[static_cast<std::size_t>(r.begin + i)]);
+    return v;
+  };
+  Episode episode;
+  episode.id = static_cast<long>(result.set.episodes.size());
+  episode.t = tau;
+  episode.x.resize(tau.size(), n);
+  episode.u.resize(tau.size(), m);
+  for (int i = 0; i < n; ++i)
+    if (columns.states[i].size() > 0) episode.x.col(i) = interpolate_linear(t, gather(columns.states[i]), tau);
+  for (const auto& [velocity, position] : report.estimated)
+    episode.x.col(index_of(system.states, velocity)) =
+        differentiator->differentiate(episode.x.col(index_of(system.states, position)), report.dt);
+  for (int j = 0; j < m; ++j)
+    episode.u.col(j) = map.average_controls ? average_held(t, gather(columns.controls[j]), tau, report.dt)
+                                            : hold_zero_order(t, gather(columns.controls[j]), tau);
+  report.episodes.push_back({episode.id, group.episode, t(0), r.size(), static_cast<long>(tau.size())});
+  report.rows_used += r.size();
+  report.samples_written += tau.size();
+  result.set.episodes.push_back(std::move(episode));
+}
+
+}  // namespace
+
+ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignature& system) {
+  ImportResult result;
+  ImportReport& report = result.report;
+  report.log = log.file;
+  report.map = map.file;
+  report.format = format_name(log.format);
+  report.system = system.name;
+  report.estimated = check_targets(map, system);
+  report.estimator = report.estimated.empty() ? std::nullopt : map.velocities;
+
+  const MappedColumns columns = read_columns(log, map, system, report);
+  const long rows = columns.rows();
+  const std::vector<RowGroup> groups = group_rows(log, map, rows);
+  list_columns(log, map, system, report);
+  const std::vector<Vector> group_times = episode_times(log, map, groups, columns.t);
+  choose_dt(log, map, group_times, report);
+  const std::vector<std::vector<SampleRange>> pieces = split_episodes(map, group_times, report);
+  check_resampled_size(map, group_times, pieces, rows, report);
+
+  const std::optional<SavitzkyGolayDerivative> differentiator = velocity_estimator(report);
   const long min_samples = differentiator ? differentiator->window() : 2;
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    const Vector& t_group = group_times[g];
-    for (const SampleRange& r : pieces[g]) {
-      const Vector t = t_group.segment(r.begin, r.size());
-      const Vector tau = uniform_grid(t, report.dt);
-      if (tau.size() < min_samples) {
-        report.dropped.push_back({groups[g].episode, t(0), t(t.size() - 1), r.size(),
-                                  fmt::format("{} sample{} at dt = {} s; expected at least {}{}", tau.size(),
-                                              tau.size() == 1 ? "" : "s", report.dt, min_samples,
-                                              differentiator ? " (the velocity estimator's window)" : "")});
-        report.rows_dropped += r.size();
-        continue;
-      }
-      auto gather = [&](const Vector& column) {
-        Vector v(r.size());
-        for (long i = 0; i < r.size(); ++i) v(i) = column(groups[g].rows[static_cast<std::size_t>(r.begin + i)]);
-        return v;
-      };
-      Episode episode;
-      episode.id = static_cast<long>(result.set.episodes.size());
-      episode.t = tau;
-      episode.x.resize(tau.size(), n);
-      episode.u.resize(tau.size(), m);
-      for (int i = 0; i < n; ++i)
-        if (state_columns[i].size() > 0) episode.x.col(i) = interpolate_linear(t, gather(state_columns[i]), tau);
-      for (const auto& [velocity, position] : report.estimated)
-        episode.x.col(index_of(system.states, velocity)) =
-            differentiator->differentiate(episode.x.col(index_of(system.states, position)), report.dt);
-      for (int j = 0; j < m; ++j)
-        episode.u.col(j) = map.average_controls ? average_held(t, gather(control_columns[j]), tau, report.dt)
-                                                : hold_zero_order(t, gather(control_columns[j]), tau);
-      report.episodes.push_back({episode.id, groups[g].episode, t(0), r.size(), static_cast<long>(tau.size())});
-      report.rows_used += r.size();
-      report.samples_written += tau.size();
-      result.set.episodes.push_back(std::move(episode));
-    }
-  }
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (const SampleRange& r : pieces[g])
+      resample_piece(groups[g], group_times[g], r, columns, map, system, differentiator, min_samples, result);
   if (result.set.episodes.empty())
     throw DataError(log.file, log.location(map.time.column),
                     fmt::format("no piece of the log is long enough: all {} rows dropped ({} pieces after splitting at "

@@ -1,5 +1,5 @@
-/// CSV measurement files (DESIGN.md section 4): a strict reader that names the offending line of
-/// any bad input, and a writer whose numbers read back bit for bit.
+/// CSV measurement files (docs/formats.md#measurement-data-csv-and-hdf5): a strict reader that names
+/// the offending line of any bad input, and a writer whose numbers read back bit for bit.
 ///
 /// A header without the leading `episode` column is a file of one episode (id 0), so a continuous
 /// record needs no column of zeros.

@@ -1,4 +1,4 @@
-/// HDF5 measurement files (DESIGN.md section 4):
+/// HDF5 measurement files (docs/formats.md#measurement-data-csv-and-hdf5):
 ///
 ///   / (attributes: system (string), state_names, control_names (1-D string arrays))
 ///   /episodes/<k>/t   (T)      float64, strictly increasing, constant step

@@ -13,7 +13,7 @@
 
 namespace gpilqg::measurements_detail {
 
-/// Relative tolerance on dt within an episode (DESIGN.md section 4).
+/// Relative tolerance on dt within an episode (docs/formats.md#measurement-data-csv-and-hdf5).
 inline constexpr double kDtRelativeTolerance = 1e-6;
 
 /// A problem at one sample of an episode: `index` is the 0-based sample (row) index within the

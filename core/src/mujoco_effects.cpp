@@ -1,4 +1,5 @@
-/// The generic effect library of MuJoCo models (DESIGN.md section 10) and their registry entries.
+/// The generic effect library of MuJoCo models
+/// (docs/own-system.md#3-diagnosis-what-is-the-model-missing) and their registry entries.
 
 #include <algorithm>
 #include <cmath>
@@ -140,7 +141,7 @@ SystemEntry mujoco_system_entry(const std::string& path) {
   entry.origin = path;
   entry.build = [file](Preset, const std::map<std::string, double>& overrides, const ActuatorNoise& noise) -> DynamicsPtr {
     // A model file has one parameter set, the file's: both presets build it, and the "real world"
-    // differs by overrides or by another file (DESIGN.md section 10).
+    // differs by overrides or by another file (docs/own-system.md#1-the-model-file).
     auto system = overrides.empty() ? std::make_shared<MujocoSystem>(file->model()) : file->with_parameters(overrides);
     system->set_noise_model(noise);
     return system;

@@ -109,11 +109,7 @@ class MujocoStepModel final : public StepModel {
     return ws;
   }
 
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians) const override {
-    const auto workspace = make_workspace();
-    step(x, u, x_next, jacobians, *workspace);
-  }
-
+  using StepModel::step;
   void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
             StepWorkspace& workspace) const override {
     auto& ws = workspace_as<MujocoStepWorkspace>(workspace);
@@ -155,9 +151,7 @@ class MujocoStepModel final : public StepModel {
   }
 
   int noise_dim() const override { return decorated_->noise_dim(); }
-  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const override {
-    decorated_->noise(x, u, out, derivatives);
-  }
+  using StepModel::noise;
   void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
              StepWorkspace& workspace) const override {
     decorated_->noise(x, u, out, derivatives, *workspace_as<MujocoStepWorkspace>(workspace).system);

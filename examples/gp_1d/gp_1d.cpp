@@ -35,6 +35,7 @@ namespace {
 
 using gpilqg::StepJacobians;
 using gpilqg::StepModel;
+using gpilqg::StepWorkspace;
 using gpilqg::Vector;
 using gpilqg::VectorCRef;
 using gpilqg::VectorRef;
@@ -52,7 +53,8 @@ class FirstOrderSystem final : public StepModel {
   int state_dim() const override { return 1; }
   int control_dim() const override { return 1; }
   double dt() const override { return kDt; }
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians) const override {
+  using StepModel::step;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians, StepWorkspace&) const override {
     x_next(0) = x(0) + kDt * (-kDecay * x(0) + u(0));
     double dx = 1.0 - kDt * kDecay;
     if (real_) {

@@ -11,7 +11,8 @@ namespace gpilqg {
 
 namespace {
 
-/// Relative agreement of the episodes' steps, as in the data contract (DESIGN.md section 4).
+/// Relative agreement of the episodes' steps, as in the data contract
+/// (docs/formats.md#measurement-data-csv-and-hdf5).
 constexpr double kDtAgreement = 1e-6;
 
 /// What a statistic beyond the largest double reads as, in the table and in JSON (where a number

@@ -1,5 +1,5 @@
 /// The `gpilqg` command-line program. Subcommands are registered from src/commands/; see
-/// `gpilqg --help` and DESIGN.md section 8 for the fixed names.
+/// `gpilqg --help` and docs/command-line.md for the fixed names.
 ///
 /// `--plugin LIB.so` (repeatable) belongs to the program, not to one command: every subcommand falls
 /// through to it, so it may stand before or after the command's name. The plugins are loaded after

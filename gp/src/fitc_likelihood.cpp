@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "gpilqg/gp/fitc.hpp"
+#include "gpilqg/core/workspace.hpp"
 #include "blas_lapack.hpp"
 #include "parallel.hpp"
 #include "sparse_linalg.hpp"
@@ -56,7 +57,7 @@ namespace gpilqg::gp {
 using sparse_detail::cholesky_with_jitter;
 namespace blas = detail::blas;
 
-struct FitcLikelihood::Workspace {
+struct FitcLikelihood::Workspace final : LikelihoodWorkspace {
   Vector inv_ell;  // 1 / l (D)
   double sf2 = 0, sn2 = 0;
   double snu2 = 0;   // total jitter on Kuu (rule + escalation)
@@ -91,8 +92,7 @@ FitcLikelihood::FitcLikelihood(const MatrixCRef& X, const VectorCRef& r, int ind
       r_(r),
       jitter_(jitter),
       schedule_(schedule),
-      threads_(threads),
-      ws_(std::make_unique<Workspace>()) {
+      threads_(threads) {
   sparse_detail::validate_likelihood_inputs("FitcLikelihood", X, r, inducing, "pseudo-inputs", threads);
   jitter.validate();
   schedule.validate();
@@ -100,41 +100,17 @@ FitcLikelihood::FitcLikelihood(const MatrixCRef& X, const VectorCRef& r, int ind
   centre_ = X_.colwise().mean().transpose();
 }
 
-FitcLikelihood::~FitcLikelihood() = default;
-FitcLikelihood::FitcLikelihood(const FitcLikelihood& other)
-    : X_(other.X_),
-      r_(other.r_),
-      centre_(other.centre_),
-      layout_(other.layout_),
-      jitter_(other.jitter_),
-      schedule_(other.schedule_),
-      threads_(other.threads_),
-      ws_(std::make_unique<Workspace>()) {}
-FitcLikelihood& FitcLikelihood::operator=(const FitcLikelihood& other) {
-  if (this != &other) {
-    X_ = other.X_;
-    r_ = other.r_;
-    centre_ = other.centre_;
-    layout_ = other.layout_;
-    jitter_ = other.jitter_;
-    schedule_ = other.schedule_;
-    threads_ = other.threads_;
-    ws_ = std::make_unique<Workspace>();
-  }
-  return *this;
+std::unique_ptr<LikelihoodWorkspace> FitcLikelihood::make_workspace() const {
+  return std::make_unique<Workspace>();
 }
-FitcLikelihood::FitcLikelihood(FitcLikelihood&&) noexcept = default;
-FitcLikelihood& FitcLikelihood::operator=(FitcLikelihood&&) noexcept = default;
 
-NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
+NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta, Workspace& w) const {
   if (theta.size() != layout_.size())
     throw std::invalid_argument("FitcLikelihood: parameter vector has " + std::to_string(theta.size()) +
                                 " entries, expected " + std::to_string(layout_.size()) +
                                 " (D = " + std::to_string(layout_.input_dim) +
                                 ", M = " + std::to_string(layout_.inducing) + ")");
   if (!theta.allFinite()) return sparse_detail::failed_evaluation();
-  if (!ws_) ws_ = std::make_unique<Workspace>();
-  Workspace& w = *ws_;
   const int D = layout_.input_dim;
   const int M = layout_.inducing;
   const Eigen::Index N = X_.rows();
@@ -220,13 +196,19 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta) const {
 }
 
 NlmlEvaluation FitcLikelihood::evaluate(const VectorCRef& theta, Vector* gradient) const {
-  const NlmlEvaluation e = factorise(theta);
+  const auto workspace = make_workspace();
+  return evaluate(theta, gradient, *workspace);
+}
+
+NlmlEvaluation FitcLikelihood::evaluate(const VectorCRef& theta, Vector* gradient,
+                                        LikelihoodWorkspace& workspace) const {
+  Workspace& w = workspace_as<Workspace>(workspace);
+  const NlmlEvaluation e = factorise(theta, w);
   if (e.status == FactorStatus::Failed) {
     if (gradient != nullptr) gradient->setZero(layout_.size());
     return e;
   }
   if (gradient == nullptr) return e;
-  Workspace& w = *ws_;
   const int D = layout_.input_dim;
   const int M = layout_.inducing;
   const Eigen::Index N = X_.rows();
@@ -328,7 +310,8 @@ NlmlEvaluation FitcLikelihood::evaluate(const VectorCRef& theta, Vector* gradien
 }
 
 FitcPredictor FitcLikelihood::predictor(const VectorCRef& theta, ConditioningReport* report) const {
-  const NlmlEvaluation e = factorise(theta);
+  Workspace w;
+  const NlmlEvaluation e = factorise(theta, w);
   if (e.status == FactorStatus::Failed)
     throw std::runtime_error(
         "FITC: no positive definite factorisation at these parameters, even with "
@@ -339,7 +322,6 @@ FitcPredictor FitcLikelihood::predictor(const VectorCRef& theta, ConditioningRep
     report->jitter = e.jitter;
     report->negative_log_marginal_likelihood = e.value;
   }
-  const Workspace& w = *ws_;
   const int M = layout_.inducing;
   FitcPredictor p;
   p.inv_lengthscale_ = w.inv_ell;

@@ -9,7 +9,7 @@
 /// heap-allocated on every call (e.g. Omega (N x N) times V (N x D) at N = 300). Splitting every
 /// dimension into tiles of at most 128 bounds both buffers by 128 x 128 doubles = 128 KiB, so they
 /// always live on the stack, whatever the machine's caches, and propagate stays allocation-free
-/// (DESIGN.md practice 1) at any N.
+/// (docs/architecture.md#models-and-workspaces) at any N.
 
 #include <algorithm>
 #include <string>

@@ -130,11 +130,6 @@ std::unique_ptr<StepWorkspace> ResidualModel::make_workspace() const {
   return ws;
 }
 
-void ResidualModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians) const {
-  const auto workspace = make_workspace();
-  step(x, u, x_next, jacobians, *workspace);
-}
-
 void ResidualModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
                          StepWorkspace& workspace) const {
   auto& s = workspace_as<ResidualWorkspace>(workspace);
@@ -163,19 +158,9 @@ void ResidualModel::step(const VectorCRef& x, const VectorCRef& u, VectorRef x_n
   }
 }
 
-void ResidualModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const {
-  simulator_->noise(x, u, out, derivatives);
-}
-
 void ResidualModel::noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
                           StepWorkspace& workspace) const {
   simulator_->noise(x, u, out, derivatives, *workspace_as<ResidualWorkspace>(workspace).simulator);
-}
-
-void ResidualModel::uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
-                                bool derivatives) const {
-  const auto workspace = make_workspace();
-  uncertainty(x, u, out, derivatives, *workspace);
 }
 
 void ResidualModel::uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,

@@ -26,24 +26,29 @@
 
 namespace gpilqg::gp::sparse_detail {
 
-/// The NLML of one data set through the backend's likelihood class; the backend fixes the start and
-/// the bounds when it builds the objective.
+/// The NLML of one data set through the backend's likelihood class, evaluated in the objective's own
+/// workspace (as the exact GP's objective holds its matrices); the backend fixes the start and the
+/// bounds when it builds the objective.
 template <class Likelihood>
 class LikelihoodObjective final : public MarginalLikelihoodObjective {
  public:
   LikelihoodObjective(Likelihood likelihood, Vector initial, ParameterBounds bounds)
-      : likelihood_(std::move(likelihood)), initial_(std::move(initial)), bounds_(std::move(bounds)) {}
+      : likelihood_(std::move(likelihood)),
+        workspace_(likelihood_.make_workspace()),
+        initial_(std::move(initial)),
+        bounds_(std::move(bounds)) {}
 
   int parameter_count() const override { return likelihood_.parameter_count(); }
   int input_dim() const override { return likelihood_.layout().input_dim; }
   NlmlEvaluation evaluate(const VectorCRef& parameters, Vector* gradient) override {
-    return likelihood_.evaluate(parameters, gradient);
+    return likelihood_.evaluate(parameters, gradient, *workspace_);
   }
   ParameterBounds bounds() const override { return bounds_; }
   Vector initial_parameters() const override { return initial_; }
 
  private:
   Likelihood likelihood_;
+  std::unique_ptr<LikelihoodWorkspace> workspace_;
   Vector initial_;
   ParameterBounds bounds_;
 };

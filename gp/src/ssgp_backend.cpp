@@ -53,10 +53,11 @@ std::pair<Vector, ParameterBounds> ssgp_start(const SsgpLikelihood& likelihood, 
   double best = std::numeric_limits<double>::infinity();
   Vector initial;
   Matrix W(layout.frequencies, D);
+  const auto workspace = likelihood.make_workspace();
   for (int k = 0; k < ssgp.initial_draws; ++k) {
     for (Eigen::Index i = 0; i < W.size(); ++i) W.data()[i] = normal(rng);
     const Vector theta = layout.pack(hyper, W);
-    const double value = likelihood.evaluate(theta).value;
+    const double value = likelihood.evaluate(theta, nullptr, *workspace).value;
     if (value < best || initial.size() == 0) {
       best = value;
       initial = theta;

@@ -14,13 +14,14 @@
 #include <vector>
 
 #include "gpilqg/gp/ssgp.hpp"
+#include "gpilqg/core/workspace.hpp"
 #include "parallel.hpp"
 #include "sparse_linalg.hpp"
 #include "ssgp_sincos.hpp"
 
 namespace gpilqg::gp {
 
-struct SsgpLikelihood::Workspace {
+struct SsgpLikelihood::Workspace final : LikelihoodWorkspace {
   Vector inv_ell;  // 1 / l (D)
   double sf2 = 0, sn2 = 0, a = 0;
   int workers = 1;                 // threads splitting the N training points into blocks of rows
@@ -38,43 +39,23 @@ struct SsgpLikelihood::Workspace {
 
 SsgpLikelihood::SsgpLikelihood(const MatrixCRef& X, const VectorCRef& r, int frequencies,
                                JitterSchedule schedule, int threads)
-    : X_(X), r_(r), schedule_(schedule), threads_(threads), ws_(std::make_unique<Workspace>()) {
+    : X_(X), r_(r), schedule_(schedule), threads_(threads) {
   sparse_detail::validate_likelihood_inputs("SsgpLikelihood", X, r, frequencies, "spectral points", threads);
   schedule.validate();
   layout_ = SsgpLayout{static_cast<int>(X.cols()), frequencies};
 }
 
-SsgpLikelihood::~SsgpLikelihood() = default;
-SsgpLikelihood::SsgpLikelihood(const SsgpLikelihood& other)
-    : X_(other.X_),
-      r_(other.r_),
-      layout_(other.layout_),
-      schedule_(other.schedule_),
-      threads_(other.threads_),
-      ws_(std::make_unique<Workspace>()) {}
-SsgpLikelihood& SsgpLikelihood::operator=(const SsgpLikelihood& other) {
-  if (this != &other) {
-    X_ = other.X_;
-    r_ = other.r_;
-    layout_ = other.layout_;
-    schedule_ = other.schedule_;
-    threads_ = other.threads_;
-    ws_ = std::make_unique<Workspace>();
-  }
-  return *this;
+std::unique_ptr<LikelihoodWorkspace> SsgpLikelihood::make_workspace() const {
+  return std::make_unique<Workspace>();
 }
-SsgpLikelihood::SsgpLikelihood(SsgpLikelihood&&) noexcept = default;
-SsgpLikelihood& SsgpLikelihood::operator=(SsgpLikelihood&&) noexcept = default;
 
-NlmlEvaluation SsgpLikelihood::factorise(const VectorCRef& theta) const {
+NlmlEvaluation SsgpLikelihood::factorise(const VectorCRef& theta, Workspace& w) const {
   if (theta.size() != layout_.size())
     throw std::invalid_argument("SsgpLikelihood: parameter vector has " + std::to_string(theta.size()) +
                                 " entries, expected " + std::to_string(layout_.size()) +
                                 " (D = " + std::to_string(layout_.input_dim) +
                                 ", m = " + std::to_string(layout_.frequencies) + ")");
   if (!theta.allFinite()) return sparse_detail::failed_evaluation();
-  if (!ws_) ws_ = std::make_unique<Workspace>();
-  Workspace& w = *ws_;
   const int D = layout_.input_dim;
   const int m = layout_.frequencies;
   const Eigen::Index N = X_.rows();
@@ -138,13 +119,19 @@ NlmlEvaluation SsgpLikelihood::factorise(const VectorCRef& theta) const {
 }
 
 NlmlEvaluation SsgpLikelihood::evaluate(const VectorCRef& theta, Vector* gradient) const {
-  const NlmlEvaluation e = factorise(theta);
+  const auto workspace = make_workspace();
+  return evaluate(theta, gradient, *workspace);
+}
+
+NlmlEvaluation SsgpLikelihood::evaluate(const VectorCRef& theta, Vector* gradient,
+                                        LikelihoodWorkspace& workspace) const {
+  Workspace& w = workspace_as<Workspace>(workspace);
+  const NlmlEvaluation e = factorise(theta, w);
   if (e.status == FactorStatus::Failed) {
     if (gradient != nullptr) gradient->setZero(layout_.size());
     return e;
   }
   if (gradient == nullptr) return e;
-  Workspace& w = *ws_;
   const int D = layout_.input_dim;
   const int m = layout_.frequencies;
   const Eigen::Index N = X_.rows();
@@ -194,7 +181,8 @@ NlmlEvaluation SsgpLikelihood::evaluate(const VectorCRef& theta, Vector* gradien
 }
 
 SsgpPredictor SsgpLikelihood::predictor(const VectorCRef& theta, ConditioningReport* report) const {
-  const NlmlEvaluation e = factorise(theta);
+  Workspace w;
+  const NlmlEvaluation e = factorise(theta, w);
   if (e.status == FactorStatus::Failed)
     throw std::runtime_error(
         "SSGP: no positive definite factorisation at these parameters, even with "
@@ -205,7 +193,6 @@ SsgpPredictor SsgpLikelihood::predictor(const VectorCRef& theta, ConditioningRep
     report->jitter = e.jitter;
     report->negative_log_marginal_likelihood = e.value;
   }
-  const Workspace& w = *ws_;
   const int m = layout_.frequencies;
   SsgpPredictor p;
   p.S_ = w.S;

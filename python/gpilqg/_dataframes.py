@@ -1,5 +1,5 @@
-"""MeasurementSet to and from pandas DataFrames with the columns of the CSV format (DESIGN.md section 4):
-episode, t, the state names, the control names."""
+"""MeasurementSet to and from pandas DataFrames with the columns of the CSV format
+(docs/formats.md#measurement-data-csv-and-hdf5): episode, t, the state names, the control names."""
 
 
 def _from_dataframe(df, system):

@@ -1,6 +1,6 @@
-/// Measurement sets (DESIGN.md section 4) from Python: from arrays, from files, and (in the package's
-/// Python part) from pandas DataFrames. An episode's arrays are read-only NumPy views of the set's
-/// memory, never copies.
+/// Measurement sets (docs/formats.md#measurement-data-csv-and-hdf5) from Python: from arrays, from
+/// files, and (in the package's Python part) from pandas DataFrames. An episode's arrays are read-only
+/// NumPy views of the set's memory, never copies.
 
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
@@ -69,8 +69,9 @@ void bind_data(py::module_& m) {
       .def("__len__", &Episode::length);
 
   py::class_<MeasurementSet>(m, "MeasurementSet", R"(
-Measured episodes of one system (DESIGN.md section 4): per episode the measured state at each time
-and the control applied from then until the next sample, at a constant step.)")
+Measured episodes of one system (docs/formats.md#measurement-data-csv-and-hdf5): per episode the
+measured state at each time and the control applied from then until the next sample, at a constant
+step.)")
       .def(py::init(&make_set), py::arg("system"), py::arg("episodes"), py::arg("ids") = std::vector<long>{},
            R"(system: a registry name or gpilqg.Dynamics; episodes: a list of (t (T,), x (T, n), u (T, m)), or of
 (t, x) for a system without controls (m = 0, u then has shape (T, 0)); ids: the episode ids (default 0, 1, ...). Raises InputError naming the episode and sample for wrong

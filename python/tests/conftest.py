@@ -21,8 +21,9 @@ def cli(*arguments):
 
 
 class PythonCartPole(gpilqg.Dynamics):
-    """The cart-pole of core/src/cartpole.cpp (DESIGN.md section 3), in NumPy: M(q) q_ddot = h(q, q_dot, u)
-    with M = [[mc + mp, mp l cos], [mp l cos, mp l^2]], h = (u + mp l sin theta_dot^2, -mp g l sin)."""
+    """The cart-pole of core/src/cartpole.cpp (docs/formats.md#systems-and-their-names), in NumPy:
+    M(q) q_ddot = h(q, q_dot, u) with M = [[mc + mp, mp l cos], [mp l cos, mp l^2]],
+    h = (u + mp l sin theta_dot^2, -mp g l sin)."""
 
     def __init__(self, name="python_cartpole", cart_mass=1.0, pole_mass=1.0, pole_length=1.0, gravity=9.81):
         super().__init__(name, states=[("x", "m"), ("x_dot", "m/s"), ("theta", "rad"), ("theta_dot", "rad/s")],

@@ -22,7 +22,8 @@ class CountingModel final : public StepModel {
   int state_dim() const override { return inner_.state_dim(); }
   int control_dim() const override { return inner_.control_dim(); }
   double dt() const override { return inner_.dt(); }
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians) const override {
+  using StepModel::step;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians, StepWorkspace&) const override {
     ++(jacobians != nullptr ? with_jacobians : without_jacobians);
     inner_.step(x, u, x_next, jacobians);
   }

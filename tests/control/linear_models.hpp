@@ -23,7 +23,8 @@ class LinearStepModel final : public StepModel {
   int control_dim() const override { return static_cast<int>(B_.cols()); }
   double dt() const override { return dt_; }
 
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jac) const override {
+  using StepModel::step;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jac, StepWorkspace&) const override {
     x_next = A_ * x + B_ * u;
     if (jac) {
       jac->A = A_;
@@ -34,7 +35,8 @@ class LinearStepModel final : public StepModel {
   int noise_dim() const override {
     return (additive_std > 0 ? state_dim() : 0) + (multiplicative_std > 0 ? control_dim() : 0);
   }
-  void noise(const VectorCRef&, const VectorCRef& u, DiffusionColumns& out, bool) const override {
+  using StepModel::noise;
+  void noise(const VectorCRef&, const VectorCRef& u, DiffusionColumns& out, bool, StepWorkspace&) const override {
     const int n = state_dim(), m = control_dim();
     out.resize(n, m, noise_dim());
     int c = 0;
@@ -47,7 +49,8 @@ class LinearStepModel final : public StepModel {
   int uncertainty_dim() const override {
     return (uncertainty_std > 0 || zero_uncertainty_columns) ? control_dim() : 0;
   }
-  void uncertainty(const VectorCRef&, const VectorCRef& u, DiffusionColumns& out, bool) const override {
+  using StepModel::uncertainty;
+  void uncertainty(const VectorCRef&, const VectorCRef& u, DiffusionColumns& out, bool, StepWorkspace&) const override {
     out.resize(state_dim(), control_dim(), uncertainty_dim());
     if (zero_uncertainty_columns) return;
     for (int j = 0; j < uncertainty_dim(); ++j) control_column(uncertainty_std, u, j, j, out);

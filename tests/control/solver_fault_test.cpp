@@ -117,7 +117,8 @@ class NanJacobians final : public StepModel {
   int state_dim() const override { return inner_.state_dim(); }
   int control_dim() const override { return inner_.control_dim(); }
   double dt() const override { return inner_.dt(); }
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians) const override {
+  using StepModel::step;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians, StepWorkspace&) const override {
     inner_.step(x, u, x_next, jacobians);
     if (jacobians != nullptr && std::abs(x(3)) > 1.0) jacobians->A(2, 3) = std::numeric_limits<double>::quiet_NaN();
   }

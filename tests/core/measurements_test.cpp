@@ -1,6 +1,6 @@
-/// Measurement data I/O (DESIGN.md section 4): every class of bad CSV and HDF5 input is rejected
-/// with an error naming the file and the line or dataset; valid files round-trip bit for bit;
-/// summarize() matches numbers computed by hand.
+/// Measurement data I/O (docs/formats.md#measurement-data-csv-and-hdf5): every class of bad CSV and
+/// HDF5 input is rejected with an error naming the file and the line or dataset; valid files round-trip
+/// bit for bit; summarize() matches numbers computed by hand.
 
 #include "gpilqg/core/measurements.hpp"
 

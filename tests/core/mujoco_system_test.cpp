@@ -1,6 +1,7 @@
 // MuJoCo models as systems (mujoco_system.hpp): names, the model's own integrator, Jacobians from
 // mjd_transitionFD against central differences of mj_step, effects inside the step against a
-// hand-written mj_step loop, parameter overrides, thread safety and the errors of DESIGN.md section 10.
+// hand-written mj_step loop, parameter overrides, thread safety and the errors of
+// docs/formats.md#systems-and-their-names.
 
 #include <fstream>
 #include <thread>

@@ -1,4 +1,4 @@
-/// The `gpilqg` program end to end (DESIGN.md section 8): help, `data info` as text and JSON, and
+/// The `gpilqg` program end to end (docs/command-line.md): help, `data info` as text and JSON, and
 /// the exit-status contract (2 with "error:" naming the file and line on bad input).
 
 #include <gtest/gtest.h>

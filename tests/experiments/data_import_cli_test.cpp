@@ -186,7 +186,7 @@ json import(const fs::path& log, const fs::path& map, const fs::path& out) {
 
 /// Each test makes the clean data and its diagnosis itself, in a folder of its own, so tests can run
 /// in parallel processes (ctest -j).
-class DataImportDefects : public ::testing::Test {
+class DataImportDefectsCli : public ::testing::Test {
  protected:
   void SetUp() override {
     dir = test::temporary_dir("data_import");
@@ -209,13 +209,13 @@ class DataImportDefects : public ::testing::Test {
 
 const auto kAll = [](int, int) { return true; };
 
-TEST_F(DataImportDefects, CleanDataNamesTheHiddenEffect) {
+TEST_F(DataImportDefectsCli, CleanDataNamesTheHiddenEffect) {
   std::cout << "[ diagnosis ] clean: " << clean.effect << " mu = " << clean.value << '\n';
   EXPECT_EQ(clean.effect, "cart_coulomb_friction");
   EXPECT_NEAR(clean.value, kMu, 0.2 * kMu);
 }
 
-TEST_F(DataImportDefects, TimestampJitterIsResampled) {
+TEST_F(DataImportDefectsCli, TimestampJitterIsResampled) {
   const auto logs = simulate_logs(true, 5);
   const fs::path log = dir / "jitter.csv";
   write_csv(log, table_of(logs, 1.0, 1.0, 1.0, true, kAll));
@@ -235,7 +235,7 @@ TEST_F(DataImportDefects, TimestampJitterIsResampled) {
   expect_same_diagnosis(dir / "jitter.h5", "jitter");
 }
 
-TEST_F(DataImportDefects, ADroppedBlockSplitsAnEpisode) {
+TEST_F(DataImportDefectsCli, ADroppedBlockSplitsAnEpisode) {
   const fs::path log = dir / "dropped.h5";
   // 20 samples (0.4 s) of episode 3 lost; an HDF5 log of 1-D datasets under /log.
   const LogTable table = table_of(clean_logs, 1.0, 1.0, 1.0, true, [](int e, int k) { return !(e == 3 && k >= 50 && k < 70); });
@@ -262,7 +262,7 @@ TEST_F(DataImportDefects, ADroppedBlockSplitsAnEpisode) {
   expect_same_diagnosis(dir / "dropped.h5.out.h5", "dropped block");
 }
 
-TEST_F(DataImportDefects, ExtraColumnsAreIgnoredAndListed) {
+TEST_F(DataImportDefectsCli, ExtraColumnsAreIgnoredAndListed) {
   LogTable table = table_of(clean_logs, 1000.0, 1.0, 1.0, true, kAll);  // time in ms
   std::vector<double> battery(table.columns[0].size()), temperature(table.columns[0].size());
   for (std::size_t r = 0; r < battery.size(); ++r) {
@@ -296,7 +296,7 @@ TEST_F(DataImportDefects, ExtraColumnsAreIgnoredAndListed) {
   expect_same_diagnosis(dir / "extra.h5", "extra columns");
 }
 
-TEST_F(DataImportDefects, DegreesAndMillimetresInAMatFile) {
+TEST_F(DataImportDefectsCli, DegreesAndMillimetresInAMatFile) {
   const double deg = 180.0 / std::numbers::pi;
   const LogTable table = table_of(clean_logs, 1.0, 1000.0, deg, true, kAll);
   // time, trial, cart and force as vectors; the pole's angle and rate as fields of a struct "pole".
@@ -329,7 +329,7 @@ TEST_F(DataImportDefects, DegreesAndMillimetresInAMatFile) {
 // smoothed steps as a weaker actuator (actuator_gain ~0.6 on every seed tried), window 5 / order 2
 // passes on most seeds; window 9 / order 4, the map's defaults, follows the corners closely enough on
 // all seeds tried.
-TEST_F(DataImportDefects, PositionsOnlyGetEstimatedVelocities) {
+TEST_F(DataImportDefectsCli, PositionsOnlyGetEstimatedVelocities) {
   const fs::path log = dir / "positions.csv";
   write_csv(log, table_of(clean_logs, 1.0, 1.0, 1.0, false, kAll));
   const fs::path map = write_map(dir / "positions.toml",
@@ -346,7 +346,7 @@ TEST_F(DataImportDefects, PositionsOnlyGetEstimatedVelocities) {
 
 // Bad maps and logs: exit 2, "error:", the file and the line and field or column.
 
-struct BadInput : ::testing::Test {
+struct BadInputCli : ::testing::Test {
   fs::path dir = test::temporary_dir("data_import_bad");
   fs::path log = dir / "log.csv";
   void SetUp() override {
@@ -371,19 +371,19 @@ struct BadInput : ::testing::Test {
   }
 };
 
-TEST_F(BadInput, UnknownColumnNamesTheMapLineAndTheLogsColumns) {
+TEST_F(BadInputCli, UnknownColumnNamesTheMapLineAndTheLogsColumns) {
   expect_error(run(map_text("x = { column = \"cart\" }"), log),
                {"map.toml:line 5: field 'states.x.column': column 'cart' is not in", "log.csv", "'time', 'trial', 'x'"});
 }
 
-TEST_F(BadInput, DuplicateTargetNamesTheLine) {
+TEST_F(BadInputCli, DuplicateTargetNamesTheLine) {
   expect_error(run(map_text("x = \"x\"\nx = \"xd\""), log), {"map.toml:line 6", "'x'"});
   // The same target under [states] and [controls] is caught too: force is not a state.
   expect_error(run(map_text("x = \"x\"\nforce = \"f\""), log),
                {"map.toml:line 6: field 'states.force': 'force' is not a state of cartpole", "x, x_dot, theta, theta_dot"});
 }
 
-TEST_F(BadInput, TimeGoingBackwardsNamesTheLogLine) {
+TEST_F(BadInputCli, TimeGoingBackwardsNamesTheLogLine) {
   std::ofstream(log) << "time,trial,x,xd,th,thd,f\n0.00,0,0,0,0,0,1\n0.02,0,0,0,0,0,1\n0.04,0,0,0,0,0,1\n"
                         "0.00,1,0,0,0,0,1\n0.02,1,0,0,0,0,1\n";
   expect_error(run(map_text("x = \"x\""), log),
@@ -394,7 +394,7 @@ TEST_F(BadInput, TimeGoingBackwardsNamesTheLogLine) {
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
-TEST_F(BadInput, TooFewSamples) {
+TEST_F(BadInputCli, TooFewSamples) {
   std::ofstream(log) << "time,trial,x,xd,th,thd,f\n0.00,0,0,0,0,0,1\n";
   expect_error(run(map_text("x = \"x\""), log), {"log.csv:column 'time': 1 sample; expected at least 2 samples"});
   // Enough rows, but every piece is shorter than the velocity estimator's window.
@@ -405,14 +405,14 @@ TEST_F(BadInput, TooFewSamples) {
                {"log.csv:column 'time': no piece of the log is long enough: all 3 rows dropped", "at least 7 samples"});
 }
 
-TEST_F(BadInput, UnknownUnitNamesTheFieldAndTheTable) {
+TEST_F(BadInputCli, UnknownUnitNamesTheFieldAndTheTable) {
   expect_error(run(map_text("x = { column = \"x\", unit = \"furlong\" }"), log),
                {"map.toml:line 5: field 'states.x.unit': unknown unit 'furlong'; expected one of: s, ms", "deg/s"});
   expect_error(run("[time]\ncolumn = \"time\"\nunit = \"mm\"\n" + map_text("x = \"x\"").substr(24), log),
                {"map.toml:line 3: field 'time.unit': 'mm' is not a unit of time"});
 }
 
-TEST_F(BadInput, BadLogsAndOtherMapMistakes) {
+TEST_F(BadInputCli, BadLogsAndOtherMapMistakes) {
   expect_error(run(map_text("x = \"x\""), dir / "missing.csv"), {"missing.csv: no such file"});
   std::ofstream(dir / "log.txt") << "time\n0\n";
   expect_error(run(map_text("x = \"x\""), dir / "log.txt"), {"log.txt: unknown extension '.txt'"});

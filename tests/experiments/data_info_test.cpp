@@ -1,4 +1,5 @@
-/// `gpilqg data info` formatting: the terminal table and the JSON document (DESIGN.md section 8).
+/// `gpilqg data info` formatting: the terminal table and the JSON document
+/// (docs/command-line.md#gpilqg-data-info-file---system-name---json).
 
 #include "gpilqg/experiments/data_info.hpp"
 

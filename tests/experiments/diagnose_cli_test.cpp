@@ -1,7 +1,8 @@
-// `gpilqg diagnose` end to end: JSON with the fixed keys of DESIGN.md section 6 on stdout and nothing
-// else, the HDF5 report, plots, the add -> write-model -> model loop, and bad input (exit 2, "error:",
-// the file and line or the option, and the valid choices). Plus the pieces of the analysis with
-// closed-form answers: fit percent, the episode split, the cross-correlation band, the model file.
+// `gpilqg diagnose` end to end: JSON with the fixed keys of
+// docs/formats.md#diagnosis-json-gpilqg-diagnose---json on stdout and nothing else, the HDF5 report,
+// plots, the add -> write-model -> model loop, and bad input (exit 2, "error:", the file and line or
+// the option, and the valid choices). Plus the pieces of the analysis with closed-form answers: fit
+// percent, the episode split, the cross-correlation band, the model file.
 
 #include <gtest/gtest.h>
 
@@ -140,7 +141,7 @@ TEST(DiagnoseCli, PlotsNeedMatplotlibAndSayWhenItIsMissing) {
   const fs::path dir = test::temporary_dir("diagnose_plots");
   const fs::path data = friction_csv(dir);
   // An interpreter without matplotlib (/bin/false fails every import) gives a clear error before any work.
-  const std::string command = "GPILQG_PYTHON=/bin/false '" + std::string(GPILQG_CLI_PATH) + "' diagnose --system cartpole --data " +
+  const std::string command = "GPILQG_PYTHON=/bin/false '" + test::program_path() + "' diagnose --system cartpole --data " +
                               quote(data) + " --plots " + quote(dir / "p") + " 2>" + quote(dir / "err.txt");
   const int status = std::system(command.c_str());
   EXPECT_EQ(WEXITSTATUS(status), 2);

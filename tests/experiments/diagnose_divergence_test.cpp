@@ -80,7 +80,7 @@ json expect_model_diverges(const std::string& arguments, const fs::path& dir) {
   return j;
 }
 
-TEST(DiagnoseDivergence, StatesWhereTheModelBlowsUpAreNotConsistent) {
+TEST(DiagnoseDivergenceCli, StatesWhereTheModelBlowsUpAreNotConsistent) {
   // States of 1e6 (velocities of 1e6 m/s and rad/s): the measurements are within the bound, the
   // model's open-loop predictions from them are not. Once reported "consistent".
   const fs::path dir = test::temporary_dir("diagnose_diverging_states");
@@ -95,7 +95,7 @@ TEST(DiagnoseDivergence, StatesWhereTheModelBlowsUpAreNotConsistent) {
   EXPECT_NE(reason.find(fmt::format("{} of {} k-step windows", diverged, windows)), std::string::npos) << reason;
 }
 
-TEST(DiagnoseDivergence, AHugeTimeStepMakesTheModelDiverge) {
+TEST(DiagnoseDivergenceCli, AHugeTimeStepMakesTheModelDiverge) {
   const fs::path dir = test::temporary_dir("diagnose_huge_dt");
   MeasurementSet set = plain_data();
   for (Episode& e : set.episodes)
@@ -104,7 +104,7 @@ TEST(DiagnoseDivergence, AHugeTimeStepMakesTheModelDiverge) {
   EXPECT_EQ(j["divergence"]["one_step"]["diverged"], j["samples"]);
 }
 
-TEST(DiagnoseDivergence, AModelWithAnAbsurdParameterDiverges) {
+TEST(DiagnoseDivergenceCli, AModelWithAnAbsurdParameterDiverges) {
   // A pole of 1e300 m: once "explained -1.5e302% +- inf%" for every candidate effect.
   const fs::path dir = test::temporary_dir("diagnose_absurd_model");
   const fs::path data = write_csv(dir, "plain.csv", plain_data());
@@ -120,7 +120,7 @@ TEST(DiagnoseDivergence, AModelWithAnAbsurdParameterDiverges) {
   EXPECT_TRUE(test::json_numbers_finite(j));
 }
 
-TEST(DiagnoseDivergence, MeasurementsBeyondTheBoundAreBadInput) {
+TEST(DiagnoseDivergenceCli, MeasurementsBeyondTheBoundAreBadInput) {
   // Cells of +-1e308 are finite, but their differences are not: rejected when read, naming the cell.
   const fs::path dir = test::temporary_dir("diagnose_huge_cells");
   MeasurementSet set = plain_data();

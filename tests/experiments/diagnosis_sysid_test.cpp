@@ -178,7 +178,8 @@ class ScalarModel final : public StepModel {
   int state_dim() const override { return 1; }
   int control_dim() const override { return 1; }
   double dt() const override { return 1.0; }
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians*) const override {
+  using StepModel::step;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians*, StepWorkspace&) const override {
     x_next(0) = a_ * x(0) + u(0);
   }
 

@@ -189,7 +189,7 @@ TEST(HeldoutBlocks, OneRecordWithHiddenFrictionIsDiagnosedPerBlock) {
 
 // Through the command: a CSV with no episode column, the JSON naming the blocks; and the error for a
 // record too short for the blocks and their gaps.
-TEST(HeldoutBlocks, DiagnoseCliReadsARecordWithoutEpisodeColumnAndNamesTheBlocks) {
+TEST(HeldoutBlocksCli, DiagnoseCliReadsARecordWithoutEpisodeColumnAndNamesTheBlocks) {
   const fs::path dir = test::temporary_dir("heldout_blocks_cli");
   const fs::path with_column = dir / "with_column.csv", record = dir / "record.csv", report = dir / "report.h5";
   write_measurements(with_column, friction_record(1.2, 5));

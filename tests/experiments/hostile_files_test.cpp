@@ -48,7 +48,7 @@ fs::path fifo(const fs::path& file) {
 /// fails the test instead of hanging it), with at most `max_file_bytes` per written file when > 0.
 test::CommandResult run_cli(const std::string& arguments, rlim_t max_file_bytes = 0) {
   const fs::path dir = test::temporary_dir("hostile_files_cli");
-  const std::string command = "exec timeout -s KILL 20 '" + std::string(GPILQG_CLI_PATH) + "' " + arguments + " >'" +
+  const std::string command = "exec timeout -s KILL 20 '" + test::program_path() + "' " + arguments + " >'" +
                               (dir / "out.txt").string() + "' 2>'" + (dir / "err.txt").string() + "' </dev/null";
   const pid_t child = ::fork();
   if (child == 0) {
@@ -206,7 +206,7 @@ TEST(HostileFiles, EveryHdf5ReaderRefusesObjectsStoredInOtherFiles) {
   }
 }
 
-TEST(HostileFiles, TheCommandsRefuseAnExternalLinkToAFifoWithExit2) {
+TEST(HostileFilesCli, TheCommandsRefuseAnExternalLinkToAFifoWithExit2) {
   const fs::path dir = test::temporary_dir("hostile_files_hdf5_cli");
   const fs::path pipe = fifo(dir / "pipe.h5"), file = dir / "x.h5";
   make_hdf5(file, [&](hid_t f, const char* path, hid_t links) { external_link(pipe, f, path, links); });
@@ -316,7 +316,7 @@ TEST(HostileFiles, EveryFileAMujocoModelNamesIsCheckedBeforeMujocoOpensIt) {
   }
 }
 
-TEST(HostileFiles, SimulateRefusesAModelIncludingAFifoWithExit2) {
+TEST(HostileFilesCli, SimulateRefusesAModelIncludingAFifoWithExit2) {
   const fs::path dir = test::temporary_dir("hostile_files_mujoco_cli");
   const fs::path model = test::write_text(dir / "main.xml", "<mujoco><include file=\"inc.xml\"/>" + std::string(kBody) + "</mujoco>");
   fifo(dir / "inc.xml");
@@ -329,7 +329,7 @@ TEST(HostileFiles, SimulateRefusesAModelIncludingAFifoWithExit2) {
 
 // ---- an output that is one of the inputs -------------------------------------------------------
 
-TEST(HostileFiles, AnOutputThatIsAnInputIsExit2AndTheInputIsKept) {
+TEST(HostileFilesCli, AnOutputThatIsAnInputIsExit2AndTheInputIsKept) {
   const fs::path dir = test::temporary_dir("hostile_files_same");
   // A log and map that import (the output would replace the log); the other inputs need not be
   // valid: the outputs are checked before any input is read.
@@ -388,7 +388,7 @@ TEST(HostileFiles, AnOutputThatIsAnInputIsExit2AndTheInputIsKept) {
 
 // ---- a file-size limit -------------------------------------------------------------------------
 
-TEST(HostileFiles, AFileSizeLimitIsExit1NamingTheFileAndKeepsThePreviousOne) {
+TEST(HostileFilesCli, AFileSizeLimitIsExit1NamingTheFileAndKeepsThePreviousOne) {
   const fs::path dir = test::temporary_dir("hostile_files_fsize");
   for (const std::string name : {"data.csv", "data.h5"}) {
     SCOPED_TRACE(name);

@@ -42,7 +42,7 @@ TEST(HostileInputs, EveryCommandLineReaderRefusesThemWithInputError) {
   test::expect_readers_refuse_hostile_inputs<InputError>(readers, test::temporary_dir("hostile"));
 }
 
-TEST(HostileInputs, TheCommandLineExitsTwoOnAFifo) {
+TEST(HostileInputsCli, TheCommandLineExitsTwoOnAFifo) {
   const fs::path dir = test::temporary_dir("hostile");
   const auto inputs = test::make_hostile_inputs(dir, ".csv", kMaxDataFileBytes);
   const fs::path fifo = inputs.front().path;

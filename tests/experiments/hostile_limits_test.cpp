@@ -89,7 +89,7 @@ TEST(HostileLimits, ALogColumnNameThatIsNotUtf8IsRefusedWhenTheLogIsRead) {
   fs::remove_all(dir);
 }
 
-TEST(HostileLimits, TheCommandLineNamesTheOptionOrReportsTheDivergence) {
+TEST(HostileLimitsCli, TheCommandLineNamesTheOptionOrReportsTheDivergence) {
   const fs::path dir = test::temporary_dir("hostile_limits_cli");
   const fs::path out = dir / "out.csv";
   // A measurement file whose name is not UTF-8: refused before it is read when --json is asked.

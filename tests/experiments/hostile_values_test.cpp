@@ -63,7 +63,7 @@ TEST(HostileValues, AnOutputNameMustCarryItsFormatsExtension) {
 }
 
 /// Every output option of a fixed format, with a name of another format: exit 2 before any work.
-TEST(HostileValues, EveryCommandRefusesAnOutputNameOfAnotherFormat) {
+TEST(HostileValuesCli, EveryCommandRefusesAnOutputNameOfAnotherFormat) {
   const fs::path dir = test::temporary_dir("hostile_extensions");
   const std::string plan = quote(test::write_text(dir / "plan.toml", test::kTinyPlan));
   test::write_text(dir / "run.toml", test::kTinyRun);
@@ -98,7 +98,7 @@ TEST(HostileValues, EveryCommandRefusesAnOutputNameOfAnotherFormat) {
     EXPECT_FALSE(fs::exists(dir / name)) << name;
 }
 
-TEST(HostileValues, AnEmptyBackendListIsRefusedNamingTheOption) {
+TEST(HostileValuesCli, AnEmptyBackendListIsRefusedNamingTheOption) {
   const fs::path dir = test::temporary_dir("hostile_backends");
   const std::string run = "run cartpole --no-plots --config " + quote(test::write_text(dir / "run.toml", test::kTinyRun));
   for (const char* list : {"''", "','", "'exact,'"}) {
@@ -220,7 +220,7 @@ TEST(HostileValues, APolicyOfAModelFileMatchesTheSameModelInAnotherFolder) {
   EXPECT_NE(reading_error(file, "cartpole").find("expected 'cartpole'"), std::string::npos);
 }
 
-TEST(HostileValues, RolloutAndPlanRefuseABadPolicyWithExit2) {
+TEST(HostileValuesCli, RolloutAndPlanRefuseABadPolicyWithExit2) {
   const fs::path dir = test::temporary_dir("hostile_policy_cli");
   const fs::path crossed = dir / "crossed.h5", other = dir / "other.h5";
   write_policy_file(crossed, small_policy(), nullptr);
@@ -296,7 +296,7 @@ TEST(HostileValues, TheWeightBoundKeepsTheCostOfStatesWithinTheDivergenceBoundFi
   EXPECT_TRUE(std::isfinite(stage * static_cast<double>(limits::kMaxHorizon) + cost.terminal(x)));
 }
 
-TEST(HostileValues, AnOverflowingCostIsReportedAsOverflowNotAsDivergence) {
+TEST(HostileValuesCli, AnOverflowingCostIsReportedAsOverflowNotAsDivergence) {
   // The solver cuts a diverging trajectory at the bound, so the cost of what it returns is finite
   // exactly when the states diverged; not finite, the cost itself overflowed.
   EXPECT_NE(initial_rollout_failure(kInf).find("keep every state within the divergence bound (|x| <= 1e+12), but their "
@@ -366,7 +366,7 @@ TEST(HostileValues, StatisticsOfExtremeFiniteDataAreFinite) {
 
 // ---- names a measurement file cannot hold ----------------------------------------------------------
 
-TEST(HostileValues, ModelNamesThatACsvCannotHoldAreRefusedOnLoading) {
+TEST(HostileValuesCli, ModelNamesThatACsvCannotHoldAreRefusedOnLoading) {
   EXPECT_EQ(column_name_problem("a b\"c "), std::nullopt);  // read back as written: fields are not trimmed
   const fs::path dir = test::temporary_dir("hostile_names");
   const auto model = [&](const std::string& file, const std::string& joint, const std::string& actuator) {

@@ -180,7 +180,7 @@ TEST(LoopDiagnosis, PlansAfterTheDiagnosedRoundOnTheDiagnosedModelAndKeepsItInTh
   std::filesystem::remove_all(folder);
 }
 
-TEST(LoopDiagnosis, PlanDiagnosesTheLogsWritesTheModelAndTheNextRoundPlansOnIt) {
+TEST(LoopDiagnosisCli, PlanDiagnosesTheLogsWritesTheModelAndTheNextRoundPlansOnIt) {
   // The loop on a robot: plan, roll out on the world, plan --diagnose (the model file for the next
   // config), roll out, plan with [system] model = the diagnosed model.
   const auto dir = test::temporary_dir("plan_diagnose");
@@ -225,7 +225,7 @@ TEST(LoopDiagnosis, PlanDiagnosesTheLogsWritesTheModelAndTheNextRoundPlansOnIt) 
   std::filesystem::remove_all(dir);
 }
 
-TEST(ConfigModel, AConfigNamesItsSimulatorAndWorldByModelFilesAndBadOnesAreRefused) {
+TEST(ConfigModelCli, AConfigNamesItsSimulatorAndWorldByModelFilesAndBadOnesAreRefused) {
   const auto folder = test::temporary_dir("config_model");
   write_world(folder);
   test::write_text(folder / "quadrotor.toml", "[model]\nsystem = \"quadrotor\"\n");

@@ -32,7 +32,8 @@ class TwoStateSystem final : public StepModel {
   int state_dim() const override { return 2; }
   int control_dim() const override { return 1; }
   double dt() const override { return kSliceDt; }
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians*) const override {
+  using StepModel::step;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians*, StepWorkspace&) const override {
     x_next(0) = x(0) + kSliceDt * x(1);
     x_next(1) = x(1) + kSliceDt * (-0.5 * x(1) + u(0));
     if (real_) x_next(1) += kSliceDt * residual(x(0));

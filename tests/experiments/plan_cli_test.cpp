@@ -1,4 +1,4 @@
-// `gpilqg plan` and `gpilqg rollout` (DESIGN.md section 11): a scripted loop of the two reproduces
+// `gpilqg plan` and `gpilqg rollout` (docs/real-robot.md): a scripted loop of the two reproduces
 // `gpilqg run`'s gp_ilqg policies, the policy file has the contract's layout and --json its content,
 // rollouts log in the data format, and bad input is exit 2 naming the file and the field.
 

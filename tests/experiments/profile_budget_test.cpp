@@ -160,7 +160,7 @@ fs::path write_benchmark(const fs::path& file, const ProfileData& data) {
   return file;
 }
 
-TEST(ProfileBudget, TheCommandLineSkipsWithTheReasonInJsonAndHdf5AndZeroDisablesIt) {
+TEST(ProfileBudgetCli, TheCommandLineSkipsWithTheReasonInJsonAndHdf5AndZeroDisablesIt) {
   const fs::path dir = test::temporary_dir("profile_time_budget");
   const fs::path data = write_benchmark(dir / "tiny.h5", synthetic(60, 20, 2));
   const std::string run = "profile '" + data.string() + "' --backends exact,ssgp --frequencies 8 --max-evaluations 10 --json";
@@ -195,7 +195,7 @@ TEST(ProfileBudget, TheCommandLineSkipsWithTheReasonInJsonAndHdf5AndZeroDisables
   }
 }
 
-TEST(ProfileBudget, BadTimeBudgetsAreRefusedNamingTheOption) {
+TEST(ProfileBudgetCli, BadTimeBudgetsAreRefusedNamingTheOption) {
   const fs::path dir = test::temporary_dir("profile_time_budget_bad");
   const fs::path data = write_benchmark(dir / "tiny.h5", synthetic(60, 20, 2));
   for (const std::string bad : {"-1", "nan", "inf", "soon"}) {

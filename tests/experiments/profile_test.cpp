@@ -93,7 +93,7 @@ const nlohmann::json& row(const nlohmann::json& report, const std::string& backe
   throw std::runtime_error("no row " + backend + " " + std::to_string(size));
 }
 
-TEST(Profile, JsonScoresEqualADirectComputationAndTheHdf5File) {
+TEST(ProfileCli, JsonScoresEqualADirectComputationAndTheHdf5File) {
   const fs::path dir = test::temporary_dir("profile");
   const Benchmark b = make_benchmark();
   const fs::path data = write_benchmark(dir / "tiny.h5", b);
@@ -131,7 +131,7 @@ TEST(Profile, JsonScoresEqualADirectComputationAndTheHdf5File) {
   EXPECT_FALSE(fs::exists(dir / ("out.h5.tmp-" + std::to_string(0))));
 }
 
-TEST(Profile, MemoryBudgetSkipsTheExactGpAndSaysWhy) {
+TEST(ProfileCli, MemoryBudgetSkipsTheExactGpAndSaysWhy) {
   const fs::path dir = test::temporary_dir("profile_budget");
   const fs::path data = write_benchmark(dir / "tiny.h5", make_benchmark());
   // 16 * 60^2 = 57.6 kB fitted, 28.8 kB conditioned: a 40 kB budget keeps only the baseline.
@@ -147,7 +147,7 @@ TEST(Profile, MemoryBudgetSkipsTheExactGpAndSaysWhy) {
   EXPECT_EQ(row(report, "ssgp", 60)["status"], "ok");
 }
 
-TEST(Profile, MeasurementSetsWithAChosenOutput) {
+TEST(ProfileCli, MeasurementSetsWithAChosenOutput) {
   const fs::path dir = test::temporary_dir("profile_measurements");
   const IntegratedStepModel real(make_system("cartpole", Preset::RealWorld), Integrator::RK4, 0.05);
   MeasurementSet set;
@@ -188,7 +188,7 @@ TEST(Profile, MeasurementSetsWithAChosenOutput) {
   EXPECT_NE(unknown.err.find("not a state of cartpole"), std::string::npos) << unknown.err;
 }
 
-TEST(Profile, BadInputExitsTwoNamingTheFileAndDataset) {
+TEST(ProfileCli, BadInputExitsTwoNamingTheFileAndDataset) {
   const fs::path dir = test::temporary_dir("profile_bad");
   const Benchmark b = make_benchmark();
   const fs::path no_targets = write_benchmark(dir / "no_y_test.h5", b, false);
@@ -215,7 +215,7 @@ fs::path declaring_benchmark(const fs::path& file, hsize_t rows) {
   return file;
 }
 
-TEST(Profile, ADeclaredDatasetSizeIsRefusedBeforeAllocating) {
+TEST(ProfileCli, ADeclaredDatasetSizeIsRefusedBeforeAllocating) {
   const fs::path dir = test::temporary_dir("profile_declared");
   for (const hsize_t rows : {hsize_t{1} << 27, hsize_t{1} << 31}) {
     const fs::path file = declaring_benchmark(dir / "declares.h5", rows);
@@ -230,7 +230,7 @@ TEST(Profile, ADeclaredDatasetSizeIsRefusedBeforeAllocating) {
   }
 }
 
-TEST(Profile, ABackendsRefusalOfTheDataNamesTheFile) {
+TEST(ProfileCli, ABackendsRefusalOfTheDataNamesTheFile) {
   const fs::path dir = test::temporary_dir("profile_constant");
   Benchmark b = make_benchmark();
   b.train.targets.setConstant(0.25);

@@ -98,7 +98,7 @@ double chosen(const std::map<std::string, double>& values, std::initializer_list
 // encoder of 1 um, positions and the motor force only, one continuous record of 12 s. The world has
 // viscous friction, Coulomb friction (MuJoCo's frictionloss) and a constant force together; the model
 // has none of them. --auto must find all three, and no proxy (a gain, a mass).
-TEST(RealMachine, ClosedLoopDriveAtOneKilohertzFindsItsThreeFrictionTerms) {
+TEST(RealMachineCli, ClosedLoopDriveAtOneKilohertzFindsItsThreeFrictionTerms) {
   const test::DriveTruth truth;
   const auto dir = test::temporary_dir("ball_drive");
   const auto model_file = test::drive_model(test::source_dir());

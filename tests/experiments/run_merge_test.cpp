@@ -86,6 +86,8 @@ class RunMerge : public ::testing::Test {
   fs::path dir_;
   std::vector<fs::path> parts_;  ///< seed_1.h5, seed_2.h5, seed_3.h5
 };
+/// The same parts for the tests that run the program (ctest label cli).
+using RunMergeCli = RunMerge;
 
 TEST(RunMergeLayout, EveryDatasetOfAnAlgorithmHasItsSeedAxis) {
   for (const char* name : {"cost", "normalised_cost", "time_fit", "policy_change", "evaluation_costs", "gp/theta/hyper", "gp/x/fitted"})
@@ -229,7 +231,7 @@ TEST_F(RunMerge, FilesThatAreNotDistinctResultPartsAreRefused) {
   EXPECT_FALSE(fs::exists(dir_ / "merged.h5"));
 }
 
-TEST_F(RunMerge, APartHoldingANaNOrAnInfIsRefusedNamingTheDatasetAndTheEntry) {
+TEST_F(RunMergeCli, APartHoldingANaNOrAnInfIsRefusedNamingTheDatasetAndTheEntry) {
   struct Case {
     const char* name;
     std::function<void(IterationRecord&)> damage;
@@ -257,7 +259,7 @@ TEST_F(RunMerge, APartHoldingANaNOrAnInfIsRefusedNamingTheDatasetAndTheEntry) {
   EXPECT_FALSE(fs::exists(dir_ / "merged.h5"));
 }
 
-TEST_F(RunMerge, TheCommandMergesPrintsASummaryAndExitsTwoOnARefusal) {
+TEST_F(RunMergeCli, TheCommandMergesPrintsASummaryAndExitsTwoOnARefusal) {
   const auto quote = [](const fs::path& p) { return "'" + p.string() + "'"; };
   const fs::path merged = dir_ / "merged.h5";
   const auto done = test::run_cli("merge " + quote(parts_[0]) + " " + quote(parts_[1]) + " --out " + quote(merged) + " --no-plots");

@@ -151,7 +151,7 @@ std::string read_bytes(const std::filesystem::path& file) {
 
 /// Starts `gpilqg run cartpole --config CONFIG --out OUT --no-plots`, output to LOG.
 pid_t start_run(const std::filesystem::path& config, const std::filesystem::path& out, const std::filesystem::path& log) {
-  const std::string program = GPILQG_CLI_PATH;
+  const std::string program = test::program_path();
   const std::string config_s = config.string(), out_s = out.string();
   std::vector<std::string> args = {program, "run", "cartpole", "--config", config_s, "--out", out_s, "--no-plots"};
   std::vector<char*> argv;
@@ -182,7 +182,7 @@ bool wait_for_checkpoint_files(const std::filesystem::path& folder, int files, p
   return false;
 }
 
-class RunSignals : public ::testing::Test {
+class RunSignalsCli : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = test::temporary_dir("run_signals");
@@ -212,7 +212,7 @@ class RunSignals : public ::testing::Test {
   std::filesystem::path dir_, config_, reference_;
 };
 
-TEST_F(RunSignals, SigintStopsAtAnIterationLeavesThePreviousResultAndResumesToTheSameResult) {
+TEST_F(RunSignalsCli, SigintStopsAtAnIterationLeavesThePreviousResultAndResumesToTheSameResult) {
   const auto out = dir_ / "result.h5";
   const std::string previous = "a previous result that must survive";
   std::ofstream(out, std::ios::binary) << previous;
@@ -232,7 +232,7 @@ TEST_F(RunSignals, SigintStopsAtAnIterationLeavesThePreviousResultAndResumesToTh
   resume_and_compare(out);
 }
 
-TEST_F(RunSignals, SigkillAtAnyMomentLeavesACheckpointThatResumesToTheSameResult) {
+TEST_F(RunSignalsCli, SigkillAtAnyMomentLeavesACheckpointThatResumesToTheSameResult) {
   // No chance to stop cleanly: whatever the moment, each checkpoint file is the old or the new one.
   const auto out = dir_ / "killed.h5";
   const pid_t child = start_run(config_, out, dir_ / "killed.log");

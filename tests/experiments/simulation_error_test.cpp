@@ -200,7 +200,7 @@ TEST(SimulationError, TheRequestChecksCriterionAndWindow) {
   EXPECT_THROW(o.validate(), std::invalid_argument);
 }
 
-TEST(SimulationError, TheCommandLineTakesTheOptionsAndNamesThemInItsErrors) {
+TEST(SimulationErrorCli, TheCommandLineTakesTheOptionsAndNamesThemInItsErrors) {
   const fs::path dir = test::temporary_dir("simulation_error_cli");
   write_measurements_csv(dir / "decay.csv", pendulum().data);
   const std::string call = "diagnose --system '" + pendulum().model.string() + "' --data '" + (dir / "decay.csv").string() + "'";

@@ -14,7 +14,7 @@ namespace {
 
 std::string config_path(const char* name) { return (test::source_dir() / "experiments" / "configs" / name).string(); }
 
-TEST(SolveCommand, ReachesTheReferenceOptimaFromTheCommandLine) {
+TEST(SolveCommandCli, ReachesTheReferenceOptimaFromTheCommandLine) {
   struct Case { const char* file; double cost; double x_final_theta; };
   // tests/reference/ilqr_cartpole: summary.csv, cases C and E.
   for (const Case c : {Case{"cartpole_swingup.toml", 0.645046921446, 3.14042815352604},
@@ -30,7 +30,7 @@ TEST(SolveCommand, ReachesTheReferenceOptimaFromTheCommandLine) {
   }
 }
 
-TEST(SolveCommand, IlqgExampleReportsTheExpectedCostAboveTheNominal) {
+TEST(SolveCommandCli, IlqgExampleReportsTheExpectedCostAboveTheNominal) {
   const auto r = test::run_cli("solve '" + config_path("cartpole_swingup_ilqg.toml") + "' --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -47,9 +47,9 @@ struct BadConfig {
 
 void PrintTo(const BadConfig& c, std::ostream* os) { *os << c.name; }
 
-class SolveBadConfig : public ::testing::TestWithParam<BadConfig> {};
+class SolveBadConfigCli : public ::testing::TestWithParam<BadConfig> {};
 
-TEST_P(SolveBadConfig, ExitsTwoWithAClearError) {
+TEST_P(SolveBadConfigCli, ExitsTwoWithAClearError) {
   const BadConfig c = GetParam();
   std::ifstream in(config_path("cartpole_swingup.toml"));
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -66,7 +66,7 @@ TEST_P(SolveBadConfig, ExitsTwoWithAClearError) {
 }
 
 INSTANTIATE_TEST_SUITE_P(
-    Table, SolveBadConfig,
+    Table, SolveBadConfigCli,
     ::testing::Values(
         BadConfig{"syntax", "horizon = 100", "horizon = = 100", "bad.toml:line 9: "},
         BadConfig{"unknown_field", "horizon = 100", "horizon = 100\nhorizn = 5", "unknown field 'problem.horizn'"},
@@ -113,7 +113,7 @@ std::string edited_config(const std::string& edit_from, const std::string& edit_
   return "'" + file.string() + "'";
 }
 
-TEST(SolveCommand, ATooLongStepStallsAndIsNotReportedConverged) {
+TEST(SolveCommandCli, ATooLongStepStallsAndIsNotReportedConverged) {
   // Euler steps of 1 s: once "converged" (cost_change) with a gradient norm of 8e53.
   const std::string file = edited_config("dt = 0.05", "dt = 1");
   const auto text = test::run_cli("solve " + file);
@@ -129,7 +129,7 @@ TEST(SolveCommand, ATooLongStepStallsAndIsNotReportedConverged) {
   EXPECT_TRUE(test::json_numbers_finite(j));
 }
 
-TEST(SolveCommand, InitialControlsThatDivergeAreAStatusWithAFiniteCost) {
+TEST(SolveCommandCli, InitialControlsThatDivergeAreAStatusWithAFiniteCost) {
   // Within the bound of the config, but the first step already leaves |x| <= 1e12.
   const std::string file = edited_config("R = [0.1]", "R = [0.1]\nu_init = [1e12]");
   const auto r = test::run_cli("solve " + file + " --json");
@@ -145,7 +145,7 @@ TEST(SolveCommand, InitialControlsThatDivergeAreAStatusWithAFiniteCost) {
   for (const char* word : {"inf", "nan"}) EXPECT_EQ(text.out.find(word), std::string::npos) << text.out;
 }
 
-TEST(SolveCommand, AMissingFileIsBadInput) {
+TEST(SolveCommandCli, AMissingFileIsBadInput) {
   const auto r = test::run_cli("solve /nonexistent/problem.toml");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("/nonexistent/problem.toml: no such file"), std::string::npos) << r.err;

@@ -76,7 +76,7 @@ TEST(UserEffects, ADeclaredCubicSpringIsRankedFirstAndFitted) {
   }
 }
 
-TEST(UserEffects, DiagnoseCliFindsAddsAndWritesTheDeclaredEffect) {
+TEST(UserEffectsCli, DiagnoseCliFindsAddsAndWritesTheDeclaredEffect) {
   const fs::path dir = test::temporary_dir("user_effects_cli");
   const fs::path data = dir / "spring.csv", model = dir / "user.toml", next = dir / "next.toml";
   write_measurements(data, spring_data(5));

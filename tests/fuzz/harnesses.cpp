@@ -328,7 +328,8 @@ void build_hdf5(Choices& c, const std::filesystem::path& file, const SystemSigna
 // ---------------------------------------------------------------------------------------------------
 // TOML loaders
 
-/// What read_solve_config promises (solve_config.hpp, DESIGN.md section 8).
+/// What read_solve_config promises (solve_config.hpp,
+/// docs/formats.md#problem-config-gpilqg-solve-and-gpilqg-plan).
 void check_solve_config(const SolveConfig& c) {
   const SystemSignature& system = system_named(c.system);
   const auto n = static_cast<Eigen::Index>(system.states.size());

@@ -1,5 +1,7 @@
-/// Practice 1 of DESIGN.md: after a warm-up, prediction, the residual model's step and uncertainty
-/// with the caller's workspace, and moment matching (PDDP's belief step) do not touch the heap. Counted by interposing glibc's malloc in this test program.
+/// No allocation in hot loops (docs/architecture.md#models-and-workspaces): after a warm-up,
+/// prediction, the residual model's step and uncertainty with the caller's workspace, and moment
+/// matching (PDDP's belief step) do not touch the heap. Counted by interposing glibc's malloc in this
+/// test program.
 
 #include <gtest/gtest.h>
 

@@ -13,7 +13,8 @@
 namespace gpilqg::gp::test {
 namespace {
 
-/// Only a fitted model can predict (practice 2), checked at compile time.
+/// Only a fitted model can predict (docs/architecture.md#conventions-of-the-code), checked at compile
+/// time.
 template <class T>
 concept CanPredict = requires(const T& t, const Vector& z, Prediction& p) { t.predict(z, p); };
 static_assert(CanPredict<FittedGp>);

@@ -188,7 +188,7 @@ FittedOutputs::FittedOutputs(std::vector<std::unique_ptr<FittedGp>> fitted) : mo
 
 PosteriorAtPoint FittedOutputs::posterior() const {
   return [this](const Vector& z, Vector& mean, Vector& variance) {
-    thread_local Prediction p;
+    Prediction p;
     for (std::size_t a = 0; a < models.size(); ++a) {
       models[a]->predict(z, p);
       mean(static_cast<Eigen::Index>(a)) = p.mean;

@@ -374,7 +374,8 @@ class Drift final : public StepModel {
   int state_dim() const override { return 1; }
   int control_dim() const override { return 1; }
   double dt() const override { return 0.1; }
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef next, StepJacobians* jac) const override {
+  using StepModel::step;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef next, StepJacobians* jac, StepWorkspace&) const override {
     next(0) = x(0) + dt() * (u(0) + (real_ ? 0.8 * std::sin(x(0)) : 0.0));
     if (jac != nullptr) {
       jac->resize(1, 1);

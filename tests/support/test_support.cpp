@@ -124,11 +124,22 @@ std::string read_file(const std::filesystem::path& p) {
 }
 }  // namespace
 
+std::string program_path() {
+  if (const auto* test = ::testing::UnitTest::GetInstance()->current_test_info()) {
+    const std::string_view suite = test->test_suite_name();
+    const std::string_view bare = suite.substr(suite.find('/') + 1);  // "Prefix/Suite" of a parametrised test
+    if (!bare.ends_with("Cli"))
+      ADD_FAILURE() << suite << "." << test->name() << " runs the gpilqg program, so its test suite's name must "
+                    << "end in Cli (the ctest label cli, tests/CMakeLists.txt)";
+  }
+  return GPILQG_CLI_PATH;
+}
+
 CommandResult run_cli(const std::string& arguments) {
   const auto dir = temporary_dir("cli");
   const auto out = dir / "stdout.txt";
   const auto err = dir / "stderr.txt";
-  const std::string command = std::string("'") + GPILQG_CLI_PATH + "' " + arguments + " >'" +
+  const std::string command = "'" + program_path() + "' " + arguments + " >'" +
                               out.string() + "' 2>'" + err.string() + "' </dev/null";
   const int raw = std::system(command.c_str());
   CommandResult result;

@@ -52,6 +52,11 @@ Vector random_vector(int size, double lo, double hi, unsigned seed);
 /// Options of `gpilqg diagnose` that keep a test of it fast: a small GP without restarts.
 inline const std::string kFastDiagnose = " --gp-points 100 --gp-restarts 0";
 
+/// The gpilqg program, for a test that runs it. Such a test belongs to a test suite whose name ends in
+/// `Cli`: tests/CMakeLists.txt labels those tests `cli` by that name (docs/testing.md says what runs
+/// where). A test of another suite that asks for the program fails, naming the rule.
+std::string program_path();
+
 /// Runs the gpilqg program with `arguments` (shell-quoted by the caller), capturing stdout and
 /// stderr separately; returns the exit status.
 struct CommandResult {

@@ -12,7 +12,7 @@ namespace gpilqg::cli {
 
 using CommandAction = std::function<int()>;
 
-/// The help text of every --system option (DESIGN.md sections 8 and 10).
+/// The help text of every --system option (docs/command-line.md#what-every-command-shares).
 inline constexpr const char* kSystemHelp =
     "System: cartpole, quadrotor, a MuJoCo model file (.xml or .urdf) or a system registered by a --plugin";
 

@@ -1,6 +1,6 @@
 /// `gpilqg data info FILE --system NAME [--json]`: summarise a measurement file (CSV or HDF5,
-/// DESIGN.md section 4), or reject it with an error naming the file and the line or dataset; and
-/// `gpilqg data import` (data_import_command.cpp).
+/// docs/formats.md#measurement-data-csv-and-hdf5), or reject it with an error naming the file and the
+/// line or dataset; and `gpilqg data import` (data_import_command.cpp).
 
 #include <iostream>
 #include <memory>

@@ -1,6 +1,7 @@
 /// `gpilqg data import LOG --system NAME --map MAP.toml --out FILE [--json]`: a robot's log (CSV, MAT
-/// or HDF5) into the measurement format of DESIGN.md section 4, by the map of docs/data-import.md.
-/// Bad maps and logs exit 2 with the file and the line, field, column or dataset at fault.
+/// or HDF5) into the measurement format of docs/formats.md#measurement-data-csv-and-hdf5, by the map of
+/// docs/data-import.md. Bad maps and logs exit 2 with the file and the line, field, column or dataset
+/// at fault.
 
 #include "data_import_command.hpp"
 #include "output_options.hpp"

@@ -1,7 +1,9 @@
 /// `gpilqg diagnose --system NAME --data FILE [--model F.toml] [--add EFFECT[=VALUE]]... [--json]
-/// [--out F.h5] [--plots DIR] [--horizons LIST] [--criterion one-step|simulation --window N]`: compare a model with measurements, see where it fails,
-/// learn which physical effect is missing, add it and watch the error fall (DESIGN.md sections 5, 6
-/// and 8).
+/// [--out F.h5] [--plots DIR] [--horizons LIST] [--criterion one-step|simulation --window N]`: compare
+/// a model with measurements, see where it fails, learn which physical effect is missing, add it and
+/// watch the error fall (docs/command-line.md#gpilqg-diagnose---system-name---data-file-options; the
+/// effects: docs/diagnosis.md#the-physical-effects-library-coreeffect_libraryhpp-coreeffectshpp; the
+/// JSON: docs/formats.md#diagnosis-json-gpilqg-diagnose---json).
 
 #include <unistd.h>
 

@@ -65,7 +65,9 @@ void add_solve_command(CLI::App& app, CommandAction& action) {
   auto file = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
   auto* cmd = app.add_subcommand("solve", "Solve one trajectory-optimisation problem described in a TOML file");
-  cmd->add_option("CONFIG", *file, "TOML problem description (DESIGN.md section 8)")->required();
+  cmd->add_option("CONFIG", *file,
+                  "TOML problem description (docs/formats.md#problem-config-gpilqg-solve-and-gpilqg-plan)")
+      ->required();
   cmd->add_flag("--json", *json, "Print one JSON document: cost, iterations, termination, x_final, u, solve_time_s");
   cmd->callback([&action, file, json] { action = [file, json] { return run_solve(*file, *json); }; });
 }

@@ -184,19 +184,18 @@ void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0
   judge_remainder(v, o);
 }
 
-}  // namespace
+/// The one-step residual of `model` on settings.data, integrated as `settings` says and driven by
+/// the measured inputs as the model applies them (its input delay).
+Matrix residual_of_model(const ModelSpec& model, const FitContext& settings) {
+  return residual_of(*settings.data, model_predictions(model, settings));
+}
 
-DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o) {
-  o.validate();
-  if (input.episodes.empty()) throw std::invalid_argument("the data has no episodes");
-  check_measurement_range(input);
-  DiagnosisReport R;
-  R.system = o.model.system;
-  // A model file's data carry the model's name (<mujoco model="...">), not the file's path.
-  if (const std::string model_name = system_signature(R.system).name; input.system.name != model_name)
-    throw std::invalid_argument("the data are of system '" + input.system.name + "'; the model is '" + model_name + "'");
-  // One continuous record: its blocks become the episodes of every step below (heldout_blocks.hpp).
-  MeasurementSet blocks_as_episodes;
+/// The episodes every step below sees. One continuous record is cut into blocks with gaps that
+/// become its episodes (heldout_blocks.hpp; stored in `blocks_as_episodes`); several episodes are
+/// used as they are. Fills the report's names, dt, held-out episodes and transitions, and returns
+/// the episodes (`blocks_as_episodes` or `input`).
+const MeasurementSet& episodes_of(const MeasurementSet& input, const DiagnosisOptions& o,
+                                  MeasurementSet& blocks_as_episodes, DiagnosisReport& R) {
   if (input.episodes.size() == 1) {
     R.blocks = split_heldout_blocks(input.episodes.front(), o.heldout_fraction, heldout_block_gap(o.horizons, o.window));
     blocks_as_episodes = block_episodes(input, *R.blocks);
@@ -211,73 +210,101 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
   for (int i : R.heldout_episode_index) R.heldout_episode_ids.push_back(set.episodes[static_cast<std::size_t>(i)].id);
   R.data = make_transitions(set, R.heldout_episode_index, R.dt);
   R.samples = R.data.size();
-  const Transitions& data = R.data;
-  const int n = static_cast<int>(R.state_names.size());
-  // The model as given; below, with the smoothing of its Coulomb candidates fitted to the data.
-  ModelSpec model0 = o.model;
+  return set;
+}
 
-  // The model as given, its residual and GP.
-  // One-step predictions of a model (its input delay applied to the measured inputs).
-  const FitContext settings{&data, model0, o.integrator, R.dt, o.substeps, Vector(), Matrix()};
-  const auto residual_of_model = [&](const ModelSpec& model) { return residual_of(data, model_predictions(model, settings)); };
-  const auto before_step = make_step_model(model0, o.integrator, R.dt, o.substeps);
-  const Matrix residual_before = residual_of_model(model0);
-  ResidualGp gp_before = fit_residual_gp(before_step, data, residual_before, o.gp);
+/// The model as given (o.model) against the data, before any effect is added.
+struct ModelAsGiven {
+  /// o.model with the smoothing velocity of its absent Coulomb candidates fitted to the data
+  /// (velocity_scales.hpp): the report's model_before and the start of every fit below.
+  ModelSpec model;
+  std::shared_ptr<const StepModel> step;  ///< o.model as given, integrated as configured
+  Matrix residual;                        ///< its one-step residual r_0 = x_next - f_0(x, u)
+  ResidualGp gp;                          ///< the GP of r_0
+  Vector weights;                         ///< 1 / floor_i^2 of r_0 and its GP (floor_weights)
+};
+
+ModelAsGiven model_as_given(const DiagnosisOptions& o, const FitContext& settings) {
+  const Transitions& data = *settings.data;
+  ModelAsGiven given;
+  given.step = make_step_model(o.model, o.integrator, settings.dt, o.substeps);
+  given.residual = residual_of_model(o.model, settings);
+  given.gp = fit_residual_gp(given.step, data, given.residual, o.gp);
   if (o.progress) o.progress("residual GP of the model fitted");
-  const Vector weights_before = floor_weights(data, residual_before, gp_before);
-  // Coulomb candidates absent from the model: their smoothing velocity from the data (velocity_scales.hpp).
-  model0 = with_fitted_smoothing(FitContext{&data, model0, o.integrator, R.dt, o.substeps, weights_before, residual_before});
-  R.model_before = model0;
+  given.weights = floor_weights(data, given.residual, given.gp);
+  given.model = with_fitted_smoothing(
+      FitContext{&data, o.model, o.integrator, settings.dt, o.substeps, given.weights, given.residual});
+  return given;
+}
 
-  // Effects to add: given values first (kept as given), then the others fitted jointly on the training
-  // episodes, together with the effects the model already has (refitted from their current values).
-  R.model = model0;
-  // The library and the model's declared effects; effects below point into it.
-  const std::vector<LibraryEffect> candidates = candidate_effects(model0);
-  Matrix residual = residual_before;
+/// The --add effects on the model as given: those with given values first (kept as given, scored
+/// under the criterion), then the others fitted jointly on the training episodes together with the
+/// effects the model already has (refitted from their current values). Sets the report's model (the
+/// diagnosed model: the model as given plus the added effects), added and refitted.
+void add_requested_effects(const DiagnosisOptions& o, const ModelAsGiven& given,
+                           const std::vector<LibraryEffect>& candidates, const FitContext& settings, DiagnosisReport& R) {
+  const Transitions& data = R.data;
+  R.model = given.model;
+  Matrix residual = given.residual;
   std::vector<const LibraryEffect*> to_fit;
-  std::vector<std::string> given;
+  std::vector<std::string> kept_as_given;
   for (const EffectRequest& request : o.add) {
     const LibraryEffect& effect = named(candidates, request.effect);
     if (!request.values) {
       to_fit.push_back(&effect);
       continue;
     }
-    const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual},
+    const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, given.weights, residual},
                                                  o.criterion, o.window);
     R.added.push_back(score_effect(effect, *request.values, context));
     R.model = R.model.with(effect, *request.values);
-    residual = residual_of_model(R.model);
-    given.push_back(effect.name);
+    residual = residual_of_model(R.model, settings);
+    kept_as_given.push_back(effect.name);
   }
-  if (!to_fit.empty()) {
-    std::vector<RefitEffect> refit;
-    for (std::size_t i = 1; i < to_fit.size(); ++i) refit.push_back({to_fit[i], R.model.current_values(*to_fit[i])});
-    for (const RefitEffect& r : model_effects(R.model, candidates)) {
-      const bool requested = std::find(to_fit.begin(), to_fit.end(), r.effect) != to_fit.end();
-      const bool kept = std::find(given.begin(), given.end(), r.effect->name) != given.end();
-      if (!requested && !kept) refit.push_back(r);
-    }
-    const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, weights_before, residual},
-                                                 o.criterion, o.window);
-    const EffectFit joint = fit_jointly(*to_fit.front(), refit, context);
-    R.model = R.model.with(*to_fit.front(), joint.estimate);
-    for (const EffectValues& v : joint.refitted) R.model = R.model.with(named(candidates, v.effect), v.estimate);
-    // One entry per requested effect, with the joint scores; the model's own effects as refitted values.
-    EffectFit first = joint;
-    first.refitted.clear();
-    R.added.push_back(first);
-    for (std::size_t i = 1; i < to_fit.size(); ++i) R.added.push_back(led_by(first, joint.refitted[i - 1]));
-    R.refitted.assign(joint.refitted.begin() + static_cast<std::ptrdiff_t>(to_fit.size() - 1), joint.refitted.end());
+  if (to_fit.empty()) return;
+  std::vector<RefitEffect> refit;
+  for (std::size_t i = 1; i < to_fit.size(); ++i) refit.push_back({to_fit[i], R.model.current_values(*to_fit[i])});
+  for (const RefitEffect& r : model_effects(R.model, candidates)) {
+    const bool requested = std::find(to_fit.begin(), to_fit.end(), r.effect) != to_fit.end();
+    const bool kept = std::find(kept_as_given.begin(), kept_as_given.end(), r.effect->name) != kept_as_given.end();
+    if (!requested && !kept) refit.push_back(r);
   }
-  const auto step = make_step_model(R.model, o.integrator, R.dt, o.substeps);
+  const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, given.weights, residual},
+                                               o.criterion, o.window);
+  const EffectFit joint = fit_jointly(*to_fit.front(), refit, context);
+  R.model = R.model.with(*to_fit.front(), joint.estimate);
+  for (const EffectValues& v : joint.refitted) R.model = R.model.with(named(candidates, v.effect), v.estimate);
+  // One entry per requested effect, with the joint scores; the model's own effects as refitted values.
+  EffectFit first = joint;
+  first.refitted.clear();
+  R.added.push_back(first);
+  for (std::size_t i = 1; i < to_fit.size(); ++i) R.added.push_back(led_by(first, joint.refitted[i - 1]));
+  R.refitted.assign(joint.refitted.begin() + static_cast<std::ptrdiff_t>(to_fit.size() - 1), joint.refitted.end());
+}
+
+/// The diagnosed model against the data: its one-step predictions and residual r, the GP of r (the
+/// model as given's when nothing was added) and the weights w_i = 1 / floor_i^2. Returns the noise
+/// floors (noise_floor).
+Vector fit_diagnosed_residual(const DiagnosisOptions& o, const ModelAsGiven& given, const FitContext& settings,
+                              const std::shared_ptr<const StepModel>& step, DiagnosisReport& R) {
+  const Transitions& data = R.data;
   R.predicted = model_predictions(R.model, settings, &R.non_finite_predictions);
   R.residual = residual_of(data, R.predicted);
-  R.gp = o.add.empty() ? gp_before : fit_residual_gp(step, data, R.residual, o.gp);
+  R.gp = o.add.empty() ? given.gp : fit_residual_gp(step, data, R.residual, o.gp);
   const Vector floors = noise_floor(data, R.residual, R.gp);
   R.weights = floors.cwiseAbs2().cwiseInverse();
+  return floors;
+}
 
-  // 1. Compare.
+/// 1. Compare the diagnosed model with the measurements: per state the one-step RMSE, fit percent,
+/// noise floor, the GP's held-out explained share and whether the residual is structured (the GP
+/// explains more than structure_threshold and the held-out RMSE exceeds floor_tolerance times the
+/// floor); per horizon k the k-step predictions from measured states, every max(1, k / 10) samples.
+/// The model diverges when a one-step prediction or a k-step window does.
+void compare(const DiagnosisOptions& o, const MeasurementSet& set, const StepModel& step, const Vector& floors,
+             DiagnosisReport& R) {
+  const Transitions& data = R.data;
+  const int n = static_cast<int>(R.state_names.size());
   const Vector gp_structure = gp_explained(R.gp, data, R.residual);
   const Vector rmse_heldout = heldout_rmse(data, R.residual);
   for (int i = 0; i < n; ++i) {
@@ -298,7 +325,7 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
     KStepScore score;
     score.k = k;
     score.stride = std::max(1, k / 10);
-    score.predictions = k_step_predictions(*step, set, all_episodes, k, score.stride, R.model.input_delay);
+    score.predictions = k_step_predictions(step, set, all_episodes, k, score.stride, R.model.input_delay);
     score.windows = static_cast<int>(score.predictions.measured.rows());
     score.diverged = score.predictions.diverged;
     score.rmse = Vector::Zero(n);
@@ -313,8 +340,14 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
     R.k_step.push_back(std::move(score));
   }
   R.model_diverges = R.non_finite_predictions > 0 || R.diverged_windows > 0;
+}
 
-  // 2. Where.
+/// 2. Where the model fails: the GP's sensitivity to every input and its rows normalised to shares
+/// (relevance), the residual in bins of every input, its cross-correlation with the controls, its RMS
+/// per episode, and the GP's weighted held-out explained share. The model is consistent when it
+/// does not diverge and no state's residual is structured.
+void where(const DiagnosisOptions& o, const MeasurementSet& set, DiagnosisReport& R) {
+  const Transitions& data = R.data;
   R.sensitivity = gp_sensitivity(R.gp, data, data.rows(false));
   R.relevance = shares(R.sensitivity);
   R.bins = bin_residuals(data, R.residual, R.input_names, o.bins);
@@ -323,11 +356,15 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
   R.consistent = !R.model_diverges;
   for (const StateScore& s : R.states) R.consistent = R.consistent && !s.structured;
   R.gp_explained_total = weighted_heldout_explained(data, R.residual, R.gp.mean, R.weights);
+}
 
-  // 3. Which: one effect (the verdict), or several by forward selection (--auto).
+/// 3. Which effect is missing: every effect of the library ranked under the criterion (unless the
+/// model diverges), the verdict (decide), and with --auto the forward selection of several, judged
+/// as a set (judge_selection).
+void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidates, DiagnosisReport& R) {
   R.criterion = o.criterion;
   R.window = o.window;
-  const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual},
+  const FitContext context = criterion_context({&R.data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual},
                                                o.criterion, o.window, &R.window_restarts);
   const std::vector<RefitEffect> present = o.auto_select ? model_effects(R.model, candidates) : std::vector<RefitEffect>{};
   if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_gain, o.progress, present, o.gp.threads);
@@ -338,29 +375,35 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
       R.ranking.front().fit.z_score >= o.min_z)
     R.consistent = false;
   R.verdict = decide(R, o);
-  if (o.auto_select && !R.model_diverges) {
-    SelectionOptions so;
-    so.method = o.search;
-    so.max_subset = o.max_subset;
-    so.alias_gain = o.alias_gain;
-    so.min_explained = o.min_step_explained;
-    so.min_z = o.min_z;
-    so.threads = o.gp.threads;
-    so.progress = o.progress;
-    // Step 1 is the verdict: its ranking is the first step's, and without an explained verdict nothing is added.
-    if (R.verdict.effect) {
-      R.selection = select_effects(context, so, R.ranking);
-      judge_selection(R.verdict, *R.selection, R.model, o);
-    } else {
-      R.selection = Selection{};
-      R.selection->method = o.search;
-      R.selection->model = R.model;
-      R.selection->rejected = R.ranking;
-      R.selection->stop_reason = "no effect is added: " + R.verdict.reason;
-    }
+  if (!o.auto_select || R.model_diverges) return;
+  SelectionOptions so;
+  so.method = o.search;
+  so.max_subset = o.max_subset;
+  so.alias_gain = o.alias_gain;
+  so.min_explained = o.min_step_explained;
+  so.min_z = o.min_z;
+  so.threads = o.gp.threads;
+  so.progress = o.progress;
+  // Step 1 is the verdict: its ranking is the first step's, and without an explained verdict nothing is added.
+  if (R.verdict.effect) {
+    R.selection = select_effects(context, so, R.ranking);
+    judge_selection(R.verdict, *R.selection, R.model, o);
+  } else {
+    R.selection = Selection{};
+    R.selection->method = o.search;
+    R.selection->model = R.model;
+    R.selection->rejected = R.ranking;
+    R.selection->stop_reason = "no effect is added: " + R.verdict.reason;
   }
+}
 
-  // 4. Add: the four models on the held-out episodes.
+/// 4. Add the effect: the model the next diagnosis starts from (the --add effects, the --auto
+/// selection or the verdict's effect, in that order of precedence) and, when there is one, the four
+/// models on the held-out episodes: sim, sim + effect, sim + GP and sim + effect + GP, with the GP's
+/// learned signal variance. Returns whether the four-model comparison exists.
+bool add(const DiagnosisOptions& o, const ModelAsGiven& given, const std::vector<LibraryEffect>& candidates,
+         const FitContext& settings, DiagnosisReport& R) {
+  const Transitions& data = R.data;
   R.model_next = R.model;
   const ModelSpec* with_effect = nullptr;
   const ResidualGp* base_gp = nullptr;
@@ -368,8 +411,8 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
   ModelSpec proposed;
   if (!o.add.empty()) {
     with_effect = &R.model;
-    base_gp = &gp_before;
-    base_residual = residual_before;
+    base_gp = &given.gp;
+    base_residual = given.residual;
     R.residual_after = R.residual;
     for (const EffectFit& f : R.added) R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + f.effect;
   } else if (R.selection && !R.selection->steps.empty()) {
@@ -377,7 +420,7 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
     with_effect = &R.model_next;
     base_gp = &R.gp;
     base_residual = R.residual;
-    R.residual_after = residual_of_model(R.model_next);
+    R.residual_after = residual_of_model(R.model_next, settings);
     for (const SelectionStep& s : R.selection->steps)
       R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + s.fit.effect;
   } else if (R.verdict.effect) {
@@ -386,33 +429,70 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
     with_effect = &proposed;
     base_gp = &R.gp;
     base_residual = R.residual;
-    R.residual_after = residual_of_model(proposed);
+    R.residual_after = residual_of_model(proposed, settings);
     R.comparison_effect = R.verdict.effect->effect;
   }
-  if (with_effect != nullptr) {
-    const ResidualGp gp_after = !o.add.empty()
-                                    ? R.gp
-                                    : fit_residual_gp(make_step_model(*with_effect, o.integrator, R.dt, o.substeps), data,
-                                                      R.residual_after, o.gp);
-    R.residual_base = base_residual;
-    R.relevance_base = !o.add.empty() ? shares(gp_sensitivity(gp_before, data, data.rows(false))) : R.relevance;
-    R.comparison.push_back({"sim", heldout_rmse(data, base_residual), Vector()});
-    R.comparison.push_back({"sim+effect", heldout_rmse(data, R.residual_after), Vector()});
-    R.comparison.push_back({"sim+GP", heldout_rmse(data, base_residual - base_gp->mean), base_gp->signal_variance});
-    R.comparison.push_back({"sim+effect+GP", heldout_rmse(data, R.residual_after - gp_after.mean), gp_after.signal_variance});
-  }
+  if (with_effect == nullptr) return false;
+  const ResidualGp gp_after = !o.add.empty()
+                                  ? R.gp
+                                  : fit_residual_gp(make_step_model(*with_effect, o.integrator, R.dt, o.substeps), data,
+                                                    R.residual_after, o.gp);
+  R.residual_base = base_residual;
+  R.relevance_base = !o.add.empty() ? shares(gp_sensitivity(given.gp, data, data.rows(false))) : R.relevance;
+  R.comparison.push_back({"sim", heldout_rmse(data, base_residual), Vector()});
+  R.comparison.push_back({"sim+effect", heldout_rmse(data, R.residual_after), Vector()});
+  R.comparison.push_back({"sim+GP", heldout_rmse(data, base_residual - base_gp->mean), base_gp->signal_variance});
+  R.comparison.push_back({"sim+effect+GP", heldout_rmse(data, R.residual_after - gp_after.mean), gp_after.signal_variance});
+  return true;
+}
 
-  // 5. Whiteness and free run on the held-out episodes.
-  R.whiteness = whiteness_test(data, R.residual, R.state_names, o.max_lag);
-  // Each model driven by the measured inputs as it applies them (its input delay).
-  const auto applied = [](const ModelSpec& model) -> ControlSource {
-    return [delay = model.input_delay](const MatrixCRef& u) { return delay_controls(Matrix(u), delay); };
-  };
-  std::vector<FreeRunModel> runs{{"sim", before_step, applied(model0)}};
-  if (with_effect != nullptr)
-    runs.push_back({"sim+effect", make_step_model(R.model_next, o.integrator, R.dt, o.substeps), applied(R.model_next)});
-  runs.push_back({"sim+GP", gp_before.model, applied(model0)});
+/// The measured inputs as `model` applies them (its input delay).
+ControlSource applied_controls(const ModelSpec& model) {
+  return [delay = model.input_delay](const MatrixCRef& u) { return delay_controls(Matrix(u), delay); };
+}
+
+/// 5. The error falls: the tests of system identification on the held-out episodes, the whiteness
+/// of the diagnosed model's one-step residual and the free run (k = infinity) of sim, sim + effect
+/// (when the four-model comparison exists) and sim + GP.
+void falls(const DiagnosisOptions& o, const MeasurementSet& set, const ModelAsGiven& given, bool compared,
+           DiagnosisReport& R) {
+  R.whiteness = whiteness_test(R.data, R.residual, R.state_names, o.max_lag);
+  std::vector<FreeRunModel> runs{{"sim", given.step, applied_controls(given.model)}};
+  if (compared)
+    runs.push_back({"sim+effect", make_step_model(R.model_next, o.integrator, R.dt, o.substeps), applied_controls(R.model_next)});
+  runs.push_back({"sim+GP", given.gp.model, applied_controls(given.model)});
   R.free_run = free_run(set, R.heldout_episode_index, runs);
+}
+
+}  // namespace
+
+DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o) {
+  o.validate();
+  if (input.episodes.empty()) throw std::invalid_argument("the data has no episodes");
+  check_measurement_range(input);
+  DiagnosisReport R;
+  R.system = o.model.system;
+  // A model file's data carry the model's name (<mujoco model="...">), not the file's path.
+  if (const std::string model_name = system_signature(R.system).name; input.system.name != model_name)
+    throw std::invalid_argument("the data are of system '" + input.system.name + "'; the model is '" + model_name + "'");
+  MeasurementSet blocks_as_episodes;
+  const MeasurementSet& set = episodes_of(input, o, blocks_as_episodes, R);
+
+  // One-step predictions of a model (its input delay applied to the measured inputs).
+  const FitContext settings{&R.data, o.model, o.integrator, R.dt, o.substeps, Vector(), Matrix()};
+  const ModelAsGiven given = model_as_given(o, settings);
+  R.model_before = given.model;
+  // The library and the model's declared effects; the fits below point into it.
+  const std::vector<LibraryEffect> candidates = candidate_effects(given.model);
+  add_requested_effects(o, given, candidates, settings, R);
+  const auto step = make_step_model(R.model, o.integrator, R.dt, o.substeps);
+  const Vector floors = fit_diagnosed_residual(o, given, settings, step, R);
+
+  compare(o, set, *step, floors, R);
+  where(o, set, R);
+  which(o, candidates, R);
+  const bool compared = add(o, given, candidates, settings, R);
+  falls(o, set, given, compared, R);
   return R;
 }
 

@@ -6,9 +6,9 @@
 ///
 ///   E[l(x, u)] = l(mu, u) + 0.5 tr(l_xx Sigma)      for x ~ N(mu, Sigma)
 ///
-/// exact for quadratic costs (the paper's and DESIGN.md's), a second-order approximation otherwise
-/// (l_xx is then taken as constant in the derivatives). Its derivative with respect to the packed
-/// entry (i, j) of Sigma is 0.5 l_xx,ii on the diagonal and l_xx,ij off it.
+/// exact for quadratic costs (the paper's and core/cost.hpp's QuadraticCost), a second-order
+/// approximation otherwise (l_xx is then taken as constant in the derivatives). Its derivative with
+/// respect to the packed entry (i, j) of Sigma is 0.5 l_xx,ii on the diagonal and l_xx,ij off it.
 
 #include "gpilqg/control/ddp_solver.hpp"
 #include "gpilqg/core/belief.hpp"
@@ -26,8 +26,7 @@ class BeliefSpaceModel final : public StepModel {
   double dt() const override { return belief_.dt(); }
   /// Holds the belief model's workspace and its Jacobians.
   std::unique_ptr<StepWorkspace> make_workspace() const override;
-  void step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next,
-            StepJacobians* jacobians = nullptr) const override;
+  using StepModel::step;
   void step(const VectorCRef& v, const VectorCRef& u, VectorRef v_next, StepJacobians* jacobians,
             StepWorkspace& workspace) const override;
   /// The moment match dominates a belief step; its derivatives add little (docs/results/pddp.md).
@@ -44,9 +43,15 @@ class BeliefCost final : public Cost {
   explicit BeliefCost(const Cost& cost);
   int state_dim() const override { return belief_dim(n_); }
   int control_dim() const override { return cost_.control_dim(); }
-  double stage(int t, const VectorCRef& v, const VectorCRef& u, CostDerivatives* d = nullptr) const override;
-  double terminal(const VectorCRef& v, CostDerivatives* d = nullptr) const override;
-  double terminal_at(int t, const VectorCRef& v, CostDerivatives* d = nullptr) const override;
+  /// Holds the state cost's workspace and the state-space derivatives that the belief ones lift.
+  std::unique_ptr<CostWorkspace> make_workspace() const override;
+  using Cost::stage;
+  using Cost::terminal;
+  using Cost::terminal_at;
+  double stage(int t, const VectorCRef& v, const VectorCRef& u, CostDerivatives* d,
+               CostWorkspace& workspace) const override;
+  double terminal(const VectorCRef& v, CostDerivatives* d, CostWorkspace& workspace) const override;
+  double terminal_at(int t, const VectorCRef& v, CostDerivatives* d, CostWorkspace& workspace) const override;
 
  private:
   /// Adds 0.5 tr(l_xx Sigma) to the value and writes the belief-space derivatives from the state ones.

@@ -20,11 +20,16 @@ class CostWindow final : public Cost {
   CostWindow(const Cost& task, int offset, int horizon) : task_(task), offset_(offset), horizon_(horizon) {}
   int state_dim() const override { return task_.state_dim(); }
   int control_dim() const override { return task_.control_dim(); }
-  double stage(int t, const VectorCRef& x, const VectorCRef& u, CostDerivatives* d = nullptr) const override {
-    return task_.stage(offset_ + t, x, u, d);
+  /// The task's workspace: the window evaluates the task's cost and nothing else.
+  std::unique_ptr<CostWorkspace> make_workspace() const override { return task_.make_workspace(); }
+  using Cost::stage;
+  using Cost::terminal;
+  double stage(int t, const VectorCRef& x, const VectorCRef& u, CostDerivatives* d,
+               CostWorkspace& workspace) const override {
+    return task_.stage(offset_ + t, x, u, d, workspace);
   }
-  double terminal(const VectorCRef& x, CostDerivatives* d = nullptr) const override {
-    return task_.terminal_at(offset_ + horizon_, x, d);
+  double terminal(const VectorCRef& x, CostDerivatives* d, CostWorkspace& workspace) const override {
+    return task_.terminal_at(offset_ + horizon_, x, d, workspace);
   }
   void move_to(int offset) { offset_ = offset; }
 

@@ -1,7 +1,7 @@
 #pragma once
 /// @file atomic_file.hpp
 /// Writing result files so that a reader never sees a half-written file and a failure never loses
-/// the previous one (DESIGN.md section 7: "written to a temporary file renamed into place").
+/// the previous one (docs/reliability.md#atomic-writes).
 ///
 /// The protocol of write_atomically(target, writer):
 ///  1. `writer(temporary)` creates and fills a fresh file in target's own folder (same file system,

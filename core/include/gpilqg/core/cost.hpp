@@ -3,8 +3,8 @@
 /// Stage and terminal costs with their first and second derivatives (paper eq. for J(x_0): the total
 /// cost l_T(x_T) + sum_t l(x_t, u_t)).
 ///
-/// QuadraticCost is the cost of DESIGN.md section 8 and of the reference problem, with an optional
-/// time-varying reference (tracking):
+/// QuadraticCost is the cost of docs/formats.md#problem-config-gpilqg-solve-and-gpilqg-plan and of the
+/// reference problem, with an optional time-varying reference (tracking):
 ///
 ///   l_t(x, u) = dt (0.5 e' Q e + 0.5 d' R d),   e = x - x_ref(t),  d = u - u_ref(t)
 ///   l_T(x)    = 0.5 e' Qf e,                    e = x - x_ref(T)
@@ -13,6 +13,7 @@
 /// Q, R and Qf are symmetric (validated); Q and Qf positive semidefinite, R positive definite is the
 /// caller's choice (the solver regularises).
 
+#include <memory>
 #include <vector>
 
 #include "gpilqg/core/types.hpp"
@@ -30,23 +31,45 @@ struct CostDerivatives {
   void resize(int n, int m);
 };
 
-/// A cost over a horizon of T steps: stages t = 0..T-1 and a terminal cost at T.
+/// The scratch space of one caller of a Cost (Crocoddyl's model/data split, as StepWorkspace is for a
+/// StepModel): made by the cost's make_workspace(), owned by the caller, used by one thread at a time
+/// and reused from call to call, so that a solver's passes do not allocate. Costs with scratch (the
+/// expected cost of a belief, which evaluates the state cost first) derive from it.
+struct CostWorkspace {
+  virtual ~CostWorkspace() = default;
+};
+
+/// A cost over a horizon of T steps: stages t = 0..T-1 and a terminal cost at T. Immutable once built
+/// and shareable between threads; all scratch space belongs to the caller. Each evaluation is one
+/// virtual call with the caller's workspace (from make_workspace()), which implementations override;
+/// the form without a workspace is a convenience that makes a temporary one (free for costs without
+/// scratch). An implementation brings those forms into its scope with `using Cost::stage;` etc.
 class Cost {
  public:
   virtual ~Cost() = default;
   virtual int state_dim() const = 0;
   virtual int control_dim() const = 0;
+
+  /// A workspace for this cost's evaluations (the default is empty).
+  virtual std::unique_ptr<CostWorkspace> make_workspace() const { return std::make_unique<CostWorkspace>(); }
+
   /// l_t(x, u); fills `derivatives` when not null.
-  virtual double stage(int t, const VectorCRef& x, const VectorCRef& u,
-                       CostDerivatives* derivatives = nullptr) const = 0;
+  virtual double stage(int t, const VectorCRef& x, const VectorCRef& u, CostDerivatives* derivatives,
+                       CostWorkspace& workspace) const = 0;
   /// l_T(x); fills lx and lxx of `derivatives` when not null.
-  virtual double terminal(const VectorCRef& x, CostDerivatives* derivatives = nullptr) const = 0;
+  virtual double terminal(const VectorCRef& x, CostDerivatives* derivatives, CostWorkspace& workspace) const = 0;
   /// The terminal cost of a horizon that ends at step t (used by receding-horizon windows); the
   /// default ignores t.
-  virtual double terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives = nullptr) const {
+  virtual double terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives,
+                             CostWorkspace& workspace) const {
     (void)t;
-    return terminal(x, derivatives);
+    return terminal(x, derivatives, workspace);
   }
+
+  /// The same with a temporary workspace.
+  double stage(int t, const VectorCRef& x, const VectorCRef& u, CostDerivatives* derivatives = nullptr) const;
+  double terminal(const VectorCRef& x, CostDerivatives* derivatives = nullptr) const;
+  double terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives = nullptr) const;
 };
 
 class QuadraticCost final : public Cost {
@@ -60,11 +83,15 @@ class QuadraticCost final : public Cost {
 
   int state_dim() const override { return static_cast<int>(Q_.rows()); }
   int control_dim() const override { return static_cast<int>(R_.rows()); }
-  double stage(int t, const VectorCRef& x, const VectorCRef& u,
-               CostDerivatives* derivatives = nullptr) const override;
-  double terminal(const VectorCRef& x, CostDerivatives* derivatives = nullptr) const override;
+  using Cost::stage;
+  using Cost::terminal;
+  using Cost::terminal_at;
+  double stage(int t, const VectorCRef& x, const VectorCRef& u, CostDerivatives* derivatives,
+               CostWorkspace& workspace) const override;
+  double terminal(const VectorCRef& x, CostDerivatives* derivatives, CostWorkspace& workspace) const override;
   /// 0.5 e' Qf e with e = x - x_ref(t) (the reference held at its final value past its end).
-  double terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives = nullptr) const override;
+  double terminal_at(int t, const VectorCRef& x, CostDerivatives* derivatives,
+                     CostWorkspace& workspace) const override;
 
   /// The state reference at step t (the goal when regulating). Past the end of a tracking reference
   /// its final value is held, so receding-horizon windows may extend beyond the task. t < 0 throws.

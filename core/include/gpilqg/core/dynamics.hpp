@@ -48,7 +48,7 @@ class Dynamics {
  public:
   virtual ~Dynamics() = default;
 
-  /// The system's registry name, e.g. "cartpole" (DESIGN.md section 3).
+  /// The system's registry name, e.g. "cartpole" (docs/formats.md#systems-and-their-names).
   virtual const std::string& name() const = 0;
   /// States in their fixed order, with units.
   virtual const std::vector<Quantity>& states() const = 0;

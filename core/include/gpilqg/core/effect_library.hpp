@@ -1,7 +1,9 @@
 #pragma once
 /// @file effect_library.hpp
-/// The physical-effects library (DESIGN.md section 5, fixed names) and the model description the
-/// diagnosis works on: a system preset, recalibrated parameters, an actuator gain and force effects.
+/// The physical-effects library
+/// (docs/diagnosis.md#the-physical-effects-library-coreeffect_libraryhpp-coreeffectshpp, fixed names)
+/// and the model description the diagnosis works on: a system preset, recalibrated parameters, an
+/// actuator gain and force effects.
 ///
 /// | name                     | parameter      | enters as                                           |
 /// |--------------------------|----------------|-----------------------------------------------------|

@@ -1,7 +1,9 @@
 #pragma once
 /// @file effects.hpp
-/// Physical effects (DESIGN.md sections 2 and 5): named, parameterised generalised forces added to a
-/// mechanical system's equations of motion, and the Dynamics decorator "system + effects".
+/// Physical effects
+/// (docs/diagnosis.md#the-physical-effects-library-coreeffect_libraryhpp-coreeffectshpp): named,
+/// parameterised generalised forces added to a mechanical system's equations of motion, and the
+/// Dynamics decorator "system + effects".
 ///
 /// With the system's generalised-force map W(x) (generalised_forces.hpp), an actuator gain k and
 /// effects e = 1..E with parameters theta_e,

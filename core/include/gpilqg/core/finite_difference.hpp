@@ -64,8 +64,9 @@ class FiniteDifferenceStepModel final : public StepModel {
   int state_dim() const override { return n_; }
   int control_dim() const override { return m_; }
   double dt() const override { return dt_; }
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
-            StepJacobians* jacobians = nullptr) const override;
+  using StepModel::step;
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
+            StepWorkspace& workspace) const override;
 
  private:
   int n_;

@@ -1,10 +1,10 @@
 #pragma once
 /// @file fork_join.hpp
-/// ForkJoin: helper threads kept alive for repeated short fork-join sections inside allocation-free
-/// hot loops (DESIGN.md practice 1), e.g. one PDDP belief step, which is called thousands of times per
-/// solve and lasts milliseconds. Starting a std::thread allocates and costs tens of microseconds, so
-/// the helpers are started once, on the first run that needs them, and then wait on a condition
-/// variable; later runs only hand them a task, which does not allocate.
+/// ForkJoin: helper threads kept alive for repeated short fork-join sections inside allocation-free hot
+/// loops (docs/architecture.md#models-and-workspaces), e.g. one PDDP belief step, which is called
+/// thousands of times per solve and lasts milliseconds. Starting a std::thread allocates and costs tens
+/// of microseconds, so the helpers are started once, on the first run that needs them, and then wait on
+/// a condition variable; later runs only hand them a task, which does not allocate.
 ///
 /// Ownership: one ForkJoin belongs to one calling thread at a time (typically inside that caller's
 /// scratch space). Copying or moving yields a fresh ForkJoin with no helpers, so copies never share

@@ -40,14 +40,12 @@ class IntegratedStepModel final : public StepModel {
 
   /// Holds the stages of the integrator and the dynamics' workspace.
   std::unique_ptr<StepWorkspace> make_workspace() const override;
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
-            StepJacobians* jacobians = nullptr) const override;
+  using StepModel::step;
   void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
             StepWorkspace& workspace) const override;
 
   int noise_dim() const override { return dynamics_->noise_dim(); }
-  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
-             bool derivatives) const override;
+  using StepModel::noise;
   void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
              StepWorkspace& workspace) const override;
 

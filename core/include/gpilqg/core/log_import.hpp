@@ -1,7 +1,8 @@
 #pragma once
 /// @file log_import.hpp
-/// A robot's raw log (raw_log.hpp) into a measurement set (DESIGN.md section 4), by a map that names
-/// the log's columns for the system's states and controls (docs/data-import.md):
+/// A robot's raw log (raw_log.hpp) into a measurement set
+/// (docs/formats.md#measurement-data-csv-and-hdf5), by a map that names the log's columns for the
+/// system's states and controls (docs/data-import.md):
 ///
 /// 1. the mapped columns are scaled to SI (units.hpp); every other column is ignored and reported;
 /// 2. rows are grouped by the episode column (in order of first appearance; one episode without it),

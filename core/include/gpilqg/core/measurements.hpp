@@ -1,7 +1,8 @@
 #pragma once
 /// @file measurements.hpp
-/// Measurement data sets (DESIGN.md section 4, a fixed contract): episodes of measured states and
-/// applied controls at a constant step, read from and written to CSV and HDF5 with full validation.
+/// Measurement data sets (docs/formats.md#measurement-data-csv-and-hdf5, a fixed contract): episodes of
+/// measured states and applied controls at a constant step, read from and written to CSV and HDF5 with
+/// full validation.
 ///
 /// CSV: header `episode,t,<state names>,<control names>`, one row per time step. A row holds the
 /// state measured at time t and the control applied from t until the next row of the same episode.

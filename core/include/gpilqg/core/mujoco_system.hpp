@@ -1,6 +1,7 @@
 #pragma once
 /// @file mujoco_system.hpp
-/// A MuJoCo model (MJCF, or URDF as MuJoCo loads it) as a gpilqg system (DESIGN.md section 10).
+/// A MuJoCo model (MJCF, or URDF as MuJoCo loads it) as a gpilqg system
+/// (docs/formats.md#systems-and-their-names; docs/own-system.md).
 ///
 /// States: the joint positions in model order, named by joint name, then their velocities named
 /// `<joint>_dot`. Controls: the actuators in model order, named by actuator name; a model without
@@ -23,7 +24,7 @@
 /// (EffectDynamics) enter inside every sub-step as passive forces, through MuJoCo's passive-force
 /// callback, so mj_step and mjd_transitionFD both see them, with their dependence on the state.
 ///
-/// Parameters by name, each a field of the model (DESIGN.md section 10):
+/// Parameters by name, each a field of the model (docs/own-system.md#1-the-model-file):
 ///   "<body>.mass" (kg; the body's inertia scales with it), "<joint>.damping", "<joint>.armature",
 ///   "<joint>.frictionloss", "<joint>.stiffness" (the model's units), "<actuator>.gear" (-),
 ///   "<actuator>.gain" (-, 1 in the file: the applied control is gain * u).
@@ -109,7 +110,8 @@ class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public
 
 /// The registry entry of a model file (system_registry.hpp calls this for names ending in .xml or
 /// .urdf): builder (both presets are the file's values; `overrides` set fields), the generic effect
-/// library of DESIGN.md section 10, no default run config. Throws like MujocoSystem::load.
+/// library of docs/own-system.md#3-diagnosis-what-is-the-model-missing, no default run config. Throws
+/// like MujocoSystem::load.
 SystemEntry mujoco_system_entry(const std::string& path);
 
 /// The generic effects of a system with a generalised-force map whose generalised forces are one per

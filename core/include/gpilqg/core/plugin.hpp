@@ -1,6 +1,6 @@
 #pragma once
 /// @file plugin.hpp
-/// Systems from shared libraries (DESIGN.md section 10): `gpilqg COMMAND --plugin LIB.so` loads a
+/// Systems from shared libraries (docs/own-system-plugin.md): `gpilqg COMMAND --plugin LIB.so` loads a
 /// library built against the installed gpilqg package, and the systems it registers work in every
 /// command like the built-in ones.
 ///

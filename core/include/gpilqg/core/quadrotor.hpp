@@ -1,9 +1,9 @@
 #pragma once
 /// @file quadrotor.hpp
-/// Quadrotor after van den Berg ("Extended LQR"), as written in the paper with the factor DESIGN.md
-/// section 3 restores. State [p (3), v (3), r (3), w (3)]: position and velocity in the world frame,
-/// r a rotation vector (rotation about r/|r| by |r|), w the body angular velocity. Controls: the four
-/// rotor forces u1..u4 [N].
+/// Quadrotor after van den Berg ("Extended LQR"), as written in the paper with the factor that
+/// docs/formats.md#systems-and-their-names restores. State [p (3), v (3), r (3), w (3)]: position and
+/// velocity in the world frame, r a rotation vector (rotation about r/|r| by |r|), w the body angular
+/// velocity. Controls: the four rotor forces u1..u4 [N].
 ///
 ///   p_dot = v
 ///   v_dot = -g e3 + ((u1 + u2 + u3 + u4) R(r) e3 - kv v) / m,       R(r) = exp([r])  (Rodrigues)

@@ -1,7 +1,8 @@
 #pragma once
 /// @file quantity.hpp
 /// Named physical quantities: the states, controls and parameters of a system carry a name (fixed by
-/// DESIGN.md section 3) and a unit, so data files, reports and error messages can speak of them.
+/// docs/formats.md#systems-and-their-names) and a unit, so data files, reports and error messages can
+/// speak of them.
 
 #include <string>
 #include <vector>

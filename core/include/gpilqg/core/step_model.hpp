@@ -1,6 +1,6 @@
 #pragma once
 /// @file step_model.hpp
-/// Discrete-time models, the interface every controller works against (DESIGN.md section 2).
+/// Discrete-time models, the interface every controller works against (docs/architecture.md#layers).
 ///
 /// The paper's discrete stochastic step (its eq. for x' in the Robust-ILQG section):
 ///
@@ -35,10 +35,11 @@ struct StepWorkspace {
 };
 
 /// A discrete-time model. Immutable once built and shareable between threads; all scratch space
-/// belongs to the caller. Like Dynamics, each call comes with the caller's workspace (what hot loops
-/// use) and without one (a temporary workspace; free for models without scratch): a model without
-/// scratch implements the forms without a workspace, a model with scratch overrides make_workspace()
-/// and the forms with one.
+/// belongs to the caller. Each call (step, noise, uncertainty) is one virtual function that takes the
+/// caller's workspace (from make_workspace(); what hot loops hold from call to call) and that
+/// implementations override; a model without scratch ignores the workspace. The form without a
+/// workspace is a non-virtual convenience of this class that makes a temporary one. An implementation
+/// brings those forms into its own scope with `using StepModel::step;` (and noise, uncertainty).
 class StepModel {
  public:
   virtual ~StepModel() = default;
@@ -51,14 +52,11 @@ class StepModel {
   /// The step length dt [s].
   virtual double dt() const = 0;
 
-  /// Mean step x' = phi(x, u); fills A and B when `jacobians` is not null.
-  virtual void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
-                    StepJacobians* jacobians = nullptr) const = 0;
-  /// The same with the caller's workspace (from make_workspace()); the default calls the form without.
+  /// Mean step x' = phi(x, u) in the caller's workspace; fills A and B when `jacobians` is not null.
   virtual void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
-                    StepWorkspace&) const {
-    step(x, u, x_next, jacobians);
-  }
+                    StepWorkspace& workspace) const = 0;
+  /// The same with a temporary workspace.
+  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians = nullptr) const;
   /// True when step() with Jacobians costs little more than without, because the work both share
   /// dominates (a belief step by moment matching: the N x N kernel expectations). DDP then asks for
   /// the Jacobians during its line search and its derivative pass reuses those of the accepted
@@ -67,30 +65,28 @@ class StepModel {
 
   /// Number of process-noise columns p (0: deterministic).
   virtual int noise_dim() const { return 0; }
-  /// F(x, u) with the derivatives of its columns when `derivatives` is true.
-  virtual void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
-                     bool derivatives) const;
+  /// F(x, u) with the derivatives of its columns when `derivatives` is true, in the caller's
+  /// workspace. The default has no columns (p = 0).
   virtual void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
-                     StepWorkspace&) const {
-    noise(x, u, out, derivatives);
-  }
+                     StepWorkspace& workspace) const;
+  /// The same with a temporary workspace.
+  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const;
 
   /// Number of model-uncertainty columns q (0 for a model without learned uncertainty).
   virtual int uncertainty_dim() const { return 0; }
-  /// G(x, u) with the derivatives of its columns (a GP residual model: G = diag(sigma_i(z))).
-  virtual void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
-                           bool derivatives) const;
+  /// G(x, u) with the derivatives of its columns (a GP residual model: G = diag(sigma_i(z))), in the
+  /// caller's workspace. The default has no columns (q = 0).
   virtual void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
-                           StepWorkspace&) const {
-    uncertainty(x, u, out, derivatives);
-  }
+                           StepWorkspace& workspace) const;
+  /// The same with a temporary workspace.
+  void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const;
 
   /// Convenience: returns phi(x, u).
   Vector next(const VectorCRef& x, const VectorCRef& u) const;
 };
 
 /// A system whose simulator is its own discrete-time integrator rather than one of integrator.hpp's:
-/// a MuJoCo model steps with its own integrator and timestep (DESIGN.md section 10).
+/// a MuJoCo model steps with its own integrator and timestep (docs/own-system.md#5-how-it-works).
 /// make_step_model (integrator.hpp) asks for it.
 class OwnIntegrator {
  public:

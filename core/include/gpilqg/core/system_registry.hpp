@@ -1,6 +1,6 @@
 #pragma once
 /// @file system_registry.hpp
-/// One registry of the systems every command works on (DESIGN.md sections 3 and 10).
+/// One registry of the systems every command works on (docs/formats.md#systems-and-their-names).
 ///
 /// An entry describes one system completely: how to build it from a preset and named parameter
 /// overrides, its presets and parameters, its physical-effects library (when it has a generalised-force

@@ -1,8 +1,9 @@
 #pragma once
 /// @file systems.hpp
-/// Systems by name (DESIGN.md sections 3 and 10), through the registry of system_registry.hpp, and the
-/// paper's two parameter sets: "sim" (the simulator the controller believes) and "real" (the world it
-/// acts in). A name is a registered system ("cartpole", "quadrotor", a plugin's) or a MuJoCo model file.
+/// Systems by name (docs/formats.md#systems-and-their-names), through the registry of
+/// system_registry.hpp, and the paper's two parameter sets: "sim" (the simulator the controller
+/// believes) and "real" (the world it acts in). A name is a registered system ("cartpole", "quadrotor",
+/// a plugin's) or a MuJoCo model file.
 
 #include <map>
 #include <optional>

@@ -1,8 +1,9 @@
 #pragma once
 /// @file workspace.hpp
-/// The model/data split (Crocoddyl's ActionModel/ActionData, DESIGN.md section 9 practice 1): models
-/// are immutable and shareable; every caller holds the scratch it writes in a workspace that the model
-/// makes (DynamicsWorkspace, StepWorkspace, BeliefWorkspace) and hands back on every call.
+/// The model/data split (Crocoddyl's ActionModel/ActionData,
+/// docs/architecture.md#models-and-workspaces): models are immutable and shareable; every caller holds
+/// the scratch it writes in a workspace that the model makes (DynamicsWorkspace, StepWorkspace,
+/// BeliefWorkspace) and hands back on every call.
 
 #include <cassert>
 

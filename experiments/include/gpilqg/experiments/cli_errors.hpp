@@ -1,9 +1,10 @@
 #pragma once
 /// @file cli_errors.hpp
-/// The command line's error contract (DESIGN.md section 8): exit 0 on success; exit 2 on bad input
-/// (usage, file, data, config) with a message on stderr that starts with "error:" and names the file
-/// and the line, field or dataset; exit 1 on an internal failure; exit 128 + signal when a command
-/// stopped early on SIGINT or SIGTERM (`gpilqg run`, after saving its progress).
+/// The command line's error contract (docs/command-line.md#what-every-command-shares;
+/// docs/architecture.md#errors): exit 0 on success; exit 2 on bad input (usage, file, data, config)
+/// with a message on stderr that starts with "error:" and names the file and the line, field or
+/// dataset; exit 1 on an internal failure; exit 128 + signal when a command stopped early on SIGINT or
+/// SIGTERM (`gpilqg run`, after saving its progress).
 
 #include <filesystem>
 #include <exception>

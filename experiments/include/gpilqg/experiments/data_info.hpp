@@ -1,7 +1,8 @@
 #pragma once
 /// @file data_info.hpp
-/// `gpilqg data info FILE --system NAME [--json]` (DESIGN.md section 8): a measurement file's
-/// summary (gpilqg::summarize) as a table for the terminal or as one JSON document.
+/// `gpilqg data info FILE --system NAME [--json]`
+/// (docs/command-line.md#gpilqg-data-info-file---system-name---json): a measurement file's summary
+/// (gpilqg::summarize) as a table for the terminal or as one JSON document.
 
 #include <filesystem>
 #include <nlohmann/json_fwd.hpp>

@@ -1,7 +1,8 @@
 #pragma once
 /// @file gp_settings.hpp
 /// The `[gp]` table that `gpilqg run` and `gpilqg plan` share: which backend learns the simulator's
-/// error and how hard its hyperparameters are fitted (DESIGN.md sections 8 and 11).
+/// error and how hard its hyperparameters are fitted (docs/formats.md#run-config-gpilqg-run,
+/// docs/real-robot.md#the-plan-config).
 ///
 ///   [gp]  backend ("exact"|"fitc"|"ssgp"|"compact"), exact_points, inducing, frequencies,
 ///         restarts, max_evaluations

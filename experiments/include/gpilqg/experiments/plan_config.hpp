@@ -1,8 +1,9 @@
 #pragma once
 /// @file plan_config.hpp
-/// The config of `gpilqg plan` (DESIGN.md section 11): the `gpilqg solve` schema (solve_config.hpp)
-/// plus an optional [gp] table (gp_settings.hpp; missing fields take GpSettings' defaults) and an
-/// optional [noise] observation (n standard deviations, as in `gpilqg run`'s config).
+/// The config of `gpilqg plan` (docs/formats.md#problem-config-gpilqg-solve-and-gpilqg-plan): the
+/// `gpilqg solve` schema (solve_config.hpp) plus an optional [gp] table (gp_settings.hpp; missing
+/// fields take GpSettings' defaults) and an optional [noise] observation (n standard deviations, as in
+/// `gpilqg run`'s config).
 ///
 /// [solver] algorithm is the solver of the rounds with data: "robust_ilqg" (the default, the paper's
 /// Robust-iLQG with the GP's uncertainty G) or "ilqg" (the GP's mean only). The round without data is

@@ -1,15 +1,16 @@
 #pragma once
 /// @file profile.hpp
 /// `gpilqg profile DATA --backends LIST [--sizes LIST] [--json] [--out F.h5] [--plots DIR]`
-/// (DESIGN.md section 8): trains every backend on growing nested subsets of one data set and reports
-/// fit time, prediction time and the test scores SMSE, MNLP, MSLL (metrics.hpp, GPML book section 2.5).
+/// (docs/command-line.md#gpilqg-profile-data---backends-list-options): trains every backend on growing
+/// nested subsets of one data set and reports fit time, prediction time and the test scores SMSE, MNLP,
+/// MSLL (metrics.hpp, GPML book section 2.5).
 ///
 /// Data (read_profile_data):
 ///  - the benchmark format (data/gp-benchmarks): datasets X_train (N x D), y_train (N), X_test
 ///    (M x D), y_test (M), optional group /reference_hyperparameters (dataset log_lengthscales (D),
 ///    attributes log_signal_std, log_noise_std; ARD squared exponential);
-///  - a measurement set (DESIGN.md section 4, CSV or HDF5 with /episodes; needs the system): inputs
-///    z = [x; u] of every step t -> t+1, target of one state `output`:
+///  - a measurement set (docs/formats.md#measurement-data-csv-and-hdf5, CSV or HDF5 with /episodes;
+///    needs the system): inputs z = [x; u] of every step t -> t+1, target of one state `output`:
 ///      residual  (default): x'_measured - phi_sim(x, u), the simulator's one-step error (the "sim"
 ///                 preset integrated with RK4 at the data's dt), i.e. what the residual model learns;
 ///      increment: x'_measured - x.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file run_checkpoint.hpp
-/// Resumable `gpilqg run` (issue "Reliability", point 4). While a run works, its checkpoint folder
+/// Resumable `gpilqg run` (docs/reliability.md). While a run works, its checkpoint folder
 /// "<result>.checkpoint/" beside the result file holds
 ///
 ///   manifest.h5                          what the run is: attrs format_version, system, config (the full

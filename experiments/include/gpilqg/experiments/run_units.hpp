@@ -31,7 +31,8 @@ struct RunUnit {
   std::uint64_t seed = 0;
   int task = 0;                ///< index into RunConfig::tasks
   UnitKind kind = UnitKind::TrueModel;
-  std::string algorithm;       ///< its name in the result (DESIGN.md section 7), e.g. "gp_ilqg_fitc"
+  /// Its name in the result (docs/formats.md#results-file-of-gpilqg-run), e.g. "gp_ilqg_fitc".
+  std::string algorithm;
   std::string backend;         ///< GpIlqg: the GP backend it fits
   std::vector<int> depends_on;  ///< indices of the units whose complete runs it needs
   /// Relative expected cost, for scheduling only (a fixed-model plan 1, a learning loop 10): ranks

@@ -1,7 +1,7 @@
 #pragma once
 /// @file sweep_config.hpp
-/// `gpilqg sweep SWEEP.toml`: a grid of `gpilqg run` configs times seeds (DESIGN.md section 8;
-/// docs/cluster.md). The file:
+/// `gpilqg sweep SWEEP.toml`: a grid of `gpilqg run` configs times seeds
+/// (docs/command-line.md#gpilqg-sweep-sweeptoml-options; docs/cluster.md#sweeps). The file:
 ///
 ///   system = "cartpole"        # required: as `gpilqg run SYSTEM`
 ///   config = "base.toml"       # optional: the run config every point starts from (relative to this

@@ -1,9 +1,9 @@
 #pragma once
 /// @file synthetic_data.hpp
-/// Synthetic measurement sets: roll a system out under random excitation with process noise
-/// (the paper's dx = f dt + F dw) and record it with Gaussian observation noise, in the measurement
-/// contract of DESIGN.md section 4. This is how the test suite and the tutorials make "real-world"
-/// data with a known ground truth.
+/// Synthetic measurement sets: roll a system out under random excitation with process noise (the
+/// paper's dx = f dt + F dw) and record it with Gaussian observation noise, in the measurement contract
+/// of docs/formats.md#measurement-data-csv-and-hdf5. This is how the test suite and the tutorials make
+/// "real-world" data with a known ground truth.
 
 #include <cstdint>
 #include <stdexcept>

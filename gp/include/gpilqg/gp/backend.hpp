@@ -1,21 +1,23 @@
 #pragma once
 /// @file backend.hpp
-/// The one interface every GP backend implements (DESIGN.md section 2; practices 2, 3, 6, 8, 9 of
-/// section 9). Three roles, three types:
+/// The one interface every GP backend implements (docs/gp-backends.md; the rules it keeps:
+/// docs/architecture.md#conventions-of-the-code). Three roles, three types:
 ///
 ///  - GpBackend: a recipe (options only, no data). `fit(data)` returns a FitResult holding a
-///    FittedGp; nothing can be predicted before that (practice 2).
+///    FittedGp; nothing can be predicted before that.
 ///  - MarginalLikelihoodObjective: the negative log marginal likelihood of one data set over the
 ///    backend's parameter vector, with its analytic gradient, bounds and data-driven starting values.
 ///    This is all the generic fitter (fit.hpp, NLopt) needs, so fitting is written once for all
 ///    backends. It owns its workspace, so one objective serves one thread.
 ///  - FittedGp: an immutable conditioned model. Prediction is const and thread-safe; the caller owns
-///    the scratch space (Prediction::workspace), so repeated queries do not allocate (practice 1).
+///    the scratch space (Prediction::workspace), so repeated queries do not allocate
+///    (docs/architecture.md#models-and-workspaces).
 ///
 /// Parameter vector: [log l (D); log sf; log sn; backend extras] (hyperparameters.hpp).
 /// Every GP here is zero-mean on its targets; prior means are handled outside (prior_mean.hpp).
 /// Numerical trouble (a Cholesky factor that fails) is a status in the result (jitter added, reported),
-/// never an exception in an inner loop and never a NaN (practice 6). I/O lives in gp_io.hpp.
+/// never an exception in an inner loop and never a NaN (docs/architecture.md#numerical-status).
+/// I/O lives in gp_io.hpp.
 
 #include <cstdint>
 #include <memory>
@@ -130,6 +132,17 @@ struct NlmlEvaluation {
   double jitter = 0.0;  ///< absolute jitter that was needed
 };
 
+/// The scratch space of one caller of a likelihood class (FitcLikelihood, SsgpLikelihood; Crocoddyl's
+/// model/data split, as StepWorkspace is for a StepModel): made by the likelihood's make_workspace(),
+/// owned by the caller (the objective that the optimiser evaluates), used by one thread at a time and
+/// reused from evaluation to evaluation. The likelihood itself is immutable and shareable.
+struct LikelihoodWorkspace {
+  virtual ~LikelihoodWorkspace() = default;
+};
+
+/// The objective an optimiser evaluates. It owns the scratch of its evaluations (the exact GP's
+/// matrices, a sparse likelihood's LikelihoodWorkspace), hence the non-const evaluate(); one objective
+/// serves one thread.
 class MarginalLikelihoodObjective {
  public:
   virtual ~MarginalLikelihoodObjective() = default;

@@ -82,7 +82,8 @@ class FitcPredictor;
 /// mean diagonal sf2), and the gradient accounts for it, so the gradient is exact for the value
 /// returned in every case.
 ///
-/// Not thread-safe: evaluate() reuses an internal O(N M) workspace (copies get their own).
+/// Immutable once built and shareable between threads: the O(N M) scratch of an evaluation lives in the
+/// caller's workspace (make_workspace()).
 class FitcLikelihood {
  public:
   /// X: N x D training inputs, r: N targets, `inducing`: M >= 1. `threads` > 1 splits the O(N M^2)
@@ -91,11 +92,6 @@ class FitcLikelihood {
   /// sizes, M < 1, threads < 1, or an invalid jitter rule or schedule.
   FitcLikelihood(const MatrixCRef& X, const VectorCRef& r, int inducing, FitcJitter jitter = {},
                  JitterSchedule schedule = {}, int threads = 1);
-  ~FitcLikelihood();
-  FitcLikelihood(const FitcLikelihood& other);
-  FitcLikelihood& operator=(const FitcLikelihood& other);
-  FitcLikelihood(FitcLikelihood&&) noexcept;
-  FitcLikelihood& operator=(FitcLikelihood&&) noexcept;
 
   const FitcLayout& layout() const { return layout_; }
   int parameter_count() const { return layout_.size(); }
@@ -104,7 +100,11 @@ class FitcLikelihood {
   /// nlZ at theta; fills `gradient` (resized to parameter_count()) when not null. Never NaN: a
   /// non-finite theta or a failed factorisation gives status Failed, value +infinity and a zero
   /// gradient. Throws std::invalid_argument only for a wrongly sized theta.
+  NlmlEvaluation evaluate(const VectorCRef& theta, Vector* gradient, LikelihoodWorkspace& workspace) const;
+  /// The same with a temporary workspace.
   NlmlEvaluation evaluate(const VectorCRef& theta, Vector* gradient = nullptr) const;
+  /// A workspace for evaluate(), sized on first use and reused after.
+  std::unique_ptr<LikelihoodWorkspace> make_workspace() const;
 
   /// The cached posterior at theta, and the conditioning report. Throws std::runtime_error when no
   /// factorisation is possible even with the largest jitter.
@@ -112,8 +112,8 @@ class FitcLikelihood {
 
  private:
   struct Workspace;
-  /// Factorises at theta into the workspace; the returned status is Failed when impossible.
-  NlmlEvaluation factorise(const VectorCRef& theta) const;
+  /// Factorises at theta into `w`; the returned status is Failed when impossible.
+  NlmlEvaluation factorise(const VectorCRef& theta, Workspace& w) const;
 
   Matrix X_;
   Vector r_;
@@ -122,7 +122,6 @@ class FitcLikelihood {
   FitcJitter jitter_;
   JitterSchedule schedule_;
   int threads_ = 1;
-  mutable std::unique_ptr<Workspace> ws_;
 };
 
 /// The fitted FITC posterior, cached so that one query costs O(M D + M^2):

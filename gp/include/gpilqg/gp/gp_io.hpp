@@ -1,6 +1,7 @@
 #pragma once
 /// @file gp_io.hpp
-/// Saving and loading fitted GPs in HDF5, kept out of the GP types (DESIGN.md practice 9).
+/// Saving and loading fitted GPs in HDF5, kept out of the GP types
+/// (docs/architecture.md#conventions-of-the-code).
 ///
 /// Layout of one fitted GP in group G (e.g. "/gp/x_dot"):
 ///   G attributes: backend (string), format_version (int, 1), input_dim (int),

@@ -118,19 +118,17 @@ class ResidualModel final : public StepModel {
   /// step and uncertainty at the same (x, u) with one workspace share their cross-covariances).
   std::unique_ptr<StepWorkspace> make_workspace() const override;
 
-  void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next,
-            StepJacobians* jacobians = nullptr) const override;
+  using StepModel::step;
   void step(const VectorCRef& x, const VectorCRef& u, VectorRef x_next, StepJacobians* jacobians,
             StepWorkspace& workspace) const override;
 
   int noise_dim() const override { return simulator_->noise_dim(); }
-  void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives) const override;
+  using StepModel::noise;
   void noise(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
              StepWorkspace& workspace) const override;
 
   int uncertainty_dim() const override { return state_dim(); }
-  void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out,
-                   bool derivatives) const override;
+  using StepModel::uncertainty;
   void uncertainty(const VectorCRef& x, const VectorCRef& u, DiffusionColumns& out, bool derivatives,
                    StepWorkspace& workspace) const override;
 

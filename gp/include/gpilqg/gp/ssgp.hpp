@@ -60,7 +60,8 @@ class SsgpPredictor;
 /// Escalated jitter (JitterSchedule, relative to N/2 = mean(diag(Phi'Phi)), a constant) is added to
 /// the ridge a in A only, so the gradient stays exact for the value returned.
 ///
-/// Not thread-safe: evaluate() reuses an internal O(N m) workspace (copies get their own).
+/// Immutable once built and shareable between threads: the O(N m) scratch of an evaluation lives in the
+/// caller's workspace (make_workspace()).
 class SsgpLikelihood {
  public:
   /// X: N x D inputs, r: N targets, `frequencies`: m >= 1. `threads` > 1 splits the O(N m^2) work
@@ -69,11 +70,6 @@ class SsgpLikelihood {
   /// m < 1, threads < 1 or an invalid schedule.
   SsgpLikelihood(const MatrixCRef& X, const VectorCRef& r, int frequencies, JitterSchedule schedule = {},
                  int threads = 1);
-  ~SsgpLikelihood();
-  SsgpLikelihood(const SsgpLikelihood& other);
-  SsgpLikelihood& operator=(const SsgpLikelihood& other);
-  SsgpLikelihood(SsgpLikelihood&&) noexcept;
-  SsgpLikelihood& operator=(SsgpLikelihood&&) noexcept;
 
   const SsgpLayout& layout() const { return layout_; }
   int parameter_count() const { return layout_.size(); }
@@ -81,7 +77,11 @@ class SsgpLikelihood {
   /// nlml at theta; fills `gradient` (resized to parameter_count()) when not null. Never NaN: a
   /// non-finite theta or a failed factorisation gives status Failed, +infinity and a zero gradient.
   /// Throws std::invalid_argument only for a wrongly sized theta.
+  NlmlEvaluation evaluate(const VectorCRef& theta, Vector* gradient, LikelihoodWorkspace& workspace) const;
+  /// The same with a temporary workspace.
   NlmlEvaluation evaluate(const VectorCRef& theta, Vector* gradient = nullptr) const;
+  /// A workspace for evaluate(), sized on first use and reused after.
+  std::unique_ptr<LikelihoodWorkspace> make_workspace() const;
 
   /// The cached posterior at theta and the conditioning report. Throws std::runtime_error when no
   /// factorisation is possible even with the largest jitter.
@@ -89,14 +89,14 @@ class SsgpLikelihood {
 
  private:
   struct Workspace;
-  NlmlEvaluation factorise(const VectorCRef& theta) const;
+  /// Factorises at theta into `w`; the returned status is Failed when impossible.
+  NlmlEvaluation factorise(const VectorCRef& theta, Workspace& w) const;
 
   Matrix X_;
   Vector r_;
   SsgpLayout layout_;
   JitterSchedule schedule_;
   int threads_ = 1;
-  mutable std::unique_ptr<Workspace> ws_;
 };
 
 /// The fitted SSGP posterior (ssgpr.m's prediction), cached so that one query is O(m D + m^2):

@@ -1,8 +1,9 @@
 #pragma once
 /// @file report.hpp
-/// The diagnosis as a terminal report and as one JSON document (DESIGN.md section 6: the keys
-/// "system", "samples", "heldout_episodes", "consistent", "states", "relevance", "ranking", "verdict"
-/// are fixed; the others are additions).
+/// The diagnosis as a terminal report and as one JSON document
+/// (docs/formats.md#diagnosis-json-gpilqg-diagnose---json: the keys "system", "samples",
+/// "heldout_episodes", "consistent", "states", "relevance", "ranking", "verdict" are fixed; the others
+/// are additions).
 ///
 /// Ranking entries carry "heldout_rmse_before" / "heldout_rmse_after" for one state, "heldout_state":
 /// the state whose held-out RMSE is furthest above its noise floor under the diagnosed model (the same
