@@ -4,6 +4,8 @@
 //   quadrotor  D = 16 (12 states + 4 controls), E = 12 outputs (belief dimension 12 + 78 = 90)
 // The ...PerOutputCentres variants give every output its own N = 300 centres (FITC's case, each output
 // its own pseudo-inputs): the same work as shared centres, so the figures should match.
+// BM_Expm1/<kind> times the moment matching's innermost step, expm1 over one 600 x 600 pair of outputs
+// (the cart-pole's exact GP), with glibc's scalar expm1 and each vector kind this processor supports.
 // Run e.g. build/bench/gpilqg_moment_matching_bench --benchmark_min_time=0.5
 
 #include <benchmark/benchmark.h>
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include "gpilqg/gp/moment_matching.hpp"
+#include "../gp/src/vector_expm1.hpp"
 
 namespace {
 
@@ -77,6 +80,31 @@ void BM_QuadrotorMomentsAndDerivativesPerOutputCentres(benchmark::State& state) 
   propagate(state, 16, 12, 4, MomentDerivatives::All, true);
 }
 
+/// expm1 over 600 x 600 arguments spread like the moment matching's D (small, of both signs).
+void BM_Expm1(benchmark::State& state, gpilqg::gp::detail::VectorIsa isa) {
+  using namespace gpilqg::gp::detail;
+  if (!supported(isa)) {
+    state.SkipWithError("not supported by this processor");
+    return;
+  }
+  std::mt19937 gen(3);
+  std::uniform_real_distribution<double> d(-0.3, 0.3);
+  std::vector<double> arguments(600 * 600);
+  for (double& x : arguments) x = d(gen);
+  std::vector<double> values(arguments.size());
+  for (auto _ : state) {
+    values = arguments;
+    expm1_in_place(values, isa);
+    benchmark::DoNotOptimize(values.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(arguments.size()));
+}
+
+BENCHMARK_CAPTURE(BM_Expm1, scalar, gpilqg::gp::detail::VectorIsa::Scalar)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Expm1, sse2, gpilqg::gp::detail::VectorIsa::Sse2)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Expm1, avx2, gpilqg::gp::detail::VectorIsa::Avx2)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Expm1, avx512, gpilqg::gp::detail::VectorIsa::Avx512)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CartpoleMoments)->Arg(300)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_CartpoleMomentsAndDerivatives)->Arg(300)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_QuadrotorMoments)->Arg(300)->Unit(benchmark::kMillisecond);

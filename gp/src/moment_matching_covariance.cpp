@@ -76,6 +76,7 @@
 #include <cmath>
 
 #include "moment_matching_internal.hpp"
+#include "vector_expm1.hpp"
 
 namespace gpilqg::gp {
 
@@ -139,8 +140,8 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, std::size_t a, s
   const auto centred_exp = [&](Eigen::Index j, Eigen::Index start) {
     const Eigen::Index len = n_a - start;
     auto col = nn.col(j).tail(len);
-    for (Eigen::Index i = 0; i < len; ++i)
-      col(i) = std::expm1(std::min(col(i) + row_term(start + i) + col_term(j), kMaxLogRatio));
+    col = (col.array() + row_term.tail(len).array() + col_term(j)).cwiseMin(kMaxLogRatio).matrix();
+    detail::expm1_in_place({col.data(), static_cast<std::size_t>(len)});
   };
 
   const double ma = out.mean(ai);

@@ -1,0 +1,101 @@
+#include "vector_expm1.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+#if defined(__x86_64__) && defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 35))
+#define GPILQG_HAVE_LIBMVEC_EXPM1 1
+#include <immintrin.h>
+
+// libmvec's entry points (x86-64 vector function ABI: b = SSE, d = AVX2, e = AVX-512; N2/N4/N8 lanes,
+// v = one vector argument). glibc declares them only under -ffast-math, so they are declared here. Each
+// is an indirect function that glibc resolves to the best implementation of its kind.
+extern "C" {
+__m128d _ZGVbN2v_expm1(__m128d);
+__attribute__((target("avx2,fma"))) __m256d _ZGVdN4v_expm1(__m256d);
+__attribute__((target("avx512f"))) __m512d _ZGVeN8v_expm1(__m512d);
+}
+#endif
+
+namespace gpilqg::gp::detail {
+
+namespace {
+
+void scalar_expm1(double* x, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) x[i] = std::expm1(x[i]);
+}
+
+#ifdef GPILQG_HAVE_LIBMVEC_EXPM1
+
+void sse2_expm1(double* x, std::size_t n) {
+  std::size_t i = 0;
+  for (; i + 2 <= n; i += 2) _mm_storeu_pd(x + i, _ZGVbN2v_expm1(_mm_loadu_pd(x + i)));
+  scalar_expm1(x + i, n - i);
+}
+
+__attribute__((target("avx2,fma"))) void avx2_expm1(double* x, std::size_t n) {
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4) _mm256_storeu_pd(x + i, _ZGVdN4v_expm1(_mm256_loadu_pd(x + i)));
+  scalar_expm1(x + i, n - i);
+}
+
+__attribute__((target("avx512f"))) void avx512_expm1(double* x, std::size_t n) {
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) _mm512_storeu_pd(x + i, _ZGVeN8v_expm1(_mm512_loadu_pd(x + i)));
+  scalar_expm1(x + i, n - i);
+}
+
+#endif
+
+VectorIsa detect_widest() {
+#ifdef GPILQG_HAVE_LIBMVEC_EXPM1
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f")) return VectorIsa::Avx512;
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return VectorIsa::Avx2;
+  return VectorIsa::Sse2;  // part of every x86-64 processor
+#else
+  return VectorIsa::Scalar;
+#endif
+}
+
+}  // namespace
+
+std::string_view to_string(VectorIsa isa) {
+  switch (isa) {
+    case VectorIsa::Scalar: return "scalar";
+    case VectorIsa::Sse2: return "sse2";
+    case VectorIsa::Avx2: return "avx2";
+    case VectorIsa::Avx512: return "avx512";
+  }
+  return "unknown";
+}
+
+VectorIsa widest_supported_isa() {
+  static const VectorIsa widest = detect_widest();
+  return widest;
+}
+
+bool supported(VectorIsa isa) { return static_cast<int>(isa) <= static_cast<int>(widest_supported_isa()); }
+
+void expm1_in_place(std::span<double> values, VectorIsa isa) {
+  if (!supported(isa))
+    throw std::invalid_argument("expm1_in_place: instruction set '" + std::string(to_string(isa)) +
+                                "' is not supported by this build or processor; the widest supported is '" +
+                                std::string(to_string(widest_supported_isa())) + "'");
+  double* x = values.data();
+  const std::size_t n = values.size();
+  switch (isa) {
+#ifdef GPILQG_HAVE_LIBMVEC_EXPM1
+    case VectorIsa::Avx512: avx512_expm1(x, n); return;
+    case VectorIsa::Avx2: avx2_expm1(x, n); return;
+    case VectorIsa::Sse2: sse2_expm1(x, n); return;
+#endif
+    default: scalar_expm1(x, n); return;
+  }
+}
+
+void expm1_in_place(std::span<double> values) { expm1_in_place(values, widest_supported_isa()); }
+
+}  // namespace gpilqg::gp::detail
