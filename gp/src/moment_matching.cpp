@@ -217,6 +217,7 @@ void SeArdMomentMatcher::prepare(MomentMatch& out, bool derivatives, int workers
     for (Vector* v : {&w.sqrt_w_pair, &w.lengthscale_pair, &w.dvec, &w.dvec2}) v->resize(d);
     if (derivatives) {
       w.outer.resize(n, d * d);
+      w.omega_v.resize(n, d);
       w.third.resize(d, d * d);
       for (Matrix* m : {&w.pair_shrink, &w.delta_a, &w.delta_b}) m->resize(d, d);
     }

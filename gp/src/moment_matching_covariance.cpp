@@ -76,20 +76,12 @@
 #include <cmath>
 
 #include "moment_matching_internal.hpp"
-#include "vector_expm1.hpp"
+#include "moment_matching_pair_sums.hpp"
 
 namespace gpilqg::gp {
 
 using detail::tiled_product;
 using detail::view;
-
-namespace {
-
-/// D_ij is capped here before expm1: D_ij > 700 needs max(q_ai, q_bj) < sf^2 e^-700, so Q_ij (<= sf_a^2
-/// sf_b^2 e^-700) is negligible, and the cap keeps q_ai q_bj expm1(D_ij) from becoming 0 * inf.
-constexpr double kMaxLogRatio = 700.0;
-
-}  // namespace
 
 void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, std::size_t a, std::size_t b,
                                               MomentMatchWorkerScratch& w, bool derivatives) const {
@@ -109,7 +101,6 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, std::size_t a, s
   const Eigen::Index n_b = v_b.rows();
   auto nd_a = view(w.nd, n_a, d);
   auto nd_b = view(w.nd2, n_b, d);
-  auto nn = view(w.nn, n_a, n_b);
   auto row_term = view(w.row_term, n_a);
   auto col_term = view(w.col_term, n_b);
   auto row_sums = view(w.row_sums, n_a);
@@ -136,57 +127,35 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, std::size_t a, s
     col_term = 0.5 * nd_b.cwiseProduct(scaled_b).rowwise().sum() - s.log_shift[b];
   }
   row_term.array() += -0.5 * (log_det - s.log_det(ai) - s.log_det(bi));
-  tiled_product(nd_a, scaled_b.transpose(), nn);
-  const auto centred_exp = [&](Eigen::Index j, Eigen::Index start) {
-    const Eigen::Index len = n_a - start;
-    auto col = nn.col(j).tail(len);
-    col = (col.array() + row_term.tail(len).array() + col_term(j)).cwiseMin(kMaxLogRatio).matrix();
-    detail::expm1_in_place({col.data(), static_cast<std::size_t>(len)});
-  };
 
+  // The N_a x N_b sums, a block of columns at a time (moment_matching_pair_sums.hpp).
+  const detail::PairTerms terms{nd_a, scaled_b, row_term, col_term, gamma_a, gamma_b, v_b,
+                                same ? &oa.Kinv : nullptr, same ? &s.kernel_mean[a] : nullptr};
   const double ma = out.mean(ai);
   const double mb = out.mean(bi);
-  double total = 0.0;  // 1' Omega 1
+  detail::PairSums sums;
   if (same) {
-    // expm1(D) is symmetric: the lower triangle (the exponentials dominate the cost), mirrored.
-    const Eigen::Index n = n_a;
-    for (Eigen::Index j = 0; j < n; ++j) centred_exp(j, j);
-    for (Eigen::Index j = 0; j + 1 < n; ++j) nn.row(j).tail(n - j - 1) = nn.col(j).tail(n - j - 1).transpose();
     const Vector& q = s.kernel_mean[a];
-    double centred = 0.0;      // gamma' expm1(D) gamma = beta' (Q - q q') beta
-    double kinv_centred = 0.0;  // <Kinv, Q - q q'>
-    for (Eigen::Index j = 0; j < n; ++j) {
-      const auto col = nn.col(j);
-      centred += gamma_a(j) * col.dot(gamma_a);
-      kinv_centred += q(j) * col.cwiseProduct(oa.Kinv.col(j)).dot(q);
-    }
-    row_sums.noalias() = oa.Kinv * q;
-    const double expected_variance = oa.signal_variance - q.dot(row_sums) - kinv_centred;
+    col_sums.noalias() = oa.Kinv * q;
+    const double q_kinv_q = q.dot(col_sums);
+    // gamma' expm1(D) gamma = beta' (Q - q q') beta and <Kinv, Q - q q'>; Omega with its Kinv term
+    sums = detail::pair_sums(terms, true, derivatives, w);
+    const double expected_variance = oa.signal_variance - q_kinv_q - sums.kinv_centred;
     const bool clamped = !(expected_variance > 0.0);
-    const double sab = centred + (clamped ? 0.0 : expected_variance);
-    out.covariance(ai, ai) = sab;
+    out.covariance(ai, ai) = sums.centred + (clamped ? 0.0 : expected_variance);
     if (!derivatives) return;
-    // Omega = gamma gamma' .* expm1(D) - Kinv .* Q (the second term dropped when clamped).
-    if (clamped) {
-      for (Eigen::Index j = 0; j < n; ++j) nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_a(j);
-    } else {
-      for (Eigen::Index j = 0; j < n; ++j)
-        nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_a(j) -
-                    (nn.col(j).array() + 1.0).matrix().cwiseProduct(oa.Kinv.col(j)).cwiseProduct(q) * q(j);
-    }
-    total = nn.sum();
+    // Clamped (rare): Omega = gamma gamma' .* expm1(D) without the Kinv term, so once more.
+    if (clamped) sums = detail::pair_sums(terms, false, true, w);
   } else {
-    for (Eigen::Index j = 0; j < n_b; ++j) centred_exp(j, 0);
     // Omega = gamma_a gamma_b' .* expm1(D) = diag(beta_a) (Q - q_a q_b') diag(beta_b).
-    for (Eigen::Index j = 0; j < n_b; ++j) nn.col(j) = nn.col(j).cwiseProduct(gamma_a) * gamma_b(j);
-    total = nn.sum();
-    out.covariance(ai, bi) = total;
-    out.covariance(bi, ai) = total;
+    sums = detail::pair_sums(terms, false, derivatives, w);
+    out.covariance(ai, bi) = sums.total;
+    out.covariance(bi, ai) = sums.total;
     if (!derivatives) return;
   }
+  const double total = sums.total;  // 1' Omega 1
+  auto omega_v = view(w.omega_v, n_a, d);
 
-  row_sums = nn.rowwise().sum();
-  col_sums = nn.colwise().sum().transpose();
   w.gain.noalias() = w.sqrt_w_pair.asDiagonal() * w.rt_inverse * w.lengthscale_pair.asDiagonal();
   w.pair_precision.noalias() = w.sqrt_w_pair.asDiagonal() * w.rt_inverse * w.sqrt_w_pair.asDiagonal();
   // Delta_a = G - G_a = (P_a - P) Sigma, exactly 0 at Sigma = 0.
@@ -217,8 +186,7 @@ void SeArdMomentMatcher::propagate_covariance(MomentMatch& out, std::size_t a, s
   tiled_product(v_b.transpose(), nd_b, w.dd);
   w.inner.noalias() += ob.inverse_squared_lengthscales.asDiagonal() * w.dd *
                        ob.inverse_squared_lengthscales.asDiagonal();
-  tiled_product(nn, v_b, nd_a);  // Omega V_b (N_a x D)
-  tiled_product(v_a.transpose(), nd_a, w.dd);
+  tiled_product(v_a.transpose(), omega_v, w.dd);
   w.dd2.noalias() = oa.inverse_squared_lengthscales.asDiagonal() * w.dd *
                     ob.inverse_squared_lengthscales.asDiagonal();
   w.inner += w.dd2 + w.dd2.transpose();

@@ -21,20 +21,23 @@ namespace gpilqg::gp::detail {
 
 inline constexpr Eigen::Index kProductTile = 128;
 
-/// dst = lhs * rhs (dst pre-sized, not aliasing lhs or rhs); lhs and rhs may be transposes or blocks,
-/// dst a matrix or a view (MatrixView).
+/// dst = lhs * rhs, or dst += lhs * rhs when `accumulate` (dst pre-sized, not aliasing lhs or rhs);
+/// lhs and rhs may be transposes or blocks, dst a matrix, a view (MatrixView) or a block of one.
 template <class Lhs, class Rhs, class Dst>
-void tiled_product(const Lhs& lhs, const Rhs& rhs, Dst&& dst) {
+void tiled_product(const Lhs& lhs, const Rhs& rhs, Dst&& dst, bool accumulate = false) {
   const Eigen::Index m = lhs.rows();
   const Eigen::Index k = lhs.cols();
   const Eigen::Index n = rhs.cols();
   constexpr Eigen::Index t = kProductTile;
   if (m <= t && k <= t && n <= t) {
-    dst.noalias() = lhs * rhs;
+    if (accumulate)
+      dst.noalias() += lhs * rhs;
+    else
+      dst.noalias() = lhs * rhs;
     return;
   }
   if (k == 0) {
-    dst.setZero();
+    if (!accumulate) dst.setZero();
     return;
   }
   for (Eigen::Index j = 0; j < n; j += t) {
@@ -44,7 +47,7 @@ void tiled_product(const Lhs& lhs, const Rhs& rhs, Dst&& dst) {
       auto target = dst.block(i, j, mi, nj);
       for (Eigen::Index p = 0; p < k; p += t) {
         const Eigen::Index kp = std::min(t, k - p);
-        if (p == 0)
+        if (p == 0 && !accumulate)
           target.noalias() = lhs.block(i, p, mi, kp) * rhs.block(p, j, kp, nj);
         else
           target.noalias() += lhs.block(i, p, mi, kp) * rhs.block(p, j, kp, nj);

@@ -2,8 +2,6 @@
 
 #include <cmath>
 #include <cstddef>
-#include <stdexcept>
-#include <string>
 
 #if defined(__x86_64__) && defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 35))
 #define GPILQG_HAVE_LIBMVEC_EXPM1 1
@@ -49,41 +47,10 @@ __attribute__((target("avx512f"))) void avx512_expm1(double* x, std::size_t n) {
 
 #endif
 
-VectorIsa detect_widest() {
-#ifdef GPILQG_HAVE_LIBMVEC_EXPM1
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx512f")) return VectorIsa::Avx512;
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return VectorIsa::Avx2;
-  return VectorIsa::Sse2;  // part of every x86-64 processor
-#else
-  return VectorIsa::Scalar;
-#endif
-}
-
 }  // namespace
 
-std::string_view to_string(VectorIsa isa) {
-  switch (isa) {
-    case VectorIsa::Scalar: return "scalar";
-    case VectorIsa::Sse2: return "sse2";
-    case VectorIsa::Avx2: return "avx2";
-    case VectorIsa::Avx512: return "avx512";
-  }
-  return "unknown";
-}
-
-VectorIsa widest_supported_isa() {
-  static const VectorIsa widest = detect_widest();
-  return widest;
-}
-
-bool supported(VectorIsa isa) { return static_cast<int>(isa) <= static_cast<int>(widest_supported_isa()); }
-
 void expm1_in_place(std::span<double> values, VectorIsa isa) {
-  if (!supported(isa))
-    throw std::invalid_argument("expm1_in_place: instruction set '" + std::string(to_string(isa)) +
-                                "' is not supported by this build or processor; the widest supported is '" +
-                                std::string(to_string(widest_supported_isa())) + "'");
+  require_supported(isa, "expm1_in_place");
   double* x = values.data();
   const std::size_t n = values.size();
   switch (isa) {

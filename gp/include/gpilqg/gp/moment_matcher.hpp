@@ -67,7 +67,8 @@ struct MomentMatchWorkerScratch {
   Matrix pair_shrink, delta_a, delta_b;                            ///< D x D, derivatives only
   Matrix nd, nd2;                                                  ///< room for N_max x D
   Vector row_term, col_term, row_sums, col_sums;                   ///< room for N_max
-  Matrix nn;                             ///< D, expm1(D), then Omega of one pair (room for N_max x N_max)
+  Matrix nn;                             ///< blocks of expm1(D), then Omega, of one pair (room for N_max x N_max)
+  Matrix omega_v;                        ///< Omega V_b of one pair (room for N_max x D), derivatives only
   Matrix outer;                          ///< t_ni t_nj (room for N_max x D*D), derivatives only
   Matrix third;                          ///< sum_n gamma_n (Sigma t_n)_k t_ni t_nj (D x D*D), derivatives only
   Vector sqrt_w_pair, lengthscale_pair, dvec, dvec2;               ///< D
