@@ -27,8 +27,34 @@ struct ObjectiveBridge {
   double max_jitter = 0.0;
   double best_value = std::numeric_limits<double>::infinity();
   Vector best_theta;
+  // The last evaluation with a gradient: the fitter evaluates the first start before NLopt does, and
+  // NLopt's first request at that point is answered from here instead of evaluating it twice.
+  std::vector<double> last_x;
+  std::vector<double> last_gradient;
+  double last_value = 0.0;
 
+  /// The nlml at x (the failure value of fit.hpp for a failed evaluation) and, when `grad` is not
+  /// empty, its gradient.
   double operator()(const std::vector<double>& x, std::vector<double>& grad) {
+    if (!grad.empty() && x == last_x) {
+      grad = last_gradient;
+      return last_value;
+    }
+    const double value = evaluate(x, grad);
+    if (!grad.empty()) {
+      last_x = x;
+      last_gradient = grad;
+      last_value = value;
+    }
+    return value;
+  }
+
+  static double call(const std::vector<double>& x, std::vector<double>& grad, void* self) {
+    return (*static_cast<ObjectiveBridge*>(self))(x, grad);
+  }
+
+ private:
+  double evaluate(const std::vector<double>& x, std::vector<double>& grad) {
     theta = Eigen::Map<const Vector>(x.data(), static_cast<Eigen::Index>(x.size()));
     const NlmlEvaluation e = objective->evaluate(theta, grad.empty() ? nullptr : &gradient);
     ++evaluations;
@@ -46,10 +72,6 @@ struct ObjectiveBridge {
       best_theta = theta;
     }
     return e.value;
-  }
-
-  static double call(const std::vector<double>& x, std::vector<double>& grad, void* self) {
-    return (*static_cast<ObjectiveBridge*>(self))(x, grad);
   }
 };
 
@@ -99,11 +121,9 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
   FitSummary& s = out.summary;
   s.parameters = p;
 
-  std::vector<double> no_gradient;
-  {
-    std::vector<double> x0 = to_std(starts.front());
-    s.initial_nlml = bridge(x0, no_gradient);
-  }
+  // With optimisation, with its gradient: NLopt's first evaluation of the first start is this one.
+  std::vector<double> first_gradient(options.optimise ? static_cast<std::size_t>(p) : 0);
+  s.initial_nlml = bridge(to_std(starts.front()), first_gradient);
   if (!options.optimise) {
     out.parameters = starts.front();
     s.starts = 1;

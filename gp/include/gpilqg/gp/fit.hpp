@@ -10,6 +10,9 @@
 /// data-driven initial values, then FitOptions::restarts random restarts (restart_parameters). The
 /// start with the lowest NLML wins.
 ///
+/// FitSummary::initial_nlml is the first start's evaluation with its gradient (when optimising), which
+/// also answers NLopt's first request: no point is evaluated twice.
+///
 /// Time limit (FitOptions::max_seconds > 0): measured from the call; each start gets NLopt's maxtime
 /// set to the time left, which NLopt checks after every evaluation, and no start begins once none is
 /// left. A fit stopped so keeps its best point so far and reports FitTermination::TimeLimit and the
