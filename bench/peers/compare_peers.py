@@ -25,6 +25,8 @@ the program first):
                    for cases b and e
   --peer-threads T OMP_NUM_THREADS = OPENBLAS_NUM_THREADS = MKL_NUM_THREADS for the peers (default 2:
                    the peers on both cores, as gpilqg's 2-thread column)
+  --fit-sizes N,.. case e at these N only (e.g. --fit-sizes 1000 --fit-repeats 3: the slow N = 4,000
+                   scikit-learn fit, about 20 s per evaluation, left out)
   GPML_PATH=DIR    an unpacked GPML (not packaged in Debian); without it case c's peer is skipped
 
 Both sides call the same OpenBLAS (libblas.so.3), which picks its kernels for the CPU model when it
@@ -66,6 +68,7 @@ def parse_args(argv):
     p.add_argument("--repeats", type=int, help="timed repetitions of cases a, c, d (default 3, --quick 2)")
     p.add_argument("--fit-repeats", type=int, default=1, help="timed repetitions of the fits (default 1)")
     p.add_argument("--peer-threads", type=int, default=2, help="BLAS/OpenMP threads of the peers (default 2)")
+    p.add_argument("--fit-sizes", help="case e at these N, comma-separated (default 1000,4000; --quick 300,600)")
     p.add_argument("--out", help="write the whole report as JSON to this file")
     p.add_argument("--data", help="keep the HDF5 data file at this path (default a temporary file)")
     p.add_argument("--strict", action="store_true", help="exit 77 when scikit-learn is missing")
@@ -75,6 +78,13 @@ def parse_args(argv):
     for name in ("repeats", "fit_repeats", "peer_threads"):
         if getattr(args, name) < 1:
             p.error("--%s must be >= 1" % name.replace("_", "-"))
+    if args.fit_sizes is not None:
+        try:
+            args.fit_sizes = [int(n) for n in args.fit_sizes.split(",")]
+        except ValueError:
+            p.error("--fit-sizes expects comma-separated whole numbers, got %r" % args.fit_sizes)
+        if not args.fit_sizes or min(args.fit_sizes) < 10:
+            p.error("--fit-sizes expects sizes of at least 10 points")
     if args.program is None:
         args.program = os.path.join(args.build, "bench", "gpilqg_peer_cases")
     if not os.access(args.program, os.X_OK):
@@ -302,7 +312,9 @@ def main(argv=None):
 
     commit, date = commit_and_date()
     info = machine()
-    sizes = peer_data.QUICK if args.quick else peer_data.FULL
+    sizes = dict(peer_data.QUICK if args.quick else peer_data.FULL)
+    if args.fit_sizes is not None:
+        sizes["fit_sizes"] = args.fit_sizes
     cases = peer_data.make_cases(sizes)
     with tempfile.TemporaryDirectory(prefix="gpilqg_peers_") as work:
         data_file = args.data or os.path.join(work, "peers.h5")
