@@ -27,7 +27,7 @@ struct ObjectiveBridge {
   double max_jitter = 0.0;
   double best_value = std::numeric_limits<double>::infinity();
   Vector best_theta;
-  // The last evaluation with a gradient: the fitter evaluates the first start before NLopt does, and
+  // The last evaluation with a gradient: the fitter evaluates each start before NLopt does, and
   // NLopt's first request at that point is answered from here instead of evaluating it twice.
   std::vector<double> last_x;
   std::vector<double> last_gradient;
@@ -49,9 +49,17 @@ struct ObjectiveBridge {
     return value;
   }
 
-  static double call(const std::vector<double>& x, std::vector<double>& grad, void* self) {
-    return (*static_cast<ObjectiveBridge*>(self))(x, grad);
+  /// NLopt's objective: its variables z are the parameters in units of `step` (first_step_unit).
+  static double call(const std::vector<double>& z, std::vector<double>& grad, void* self) {
+    ObjectiveBridge& bridge = *static_cast<ObjectiveBridge*>(self);
+    bridge.parameters.resize(z.size());
+    for (std::size_t i = 0; i < z.size(); ++i) bridge.parameters[i] = bridge.step * z[i];
+    const double value = bridge(bridge.parameters, grad);
+    for (double& g : grad) g *= bridge.step;
+    return value;
   }
+  double step = 1.0;
+  std::vector<double> parameters;  // reused buffer of call
 
  private:
   double evaluate(const std::vector<double>& x, std::vector<double>& grad) {
@@ -80,6 +88,22 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 std::vector<double> to_std(const Vector& v) { return {v.data(), v.data() + v.size()}; }
+
+/// The unit of NLopt's variables for a start whose gradient there is g0: the power of two nearest to
+/// 1 / sqrt(max(1, |g0|_inf)). L-BFGS's first iteration is a steepest-descent step whose first trial
+/// is the unit step in the optimiser's variables, -step g0 in its variables, i.e. -step^2 g0 in the
+/// parameters: with this unit no parameter moves by more than about 1 (a factor of e in a
+/// log-parametrised quantity), instead of by |g0|_inf, which grows with N (the nlml is a sum over the
+/// data) and sends the first trial far outside the region the line search then backtracks into.
+/// Later steps use the curvature L-BFGS has measured. A power of two keeps parameters = step x
+/// variables exact, and xtol_rel and ftol_rel are relative, so the stopping rules do not change.
+double first_step_unit(const std::vector<double>& g0) {
+  double largest = 1.0;
+  for (const double g : g0) largest = std::max(largest, std::abs(g));
+  return std::isfinite(largest) ? std::exp2(-std::round(0.5 * std::log2(largest))) : 1.0;
+}
+
+std::vector<double> in_units(const Vector& v, double step) { return to_std(v / step); }
 
 Vector clip(const Vector& theta, const ParameterBounds& b) {
   return theta.cwiseMax(b.lower).cwiseMin(b.upper);
@@ -134,23 +158,28 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
     bool out_of_time = false;
     std::size_t begun = 0;
     for (std::size_t k = 0; k < starts.size(); ++k) {
-      nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(p));
-      opt.set_lower_bounds(to_std(bounds.lower));
-      opt.set_upper_bounds(to_std(bounds.upper));
-      opt.set_min_objective(&ObjectiveBridge::call, &bridge);
-      opt.set_maxeval(options.max_evaluations);
-      opt.set_ftol_rel(options.relative_tolerance);
-      opt.set_xtol_rel(options.parameter_tolerance);
+      double left = 0.0;
       if (options.max_seconds > 0.0) {
-        const double left = options.max_seconds - seconds_since(start_time);
+        left = options.max_seconds - seconds_since(start_time);
         if (left <= 0.0) {  // no start begins once the time is used up
           out_of_time = true;
           break;
         }
-        opt.set_maxtime(left);
       }
       ++begun;
-      std::vector<double> x = to_std(starts[k]);
+      // The start's gradient (NLopt's first evaluation, served from the bridge) sets its unit.
+      std::vector<double> gradient_at_start = first_gradient;
+      if (k > 0) bridge(to_std(starts[k]), gradient_at_start);
+      bridge.step = first_step_unit(gradient_at_start);
+      nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(p));
+      opt.set_lower_bounds(in_units(bounds.lower, bridge.step));
+      opt.set_upper_bounds(in_units(bounds.upper, bridge.step));
+      opt.set_min_objective(&ObjectiveBridge::call, &bridge);
+      opt.set_maxeval(options.max_evaluations);
+      opt.set_ftol_rel(options.relative_tolerance);
+      opt.set_xtol_rel(options.parameter_tolerance);
+      if (options.max_seconds > 0.0) opt.set_maxtime(left);
+      std::vector<double> x = in_units(starts[k], bridge.step);
       double value = 0.0;
       FitTermination termination = FitTermination::Converged;
       bool worked = true;
