@@ -158,13 +158,9 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
     bool out_of_time = false;
     std::size_t begun = 0;
     for (std::size_t k = 0; k < starts.size(); ++k) {
-      double left = 0.0;
-      if (options.max_seconds > 0.0) {
-        left = options.max_seconds - seconds_since(start_time);
-        if (left <= 0.0) {  // no start begins once the time is used up
-          out_of_time = true;
-          break;
-        }
+      if (options.max_seconds > 0.0 && seconds_since(start_time) >= options.max_seconds) {
+        out_of_time = true;  // no start begins once the time is used up
+        break;
       }
       ++begun;
       // The start's gradient (NLopt's first evaluation, served from the bridge) sets its unit.
@@ -178,7 +174,8 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
       opt.set_maxeval(options.max_evaluations);
       opt.set_ftol_rel(options.relative_tolerance);
       opt.set_xtol_rel(options.parameter_tolerance);
-      if (options.max_seconds > 0.0) opt.set_maxtime(left);
+      if (options.max_seconds > 0.0)  // the time left after the start's evaluation (for NLopt 0 is no limit)
+        opt.set_maxtime(std::max(options.max_seconds - seconds_since(start_time), 1e-9));
       std::vector<double> x = in_units(starts[k], bridge.step);
       double value = 0.0;
       FitTermination termination = FitTermination::Converged;
