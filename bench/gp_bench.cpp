@@ -1,5 +1,6 @@
 // Cost of the exact GP's units of work at N = 300, 1000, 2000, 4000 training points with D = 5 inputs:
-// one NLML with its gradient (what every optimiser step pays), a whole fit (L-BFGS from the
+// one NLML with its gradient (what every optimiser step pays; its achieved GFLOP/s against the
+// machine's dgemm rate, BM_Dgemm), a whole fit (L-BFGS from the
 // data-driven start only: no warm start, no random restarts; N <= 2000, since at N = 4000 one fit
 // takes minutes), and one prediction of mean and variance with their input gradients (what every
 // DDP step pays per state dimension). Synthetic data with a fixed seed. Run times are fixed in the
@@ -13,7 +14,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "gpilqg/core/integrator.hpp"
@@ -21,6 +24,11 @@
 #include "gpilqg/gp/exact_gp.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 #include "system_samples.hpp"
+
+// The BLAS's Fortran interface (LP64), as gp/src/blas_lapack.cpp declares it.
+extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k,
+                       const double* alpha, const double* a, const int* lda, const double* b, const int* ldb,
+                       const double* beta, double* c, const int* ldc, std::size_t, std::size_t);
 
 namespace {
 
@@ -55,8 +63,18 @@ Vector typical_parameters() {
 /// The full exact GP (no subsample) on `threads` threads.
 ExactGpBackend all_points_backend(int threads = 1) { return ExactGpBackend(ExactGpOptions{ExactGpOptions::kAllPoints, threads}); }
 
+/// Floating-point operations of one exact NLML with its gradient (exact_objective.cpp), N points, D inputs:
+///   Cholesky N^3/3, K^-1 from the factor 2 N^3/3 (dtrtri + dlauum), the two triangular solves for
+///   alpha 2 N^2, the kernel matrix's lower triangle N^2/2 (3 D + 2) (a difference, a square and a
+///   multiply-add per input, the exponential and sf^2 counted as one each), and the gradient sums
+///   N^2/2 (4 D + 4) (W_ij Kf_ij, then per input a difference, a square and a multiply-add).
+double exact_nlml_gradient_flops(double n, double d) {
+  return n * n * n + 2.0 * n * n + 0.5 * n * n * (3.0 * d + 2.0) + 0.5 * n * n * (4.0 * d + 4.0);
+}
+
 void BM_ExactNlmlWithGradient(benchmark::State& state) {
-  const TrainingSet data = synthetic_data(static_cast<int>(state.range(0)));
+  const int n = static_cast<int>(state.range(0));
+  const TrainingSet data = synthetic_data(n);
   auto objective = all_points_backend(static_cast<int>(state.range(1))).objective(data, FitOptions{});
   const Vector theta = typical_parameters();
   Vector gradient;
@@ -65,6 +83,10 @@ void BM_ExactNlmlWithGradient(benchmark::State& state) {
     benchmark::DoNotOptimize(e.value);
     benchmark::DoNotOptimize(gradient.data());
   }
+  // Achieved rate (exact_nlml_gradient_flops per wall-clock second), to set against BM_Dgemm's.
+  state.counters["GFLOP/s"] = benchmark::Counter(1e-9 * exact_nlml_gradient_flops(n, kInputs) *
+                                                 static_cast<double>(state.iterations()),
+                                                 benchmark::Counter::kIsRate);
 }
 // Arguments: N, threads. Wall-clock time (UseRealTime) so that threads = 2 is not understated; the
 // CPU-time column of the threads = 1 rows is the single-core cost.
@@ -85,6 +107,46 @@ BENCHMARK(BM_ExactNlmlWithGradient)
     ->ArgNames({"N", "threads"})
     ->Args({4000, 1})
     ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// The machine's dgemm rate, the ceiling of the dense work above: C = A B with N x N matrices through
+/// the BLAS the GP backends call (libblas.so.3, Fortran interface; docs/building.md#blas), 2 N^3 flops.
+/// The library runs every BLAS call on one thread and splits large matrices over its own threads
+/// (dense_cholesky.hpp), so threads = 2 here is the same split: each thread one half of C's columns.
+void BM_Dgemm(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const int threads = static_cast<int>(state.range(1));
+  const gpilqg::Matrix a = gpilqg::Matrix::Random(n, n), b = gpilqg::Matrix::Random(n, n);
+  gpilqg::Matrix c(n, n);
+  auto columns = [&](int first, int count) {
+    const char no = 'N';
+    const double one = 1.0, zero = 0.0;
+    dgemm_(&no, &no, &n, &count, &n, &one, a.data(), &n, b.data() + static_cast<std::ptrdiff_t>(first) * n, &n,
+           &zero, c.data() + static_cast<std::ptrdiff_t>(first) * n, &n, 1, 1);
+  };
+  for (auto _ : state) {
+    if (threads == 1) {
+      columns(0, n);
+    } else {
+      std::thread other(columns, n / 2, n - n / 2);
+      columns(0, n / 2);
+      other.join();
+    }
+    benchmark::DoNotOptimize(c.data());
+  }
+  state.counters["GFLOP/s"] = benchmark::Counter(2e-9 * n * static_cast<double>(n) * n *
+                                                 static_cast<double>(state.iterations()),
+                                                 benchmark::Counter::kIsRate);
+}
+// Arguments: N, threads (1, or 2: two single-threaded calls on the halves of C).
+BENCHMARK(BM_Dgemm)
+    ->ArgNames({"N", "threads"})
+    ->Args({2000, 1})
+    ->Args({2000, 2})
+    ->MinTime(0.3)
+    ->Repetitions(3)
+    ->ComputeStatistics("min", minimum)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -6,6 +6,12 @@ N, D and hyperparameters:
   b. a whole exact-GP fit at N = 1,000, one start from the same point        vs scikit-learn
   c. FITC NLML + gradient, N = 5,000, M = 100                                vs GPML under Octave
   d. batched exact prediction with variance, 1,750 points at N = 4,000       vs scikit-learn
+  e. a whole exact-GP fit as a user calls it, N = 1,000 and 4,000: one start  vs scikit-learn
+     each, from each library's own default (gpilqg: its data-driven start and box, fit.hpp;
+     scikit-learn: GaussianProcessRegressor(ConstantKernel() * RBF(ones(D)) + WhiteKernel(),
+     n_restarts_optimizer=0), every parameter and setting at its documented default), gpilqg on
+     2 threads, the peer on --peer-threads; both optima scored with one function (scikit-learn's
+     log_marginal_likelihood with alpha = 0, the model both fit)
 
 Usage, from the repository root (Debian's /usr/bin/python3, which has NumPy, h5py and scikit-learn; build
 the program first):
@@ -16,11 +22,21 @@ the program first):
 
   --quick          small sizes (the ctest smoke test bench_peers_quick)
   --repeats K      timed repetitions of cases a, c, d (default 3; --quick 2); --fit-repeats (default 1)
-  --peer-threads T OMP_NUM_THREADS = OPENBLAS_NUM_THREADS = MKL_NUM_THREADS for the peers (default 1)
+                   for cases b and e
+  --peer-threads T OMP_NUM_THREADS = OPENBLAS_NUM_THREADS = MKL_NUM_THREADS for the peers (default 2:
+                   the peers on both cores, as gpilqg's 2-thread column)
+  --fit-sizes N,.. case e at these N only (e.g. --fit-sizes 1000 --fit-repeats 3: the slow N = 4,000
+                   scikit-learn fit, about 20 s per evaluation, left out)
   GPML_PATH=DIR    an unpacked GPML (not packaged in Debian); without it case c's peer is skipped
 
+Both sides call the same OpenBLAS (libblas.so.3), which picks its kernels for the CPU model when it
+loads; on a CPU model its build does not know it falls back to its Prescott (SSE3) kernels, on both
+sides alike. The report names the kernels it chose (threadpoolctl's "architecture"); exporting
+OPENBLAS_CORETYPE (e.g. SkylakeX on an AVX-512 CPU) before the run selects them for both sides.
+
 The script writes the data to one HDF5 file (peer_data.py), runs gpilqg_peer_cases on it with 1 and
-with 2 threads (it times itself and prints JSON), times the peers in this process, and checks that
+with 2 threads (it times itself and prints JSON; case e in the 2-thread run only; each run with the
+thread variables set to its own thread count), times the peers in this process, and checks that
 the two agree: the peer is also the oracle (NLML and gradient after the chain rule between the
 parametrisations, peer_sklearn.py; predictions; FITC against GPML or a NumPy formula). It prints a
 Markdown table of times and ratios peer time / gpilqg time to stdout (progress to stderr) and writes
@@ -40,6 +56,7 @@ import tempfile
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 TOLERANCE = 1e-8
 SKIP = 77
+DEFAULT_FIT_THREADS = 2  # case e: gpilqg on both cores of the development machine
 
 
 def parse_args(argv):
@@ -49,8 +66,9 @@ def parse_args(argv):
     p.add_argument("--program", help="the gpilqg_peer_cases program (default BUILD/bench/gpilqg_peer_cases)")
     p.add_argument("--quick", action="store_true", help="small sizes for a smoke test")
     p.add_argument("--repeats", type=int, help="timed repetitions of cases a, c, d (default 3, --quick 2)")
-    p.add_argument("--fit-repeats", type=int, default=1, help="timed repetitions of the fit (default 1)")
-    p.add_argument("--peer-threads", type=int, default=1, help="BLAS/OpenMP threads of the peers (default 1)")
+    p.add_argument("--fit-repeats", type=int, default=1, help="timed repetitions of the fits (default 1)")
+    p.add_argument("--peer-threads", type=int, default=2, help="BLAS/OpenMP threads of the peers (default 2)")
+    p.add_argument("--fit-sizes", help="case e at these N, comma-separated (default 1000,4000; --quick 300,600)")
     p.add_argument("--out", help="write the whole report as JSON to this file")
     p.add_argument("--data", help="keep the HDF5 data file at this path (default a temporary file)")
     p.add_argument("--strict", action="store_true", help="exit 77 when scikit-learn is missing")
@@ -60,6 +78,13 @@ def parse_args(argv):
     for name in ("repeats", "fit_repeats", "peer_threads"):
         if getattr(args, name) < 1:
             p.error("--%s must be >= 1" % name.replace("_", "-"))
+    if args.fit_sizes is not None:
+        try:
+            args.fit_sizes = [int(n) for n in args.fit_sizes.split(",")]
+        except ValueError:
+            p.error("--fit-sizes expects comma-separated whole numbers, got %r" % args.fit_sizes)
+        if not args.fit_sizes or min(args.fit_sizes) < 10:
+            p.error("--fit-sizes expects sizes of at least 10 points")
     if args.program is None:
         args.program = os.path.join(args.build, "bench", "gpilqg_peer_cases")
     if not os.access(args.program, os.X_OK):
@@ -110,8 +135,9 @@ def peer_libraries():
         pass
     try:
         from threadpoolctl import threadpool_info
-        pools = ["%s %s (%s, %d thread%s)" % (p.get("internal_api"), p.get("version") or "", p.get("filepath"),
-                                              p.get("num_threads"), "" if p.get("num_threads") == 1 else "s")
+        pools = ["%s %s (%s, %s kernels, %d thread%s)" % (
+                     p.get("internal_api"), p.get("version") or "", p.get("filepath"), p.get("architecture") or "its",
+                     p.get("num_threads"), "" if p.get("num_threads") == 1 else "s")
                  for p in threadpool_info()]
         if pools:
             text += "; BLAS: " + "; ".join(pools)
@@ -121,10 +147,15 @@ def peer_libraries():
 
 
 def run_gpilqg(args, data_file, threads):
+    """gpilqg_peer_cases on `threads` threads, with the thread variables set to the same count (case e,
+    the fits from the default start, in the run on DEFAULT_FIT_THREADS threads only)."""
     command = [args.program, data_file, "--threads", str(threads), "--repeats", str(args.repeats),
                "--fit-repeats", str(args.fit_repeats)]
+    if threads == DEFAULT_FIT_THREADS:
+        command.append("--default-fits")
+    environment = dict(os.environ, **{name: str(threads) for name in THREAD_VARIABLES})
     progress("gpilqg, %s: %s" % (thread_count(threads), " ".join(command)))
-    run = subprocess.run(command, stdout=subprocess.PIPE, text=True)
+    run = subprocess.run(command, stdout=subprocess.PIPE, text=True, env=environment)
     if run.returncode != 0:
         sys.exit("error: %s exited with %d" % (args.program, run.returncode))
     return json.loads(run.stdout)
@@ -230,7 +261,25 @@ def compare(args, cases, ours, sk, checks, notes):
                       difference(p["variance"], peer["variance"], sf * sf))
         notes.append("Prediction: scikit-learn's std includes the noise sn^2 = %.3g (WhiteKernel); gpilqg's variance is "
                      "latent." % sn2)
-    return rows, fit_table
+    default_fits = []
+    for i, n in enumerate(cases["fit_sizes"]):
+        f = ours[DEFAULT_FIT_THREADS]["default_fits"][i]
+        entry = {"size": "N = %d, D = %d" % (n, d), "gpilqg": f}
+        if skipped is None:
+            progress("scikit-learn, case e, N = %d" % n)
+            peer = sk.default_fit_case(X[:n], y[:n], args.fit_repeats)
+            gpilqg_value = f["nlml"]
+            f["nlml_gpilqg"] = gpilqg_value
+            f["nlml"] = sk.nlml_of(X[:n], y[:n], f["theta"])
+            add_check(checks, "e. NLML at gpilqg's optimum, N = %d, vs scikit-learn" % n,
+                      difference(gpilqg_value, f["nlml"]))
+            entry["peer"] = peer
+        else:
+            entry["peer"] = skipped
+        default_fits.append(entry)
+        rows.append({"case": "e. exact fit, each from its own default start", "size": entry["size"],
+                     "peer": "scikit-learn", "gpilqg_1": None, "gpilqg_2": f, "peer_result": entry["peer"]})
+    return rows, fit_table, default_fits
 
 
 def without_arrays(value):
@@ -263,7 +312,9 @@ def main(argv=None):
 
     commit, date = commit_and_date()
     info = machine()
-    sizes = peer_data.QUICK if args.quick else peer_data.FULL
+    sizes = dict(peer_data.QUICK if args.quick else peer_data.FULL)
+    if args.fit_sizes is not None:
+        sizes["fit_sizes"] = args.fit_sizes
     cases = peer_data.make_cases(sizes)
     with tempfile.TemporaryDirectory(prefix="gpilqg_peers_") as work:
         data_file = args.data or os.path.join(work, "peers.h5")
@@ -272,7 +323,7 @@ def main(argv=None):
     checks, notes = [], []
     if isinstance(sk, str):
         notes.append("scikit-learn skipped: " + sk)
-    rows, fit_table = compare(args, cases, ours, sk, checks, notes)
+    rows, fit_table, default_fits = compare(args, cases, ours, sk, checks, notes)
     info["load_end"] = os.getloadavg()[0]
 
     report = {"commit": commit, "date": date, "machine": info,
@@ -280,7 +331,7 @@ def main(argv=None):
                            "program": args.program, "peer_threads": args.peer_threads,
                            "thread_variables": {k: os.environ[k] for k in THREAD_VARIABLES},
                            "peer_libraries": peer_libraries(), "tolerance": TOLERANCE},
-              "rows": rows, "fit_table": fit_table, "checks": checks, "notes": notes,
+              "rows": rows, "fit_table": fit_table, "default_fits": default_fits, "checks": checks, "notes": notes,
               "gpilqg": {str(t): ours[t] for t in ours}, "ok": all(c["ok"] for c in checks)}
     import peer_report
     sys.stdout.write(peer_report.markdown(report))

@@ -7,7 +7,9 @@
 ///
 ///  a. nlml_case:    NLML and its gradient of the exact GP on the first n rows (GPML eqs. 2.30, 5.9)
 ///  b. fit_case:     a whole exact-GP fit on the first n rows: one start, the data-driven initial values,
-///                   NLopt L-BFGS in the data-driven box, then conditioning (GpBackend::fit, fit.hpp)
+///                   NLopt L-BFGS in the data-driven box, then conditioning (GpBackend::fit, fit.hpp);
+///                   case e is the same call at every N of fit_sizes (its peer starts from its own
+///                   default instead of from gpilqg's start)
 ///  c. fitc_case:    FITC NLML and its gradient, hyperparameters and pseudo-inputs (fitc.hpp)
 ///  d. predict_case: latent mean and variance of the exact GP conditioned on the first n rows at every
 ///                   test point, in one batched call (FittedGp::predict(points, mean, variance))

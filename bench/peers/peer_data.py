@@ -17,9 +17,9 @@ INPUTS = 5
 THETA = np.array([0.3, 0.5, 1.0, 0.8, 0.8, 0.0, math.log(0.05)])
 
 # Sizes of the cases and of the smoke test (--quick).
-FULL = {"nlml_sizes": [1000, 4000], "fit_size": 1000, "predict_size": 4000, "test_points": 1750,
-        "fitc_size": 5000, "fitc_inducing": 100}
-QUICK = {"nlml_sizes": [300, 600], "fit_size": 300, "predict_size": 600, "test_points": 350,
+FULL = {"nlml_sizes": [1000, 4000], "fit_size": 1000, "fit_sizes": [1000, 4000], "predict_size": 4000,
+        "test_points": 1750, "fitc_size": 5000, "fitc_inducing": 100}
+QUICK = {"nlml_sizes": [300, 600], "fit_size": 300, "fit_sizes": [300, 600], "predict_size": 600, "test_points": 350,
          "fitc_size": 1000, "fitc_inducing": 20}
 
 
@@ -36,7 +36,7 @@ def make_cases(sizes, seed=17):
     first rows), its test points, and the FITC set with theta = [THETA; vec(Xu)] (Xu column-major,
     FitcLayout in gp/include/gpilqg/gp/fitc.hpp)."""
     rng = np.random.default_rng(seed)
-    rows = max(max(sizes["nlml_sizes"]), sizes["fit_size"], sizes["predict_size"])
+    rows = max(max(sizes["nlml_sizes"]), sizes["fit_size"], max(sizes["fit_sizes"]), sizes["predict_size"])
     X, y = synthetic(rng, rows)
     X_test = rng.uniform(-2.0, 2.0, size=(sizes["test_points"], INPUTS))
     Xf, yf = synthetic(rng, sizes["fitc_size"])
@@ -44,7 +44,7 @@ def make_cases(sizes, seed=17):
     return {"X": X, "y": y, "theta": THETA.copy(), "X_test": X_test,
             "fitc_X": Xf, "fitc_y": yf, "fitc_theta": np.concatenate([THETA, Xu.ravel(order="F")]),
             "fitc_inducing": sizes["fitc_inducing"], "nlml_sizes": list(sizes["nlml_sizes"]),
-            "fit_size": sizes["fit_size"], "predict_size": sizes["predict_size"]}
+            "fit_size": sizes["fit_size"], "fit_sizes": list(sizes["fit_sizes"]), "predict_size": sizes["predict_size"]}
 
 
 def write_cases(path, cases):
@@ -59,4 +59,5 @@ def write_cases(path, cases):
         f["fitc/theta"] = cases["fitc_theta"]
         f.attrs["nlml_sizes"] = np.array(cases["nlml_sizes"], dtype=np.int64)
         f.attrs["fit_size"] = cases["fit_size"]
+        f.attrs["fit_sizes"] = np.array(cases["fit_sizes"], dtype=np.int64)
         f.attrs["predict_size"] = cases["predict_size"]

@@ -92,13 +92,15 @@ PeerInput read_peer_input(const std::filesystem::path& file) {
     fail(reader, "/fitc/theta", std::string("expected D + 2 + M D entries: ") + e.what());
   }
 
-  for (const char* name : {"nlml_sizes", "fit_size", "predict_size"})
+  for (const char* name : {"nlml_sizes", "fit_size", "fit_sizes", "predict_size"})
     if (!reader.has_attribute("/", name))
       fail(reader, "/", std::string("attribute ") + name + " is missing (bench/peers/peer_input.hpp)");
   for (const double n : reader.number_list_attribute("/", "nlml_sizes"))
     in.nlml_sizes.push_back(read_size(reader, "nlml_sizes", n, d, rows));
   if (in.nlml_sizes.empty()) fail(reader, "/", "attribute nlml_sizes is empty; expected at least one N");
   in.fit_size = read_size(reader, "fit_size", reader.number_attribute("/", "fit_size"), d, rows);
+  for (const double n : reader.number_list_attribute("/", "fit_sizes"))
+    in.fit_sizes.push_back(read_size(reader, "fit_sizes", n, d, rows));
   in.predict_size = read_size(reader, "predict_size", reader.number_attribute("/", "predict_size"), d, rows);
   return in;
 }

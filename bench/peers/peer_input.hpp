@@ -11,7 +11,8 @@
 ///   /fitc/X, /fitc/y   training set of the FITC case (its own N, the same D)
 ///   /fitc/theta    D + 2 + M D: the hyperparameters, then the M x D pseudo-inputs column-major
 ///                  (fitc.hpp, FitcLayout)
-///   root attributes: nlml_sizes (list of N, the first N rows of /exact), fit_size, predict_size
+///   root attributes: nlml_sizes (list of N, the first N rows of /exact), fit_size, fit_sizes (list),
+///                    predict_size
 ///
 /// Every size must be between D and the rows of /exact; values must be finite.
 
@@ -32,6 +33,7 @@ struct PeerInput {
   int fitc_inducing = 0;        ///< M, read from the length of /fitc/theta
   std::vector<int> nlml_sizes;  ///< case a: NLML and gradient on the first N rows
   int fit_size = 0;             ///< case b: a whole fit on the first N rows
+  std::vector<int> fit_sizes;   ///< case e: whole fits from the default start on the first N rows
   int predict_size = 0;         ///< case d: conditioned on the first N rows, predicting /exact/X_test
 };
 

@@ -1,5 +1,6 @@
 """The Markdown report of bench/peers/compare_peers.py: the settings line, the timing table with
-the ratios peer time / gpilqg time (best of k against best of k), the fit table and the checks."""
+the ratios peer time / gpilqg time (best of k against best of k), the fit tables (cases b and e) and
+the checks."""
 
 
 def seconds(t):
@@ -35,6 +36,9 @@ def markdown(report):
                      s["program"], s["repeats"], s["fit_repeats"]))
     lines.append("Peer threads: %s; %s." % (
         ", ".join("%s=%s" % kv for kv in s["thread_variables"].items()), s["peer_libraries"]))
+    blas = report.get("gpilqg", {}).get("2", {}).get("blas")
+    if blas:
+        lines.append("gpilqg's BLAS: %s." % blas)
     lines.append("")
     lines.append("| case | size | gpilqg, 1 thread | gpilqg, 2 threads | peer | peer | peer / gpilqg 1 thread "
                  "| peer / gpilqg 2 threads |")
@@ -54,6 +58,25 @@ def markdown(report):
         lines.append("|---|---|---|---|---|")
         for r in fit:
             lines.append("| %s | %s | %d | %.10g | %s |" % (r["who"], timing(r), r["evaluations"], r["nlml"], r["stopped"]))
+        lines.append("")
+    default_fits = report.get("default_fits")
+    if default_fits:
+        lines.append("Fit as a user calls it (case e): one start each from each library's own default, gpilqg on "
+                     "%d threads, scikit-learn on %d; both optima scored with scikit-learn's log_marginal_likelihood "
+                     "(alpha = 0). Ratio: scikit-learn best / gpilqg best." % (2, s["peer_threads"]))
+        lines.append("")
+        lines.append("| size | gpilqg | evaluations | NLML | scikit-learn | evaluations | NLML | ratio "
+                     "| NLML gpilqg - scikit-learn |")
+        lines.append("|---|---|---|---|---|---|---|---|---|")
+        for e in default_fits:
+            ours, peer = e["gpilqg"], e["peer"]
+            if "skipped" in peer:
+                lines.append("| %s | %s | %d | %.10g | %s | | | | |" % (e["size"], timing(ours), ours["evaluations"],
+                                                                     ours["nlml"], timing(peer)))
+                continue
+            lines.append("| %s | %s | %d | %.10g | %s | %d | %.10g | %s | %.3g |" % (
+                e["size"], timing(ours), ours["evaluations"], ours["nlml"], timing(peer), peer["evaluations"],
+                peer["nlml"], ratio(peer, ours), ours["nlml"] - peer["nlml"]))
         lines.append("")
     lines.append("Checks (the peer, or a formula, as the oracle):")
     lines.append("")

@@ -1,5 +1,6 @@
-"""scikit-learn's GaussianProcessRegressor as the peer of gpilqg's exact GP (cases a, b, d of
-bench/peers/compare_peers.py), at gpilqg's hyperparameters exactly.
+"""scikit-learn's GaussianProcessRegressor as the peer of gpilqg's exact GP (cases a, b, d, e of
+bench/peers/compare_peers.py), at gpilqg's hyperparameters exactly (case e: from scikit-learn's own
+default start).
 
 The kernel ConstantKernel * RBF(ARD) + WhiteKernel is
     k(a, b) = sf^2 exp(-0.5 sum_d (a_d - b_d)^2 / l_d^2) + sn^2 [a == b],
@@ -106,6 +107,36 @@ def fit_case(X, y, initial, lower, upper, repeats):
     return {**timing, "theta": theta.tolist(), "evaluations": gpr.evaluations_,
             "nlml": -float(gpr.log_marginal_likelihood(gpr.kernel_.theta)),
             "warnings": sorted({str(w.message) for w in caught}), "regressor": gpr}
+
+
+def default_kernel(d):
+    """The kernel a user writes for this model with every parameter at the default scikit-learn documents
+    (constant_value = length_scale = noise_level = 1.0, bounds (1e-5, 1e5)), one length-scale per input."""
+    return ConstantKernel() * RBF(np.ones(d)) + WhiteKernel()
+
+
+def default_fit_case(X, y, repeats):
+    """Case e: a whole fit as a user calls it, GaussianProcessRegressor(default_kernel(D),
+    n_restarts_optimizer=0) with every other setting at its default (alpha = 1e-10, L-BFGS-B at SciPy's
+    tolerances): one start, from the default kernel. Returns the time, the evaluations, the optimum in
+    gpilqg's theta and its NLML under the common function nlml_of (alpha = 0, gpilqg's model)."""
+    def work():
+        gpr = _CountingRegressor(default_kernel(X.shape[1]), n_restarts_optimizer=0)
+        return gpr.fit(X, y)
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        timing, gpr = time_repeated(repeats, work, warm_up=False)
+    theta = from_sklearn(gpr.kernel_.theta)
+    return {**timing, "theta": theta.tolist(), "evaluations": gpr.evaluations_, "nlml": nlml_of(X, y, theta),
+            "start": from_sklearn(default_kernel(X.shape[1]).theta).tolist(),
+            "warnings": sorted({str(w.message) for w in caught})}
+
+
+def nlml_of(X, y, theta):
+    """scikit-learn's NLML of (X, y) at gpilqg's theta with alpha = 0: the function both fits of case e
+    are scored with."""
+    return nlml_at(_conditioned(X, y, theta), theta)
 
 
 def nlml_at(gpr, theta):

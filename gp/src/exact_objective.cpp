@@ -1,14 +1,21 @@
 /// The exact GP's negative log marginal likelihood and its gradient (GPML eqs. 2.30 and 5.9).
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "dense_cholesky.hpp"
 #include "exact_gp_internal.hpp"
+#include "parallel.hpp"
 
 namespace gpilqg::gp::detail {
 
 namespace {
+
+/// From this many points on, the O(N^2 D) gradient sums run on the objective's threads (below it,
+/// starting the helpers costs more than the sums; the kernel matrix uses the same bound).
+constexpr Eigen::Index kParallelGradientSize = 512;
 
 class ExactObjective final : public MarginalLikelihoodObjective {
  public:
@@ -50,23 +57,20 @@ class ExactObjective final : public MarginalLikelihoodObjective {
     if (gradient == nullptr) return result;
 
     inverse_from_cholesky(factor_, threads_);  // factor_ now holds K^-1 (lower)
-    const Matrix& inverse = factor_;
     gradient->setZero(parameter_count());
-    if (weighted_.size() != n) weighted_.resize(n);
-    double sum_weighted_kernel = 0.0;
-    double trace_w = 0.0;
-    for (Eigen::Index j = 0; j < n; ++j) {
-      const double w_jj = inverse(j, j) - alpha_(j) * alpha_(j);
-      trace_w += w_jj;
-      sum_weighted_kernel += w_jj * kernel_(j, j);
-      const Eigen::Index m = n - j - 1;
-      if (m == 0) continue;
-      auto q = weighted_.head(m).array();
-      q = (inverse.col(j).tail(m).array() - alpha_(j) * alpha_.tail(m).array()) * kernel_.col(j).tail(m).array();
-      sum_weighted_kernel += 2.0 * q.sum();
-      for (int dim = 0; dim < d; ++dim)
-        (*gradient)(dim) += (q * (data_.inputs.col(dim).tail(m).array() - data_.inputs(j, dim)).square()).sum();
+    // Worker w sums columns w, w + workers, ... (column j has n - j - 1 entries below the diagonal,
+    // so the strides balance) into its own partial sums, which are added in worker order: the same
+    // operations in the same order on every run with the same number of threads.
+    const int workers = n >= kParallelGradientSize ? std::max(1, threads_) : 1;
+    if (static_cast<int>(partial_.size()) < workers) {
+      partial_.resize(static_cast<std::size_t>(workers));
+      weighted_.resize(static_cast<std::size_t>(workers));
     }
+    for (int w = 0; w < workers; ++w) partial_[static_cast<std::size_t>(w)].setZero(d + 2);
+    run_workers(threads_, workers, [&](int worker, int count) { gradient_columns(alpha_, worker, count); });
+    for (int w = 0; w < workers; ++w) *gradient += partial_[static_cast<std::size_t>(w)];
+    const double sum_weighted_kernel = (*gradient)(d);
+    const double trace_w = (*gradient)(d + 1);
     // The strict lower triangle counts twice in the full sums; the 0.5 of eq. 5.9 cancels that.
     gradient->head(d).array() *= inverse_squared_lengthscales.array();
     (*gradient)(d) = sum_weighted_kernel;
@@ -81,6 +85,30 @@ class ExactObjective final : public MarginalLikelihoodObjective {
   }
 
  private:
+  /// Columns first, first + stride, ... of the sums of evaluate() into partial_[first]: entries 0..D-1
+  /// the length-scale sums sum_ij W_ij Kf_ij (x_id - x_jd)^2 (before the factor 1 / l_d^2), entry D
+  /// sum_ij W_ij Kf_ij, entry D + 1 tr(W), from factor_ = K^-1 and kernel_ = Kf (lower triangles).
+  void gradient_columns(const Vector& alpha, int first, int stride) {
+    const int d = data_.input_dim();
+    const Eigen::Index n = data_.size();
+    const Matrix& inverse = factor_;
+    Vector& sums = partial_[static_cast<std::size_t>(first)];
+    Vector& weighted = weighted_[static_cast<std::size_t>(first)];
+    if (weighted.size() != n) weighted.resize(n);
+    for (Eigen::Index j = first; j < n; j += stride) {
+      const double w_jj = inverse(j, j) - alpha(j) * alpha(j);
+      sums(d + 1) += w_jj;
+      sums(d) += w_jj * kernel_(j, j);
+      const Eigen::Index m = n - j - 1;
+      if (m == 0) continue;
+      auto q = weighted.head(m).array();
+      q = (inverse.col(j).tail(m).array() - alpha(j) * alpha.tail(m).array()) * kernel_.col(j).tail(m).array();
+      sums(d) += 2.0 * q.sum();
+      for (int dim = 0; dim < d; ++dim)
+        sums(dim) += (q * (data_.inputs.col(dim).tail(m).array() - data_.inputs(j, dim)).square()).sum();
+    }
+  }
+
   TrainingSet data_;
   int threads_;
   double min_noise_std_;
@@ -89,7 +117,8 @@ class ExactObjective final : public MarginalLikelihoodObjective {
   Matrix kernel_;   // lower triangle of Kf = K(X, X) without noise
   Matrix factor_;   // chol(K), then K^-1 (lower)
   Vector alpha_;
-  Vector weighted_;
+  std::vector<Vector> weighted_;  // per worker
+  std::vector<Vector> partial_;   // per worker: the sums of gradient_columns
 };
 
 // ---------------------------------------------------------------------------------------------------

@@ -27,8 +27,42 @@ struct ObjectiveBridge {
   double max_jitter = 0.0;
   double best_value = std::numeric_limits<double>::infinity();
   Vector best_theta;
+  // The last evaluation with a gradient: the fitter evaluates each start before NLopt does, and
+  // NLopt's first request at that point is answered from here instead of evaluating it twice.
+  std::vector<double> last_x;
+  std::vector<double> last_gradient;
+  double last_value = 0.0;
 
+  /// The nlml at x (the failure value of fit.hpp for a failed evaluation) and, when `grad` is not
+  /// empty, its gradient.
   double operator()(const std::vector<double>& x, std::vector<double>& grad) {
+    if (!grad.empty() && x == last_x) {
+      grad = last_gradient;
+      return last_value;
+    }
+    const double value = evaluate(x, grad);
+    if (!grad.empty()) {
+      last_x = x;
+      last_gradient = grad;
+      last_value = value;
+    }
+    return value;
+  }
+
+  /// NLopt's objective: its variables z are the parameters in units of `step` (first_step_unit).
+  static double call(const std::vector<double>& z, std::vector<double>& grad, void* self) {
+    ObjectiveBridge& bridge = *static_cast<ObjectiveBridge*>(self);
+    bridge.parameters.resize(z.size());
+    for (std::size_t i = 0; i < z.size(); ++i) bridge.parameters[i] = bridge.step * z[i];
+    const double value = bridge(bridge.parameters, grad);
+    for (double& g : grad) g *= bridge.step;
+    return value;
+  }
+  double step = 1.0;
+  std::vector<double> parameters;  // reused buffer of call
+
+ private:
+  double evaluate(const std::vector<double>& x, std::vector<double>& grad) {
     theta = Eigen::Map<const Vector>(x.data(), static_cast<Eigen::Index>(x.size()));
     const NlmlEvaluation e = objective->evaluate(theta, grad.empty() ? nullptr : &gradient);
     ++evaluations;
@@ -47,10 +81,6 @@ struct ObjectiveBridge {
     }
     return e.value;
   }
-
-  static double call(const std::vector<double>& x, std::vector<double>& grad, void* self) {
-    return (*static_cast<ObjectiveBridge*>(self))(x, grad);
-  }
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -58,6 +88,22 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 std::vector<double> to_std(const Vector& v) { return {v.data(), v.data() + v.size()}; }
+
+/// The unit of NLopt's variables for a start whose gradient there is g0: the power of two nearest to
+/// 1 / sqrt(max(1, |g0|_inf)). L-BFGS's first iteration is a steepest-descent step whose first trial
+/// is the unit step in the optimiser's variables, -step g0 in its variables, i.e. -step^2 g0 in the
+/// parameters: with this unit no parameter moves by more than about 1 (a factor of e in a
+/// log-parametrised quantity), instead of by |g0|_inf, which grows with N (the nlml is a sum over the
+/// data) and sends the first trial far outside the region the line search then backtracks into.
+/// Later steps use the curvature L-BFGS has measured. A power of two keeps parameters = step x
+/// variables exact, and xtol_rel and ftol_rel are relative, so the stopping rules do not change.
+double first_step_unit(const std::vector<double>& g0) {
+  double largest = 1.0;
+  for (const double g : g0) largest = std::max(largest, std::abs(g));
+  return std::isfinite(largest) ? std::exp2(-std::round(0.5 * std::log2(largest))) : 1.0;
+}
+
+std::vector<double> in_units(const Vector& v, double step) { return to_std(v / step); }
 
 Vector clip(const Vector& theta, const ParameterBounds& b) {
   return theta.cwiseMax(b.lower).cwiseMin(b.upper);
@@ -99,11 +145,9 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
   FitSummary& s = out.summary;
   s.parameters = p;
 
-  std::vector<double> no_gradient;
-  {
-    std::vector<double> x0 = to_std(starts.front());
-    s.initial_nlml = bridge(x0, no_gradient);
-  }
+  // With optimisation, with its gradient: NLopt's first evaluation of the first start is this one.
+  std::vector<double> first_gradient(options.optimise ? static_cast<std::size_t>(p) : 0);
+  s.initial_nlml = bridge(to_std(starts.front()), first_gradient);
   if (!options.optimise) {
     out.parameters = starts.front();
     s.starts = 1;
@@ -114,23 +158,25 @@ ParameterFit fit_parameters(MarginalLikelihoodObjective& objective, const FitOpt
     bool out_of_time = false;
     std::size_t begun = 0;
     for (std::size_t k = 0; k < starts.size(); ++k) {
+      if (options.max_seconds > 0.0 && seconds_since(start_time) >= options.max_seconds) {
+        out_of_time = true;  // no start begins once the time is used up
+        break;
+      }
+      ++begun;
+      // The start's gradient (NLopt's first evaluation, served from the bridge) sets its unit.
+      std::vector<double> gradient_at_start = first_gradient;
+      if (k > 0) bridge(to_std(starts[k]), gradient_at_start);
+      bridge.step = first_step_unit(gradient_at_start);
       nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(p));
-      opt.set_lower_bounds(to_std(bounds.lower));
-      opt.set_upper_bounds(to_std(bounds.upper));
+      opt.set_lower_bounds(in_units(bounds.lower, bridge.step));
+      opt.set_upper_bounds(in_units(bounds.upper, bridge.step));
       opt.set_min_objective(&ObjectiveBridge::call, &bridge);
       opt.set_maxeval(options.max_evaluations);
       opt.set_ftol_rel(options.relative_tolerance);
       opt.set_xtol_rel(options.parameter_tolerance);
-      if (options.max_seconds > 0.0) {
-        const double left = options.max_seconds - seconds_since(start_time);
-        if (left <= 0.0) {  // no start begins once the time is used up
-          out_of_time = true;
-          break;
-        }
-        opt.set_maxtime(left);
-      }
-      ++begun;
-      std::vector<double> x = to_std(starts[k]);
+      if (options.max_seconds > 0.0)  // the time left after the start's evaluation (for NLopt 0 is no limit)
+        opt.set_maxtime(std::max(options.max_seconds - seconds_since(start_time), 1e-9));
+      std::vector<double> x = in_units(starts[k], bridge.step);
       double value = 0.0;
       FitTermination termination = FitTermination::Converged;
       bool worked = true;

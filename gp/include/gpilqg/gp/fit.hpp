@@ -10,6 +10,13 @@
 /// data-driven initial values, then FitOptions::restarts random restarts (restart_parameters). The
 /// start with the lowest NLML wins.
 ///
+/// Each start is evaluated with its gradient g0 before NLopt begins; that evaluation answers NLopt's
+/// first request (no point is evaluated twice; for the first start it is FitSummary::initial_nlml).
+/// NLopt's variables are the parameters in units of a power of two near 1 / sqrt(max(1, |g0|_inf)),
+/// so that L-BFGS's first trial step, steepest descent with unit length in its variables, moves no
+/// parameter by more than about 1 (a factor of e in a log-parametrised quantity) instead of by
+/// |g0|_inf, which grows with N. The tolerances are relative, hence the same in either unit.
+///
 /// Time limit (FitOptions::max_seconds > 0): measured from the call; each start gets NLopt's maxtime
 /// set to the time left, which NLopt checks after every evaluation, and no start begins once none is
 /// left. A fit stopped so keeps its best point so far and reports FitTermination::TimeLimit and the
