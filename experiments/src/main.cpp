@@ -8,9 +8,13 @@
 
 #include <algorithm>
 #include <csignal>
+#include <cstdlib>
+#include <optional>
 #include <iostream>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
@@ -62,6 +66,15 @@ int main(int argc, char** argv) {
   // the process, and a program embedding the library chooses its own (Python already ignores
   // SIGXFSZ at start-up, so the Python module gets the same messages).
   std::signal(SIGXFSZ, SIG_IGN);
+  // OpenBLAS chose its kernels when it loaded; on a processor it does not know it falls back to SSE3
+  // kernels five times slower than the AVX-512 ones (gp/blas_library.hpp). The program then starts
+  // itself again with OPENBLAS_CORETYPE naming the right ones: the same command, the same process
+  // (execv keeps the process id, so MPI and a waiting parent see nothing), once, since the variable
+  // is set the second time. If the new start fails the program carries on with the kernels it has.
+  if (const std::optional<std::string> core = gpilqg::gp::better_openblas_coretype()) {
+    setenv("OPENBLAS_CORETYPE", core->c_str(), 1);
+    execv("/proc/self/exe", argv);
+  }
   CLI::App app{"gpilqg: data-driven robust optimal control (GP-corrected simulators, Robust-iLQG)",
                "gpilqg"};
   app.require_subcommand(1);

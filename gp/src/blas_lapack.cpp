@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstdlib>
 #include <cstddef>
 #include <filesystem>
 #include <stdexcept>
@@ -166,5 +167,25 @@ std::string library_description() {
 namespace gpilqg::gp {
 
 std::string blas_library() { return detail::blas::library_description(); }
+
+std::optional<std::string> better_openblas_coretype() {
+#if defined(__x86_64__)
+  if (std::getenv("OPENBLAS_CORETYPE") != nullptr) return std::nullopt;
+  using CoreName = const char* (*)();
+  const auto core_name = reinterpret_cast<CoreName>(dlsym(RTLD_DEFAULT, "openblas_get_corename"));
+  if (core_name == nullptr) return std::nullopt;  // not OpenBLAS
+  const std::string core = core_name();
+  // OpenBLAS's x86-64 kernel sets that use AVX2 or AVX-512 (its names as openblas_get_corename spells them).
+  for (const char* wide : {"Haswell", "Zen", "SkylakeX", "Cooperlake", "SapphireRapids", "Excavator"})
+    if (core == wide) return std::nullopt;
+  __builtin_cpu_init();
+  const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
+                      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+                      __builtin_cpu_supports("avx512vl");
+  if (avx512) return "SkylakeX";
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return "Haswell";
+#endif
+  return std::nullopt;
+}
 
 }  // namespace gpilqg::gp

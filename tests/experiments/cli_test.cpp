@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -50,6 +51,26 @@ TEST(Cli, VersionNamesTheBlasLibraryItLoaded) {
   const auto blas = result.out.find("BLAS: /");
   ASSERT_NE(blas, std::string::npos) << result.out;
   EXPECT_TRUE(result.out.find("blas", blas + 7) != std::string::npos) << result.out;
+}
+
+TEST(Cli, RunsOpenBlasOnKernelsThisProcessorCanUse) {
+  // OpenBLAS 0.3.21 falls back to its SSE3 ("Prescott") kernels on processors it does not know; the
+  // program then starts itself again with OPENBLAS_CORETYPE set (gp/blas_library.hpp).
+  if (std::getenv("OPENBLAS_CORETYPE") != nullptr) GTEST_SKIP() << "OPENBLAS_CORETYPE is set by the caller";
+  const auto result = test::run_cli("--version");
+  ASSERT_EQ(result.status, 0) << result.err;
+  const auto core = result.out.find(", core ");
+  if (core == std::string::npos) GTEST_SKIP() << "not OpenBLAS: " << result.out;
+#if defined(__x86_64__)
+  __builtin_cpu_init();
+  if (!(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))) GTEST_SKIP() << "no AVX2 here";
+  const std::string name = result.out.substr(core + 7, result.out.find(')', core) - core - 7);
+  bool wide = false;
+  for (const char* w : {"Haswell", "Zen", "SkylakeX", "Cooperlake", "SapphireRapids", "Excavator"}) wide = wide || name == w;
+  EXPECT_TRUE(wide) << "OpenBLAS runs its '" << name << "' kernels on a processor with AVX2:\n" << result.out;
+#else
+  GTEST_SKIP() << "x86-64 only";
+#endif
 }
 
 TEST(Cli, DataInfoPrintsASummaryTable) {
