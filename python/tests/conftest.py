@@ -1,6 +1,7 @@
 """Shared fixtures of the Python tests: the repository, the command-line program, the C++ cart-pole
 written again in Python."""
 
+import ctypes
 import os
 import pathlib
 import subprocess
@@ -14,9 +15,27 @@ SOURCE_DIR = pathlib.Path(os.environ.get("GPILQG_SOURCE_DIR", pathlib.Path(__fil
 CLI = os.environ.get("GPILQG_CLI", str(SOURCE_DIR / "build" / "experiments" / "gpilqg"))
 
 
+def this_process_openblas_core():
+    """The OpenBLAS kernels the gpilqg module runs on in this process (openblas_get_corename of the
+    libblas.so.3 it loaded), or None when the BLAS is not OpenBLAS."""
+    try:
+        name = ctypes.CDLL("libblas.so.3").openblas_get_corename
+    except (OSError, AttributeError):
+        return None
+    name.restype = ctypes.c_char_p
+    return name().decode()
+
+
 def cli(*arguments):
-    """Runs the gpilqg program; returns (exit status, stdout, stderr)."""
-    r = subprocess.run([CLI, *map(str, arguments)], capture_output=True, text=True)
+    """Runs the gpilqg program; returns (exit status, stdout, stderr). The program runs on the OpenBLAS
+    kernels of this process (OPENBLAS_CORETYPE): the tests compare its results with the module's bit for
+    bit, and another kernel set rounds differently (the program chooses wider kernels than OpenBLAS's
+    own choice where that is a fallback, docs/building.md#blas, which a running Python cannot)."""
+    env = dict(os.environ)
+    core = this_process_openblas_core()
+    if core and "OPENBLAS_CORETYPE" not in env:
+        env["OPENBLAS_CORETYPE"] = core
+    r = subprocess.run([CLI, *map(str, arguments)], capture_output=True, text=True, env=env)
     return r.returncode, r.stdout, r.stderr
 
 
