@@ -74,13 +74,13 @@ std::vector<LibraryEffect> cartpole_library() {
   // Q = (Q_x, Q_theta); x = (x, x_dot, theta, theta_dot).
   using namespace effect_bases;
   std::vector<LibraryEffect> out;
-  out.push_back(linear_force_entry("cart_viscous_friction", {"b", "N s/m", 1.0}, "Q_x = -b x_dot", 2, viscous(0, 1)));
-  out.push_back(coulomb_friction_entry("cart_coulomb_friction", {"mu", "N", 1.0}, "x", "x_dot", 2, 0, 1));
-  out.push_back(linear_force_entry("pole_viscous_damping", {"c", "N m s/rad", 0.1}, "Q_theta = -c theta_dot", 2,
+  out.push_back(linear_force_entry("cart_viscous_friction", {"b", "N s/m", 1.0, 0.0}, "Q_x = -b x_dot", 2, viscous(0, 1)));
+  out.push_back(coulomb_friction_entry("cart_coulomb_friction", {"mu", "N", 1.0, 0.0}, "x", "x_dot", 2, 0, 1));
+  out.push_back(linear_force_entry("pole_viscous_damping", {"c", "N m s/rad", 0.1, 0.0}, "Q_theta = -c theta_dot", 2,
                                    viscous(1, 3)));
-  out.push_back(coulomb_friction_entry("pole_coulomb_friction", {"tau", "N m", 0.1}, "theta", "theta_dot", 2, 1, 3));
+  out.push_back(coulomb_friction_entry("pole_coulomb_friction", {"tau", "N m", 0.1, 0.0}, "theta", "theta_dot", 2, 1, 3));
   out.push_back(linear_force_entry("external_force_x", {"F", "N", 1.0}, "Q_x = F", 2, constant(0)));
-  out.push_back(linear_force_entry("quadratic_drag", {"c_d", "N s^2/m^2", 0.1}, "Q_x = -c_d |x_dot| x_dot", 2,
+  out.push_back(linear_force_entry("quadratic_drag", {"c_d", "N s^2/m^2", 0.1, 0.0}, "Q_x = -c_d |x_dot| x_dot", 2,
                                    quadratic_drag(1, 1)));
   out.push_back(actuator_gain_entry());
   out.push_back(input_delay_entry());
@@ -96,7 +96,7 @@ std::vector<LibraryEffect> quadrotor_library() {
   for (int i = 0; i < 3; ++i)
     out.push_back(linear_force_entry(std::string("external_force_") + axes[i], {"F", "N", 1.0},
                                      std::string("F_") + axes[i] + " = F (world frame)", 6, constant(i)));
-  out.push_back(linear_force_entry("quadratic_drag", {"c_d", "N s^2/m^2", 0.1}, "F_i = -c_d |v_i| v_i (world frame)", 6,
+  out.push_back(linear_force_entry("quadratic_drag", {"c_d", "N s^2/m^2", 0.1, 0.0}, "F_i = -c_d |v_i| v_i (world frame)", 6,
                                    quadratic_drag(3, 3)));
   out.push_back(actuator_gain_entry());
   out.push_back(input_delay_entry());

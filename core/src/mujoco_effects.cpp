@@ -98,9 +98,9 @@ std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
   for (const std::string& joint : system.joint_names()) {
     const int dof = system.joint_dof(joint);
     const bool slide = m->jnt_type[mj_name2id(m, mjOBJ_JOINT, joint.c_str())] == mjJNT_SLIDE;
-    out.push_back(linear_force_entry("joint_viscous_damping:" + joint, {"b", slide ? "N s/m" : "N m s/rad", 0.1},
+    out.push_back(linear_force_entry("joint_viscous_damping:" + joint, {"b", slide ? "N s/m" : "N m s/rad", 0.1, 0.0},
                                      fmt::format("Q_{0} = -b {0}_dot", joint), nv, viscous(dof, nv + dof)));
-    out.push_back(coulomb_friction_entry("joint_coulomb_friction:" + joint, {"tau", slide ? "N" : "N m", 0.1}, joint,
+    out.push_back(coulomb_friction_entry("joint_coulomb_friction:" + joint, {"tau", slide ? "N" : "N m", 0.1, 0.0}, joint,
                                          joint + "_dot", nv, dof, nv + dof));
   }
   for (const std::string& actuator : system.actuator_names()) {

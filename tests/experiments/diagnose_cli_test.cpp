@@ -121,6 +121,38 @@ TEST(DiagnoseCli, BadInputIsExitTwoNamingWhatIsWrong) {
   EXPECT_NE(missing.err.find("none.csv"), std::string::npos) << missing.err;
 }
 
+// --exclude leaves candidates out (by name or pattern), says so in both reports, and refuses a pattern that
+// names nothing or an excluded effect given to --add.
+TEST(DiagnoseCli, ExcludeLeavesCandidatesOutAndSaysWhich) {
+  const fs::path dir = test::temporary_dir("diagnose_exclude");
+  const fs::path data = friction_csv(dir);
+  const std::string base = "diagnose --system cartpole --data " + quote(data) + test::kFastDiagnose;
+  const auto result = test::run_cli(base + " --exclude 'pole_*' --exclude actuator_gain --json");
+  ASSERT_EQ(result.status, 0) << result.err;
+  const json j = json::parse(result.out);
+  EXPECT_EQ(j["excluded"], json::array({"pole_viscous_damping", "pole_coulomb_friction", "actuator_gain"}));
+  for (const json& entry : j["ranking"]) {
+    const std::string name = entry["effect"];
+    EXPECT_EQ(name.rfind("pole_", 0), std::string::npos) << name;
+    EXPECT_NE(name, "actuator_gain");
+  }
+  EXPECT_EQ(j["verdict"]["effect"], "cart_coulomb_friction");
+  // The hidden effect itself excluded: it is never proposed, and the text report says what was left out.
+  const auto without = test::run_cli(base + " --exclude cart_coulomb_friction");
+  ASSERT_EQ(without.status, 0) << without.err;
+  EXPECT_NE(without.out.find("excluded by --exclude (never ranked, searched or proposed): cart_coulomb_friction"),
+            std::string::npos) << without.out;
+  EXPECT_EQ(without.out.find("verdict: explained: cart_coulomb_friction"), std::string::npos) << without.out;
+
+  const auto nothing = test::run_cli(base + " --exclude 'wind*'");
+  EXPECT_EQ(nothing.status, 2);
+  EXPECT_NE(nothing.err.find("--exclude 'wind*': matches no candidate effect"), std::string::npos) << nothing.err;
+  EXPECT_NE(nothing.err.find("cart_viscous_friction"), std::string::npos) << nothing.err;
+  const auto both = test::run_cli(base + " --exclude cart_coulomb_friction --add cart_coulomb_friction");
+  EXPECT_EQ(both.status, 2);
+  EXPECT_NE(both.err.find("--add cart_coulomb_friction: the effect is excluded"), std::string::npos) << both.err;
+}
+
 TEST(DiagnoseCli, SimulateAddsHiddenEffectsOfTheLibrary) {
   const fs::path dir = test::temporary_dir("simulate_effect");
   const std::string base = "simulate --system cartpole --episodes 2 --steps 20 --seed 3 --out ";

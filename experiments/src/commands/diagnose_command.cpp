@@ -69,9 +69,12 @@ std::string plugin_option(const std::string& system) {
   return origin == "built-in" ? "" : " --plugin " + origin;
 }
 
-/// " --criterion simulation --window N" when the request has them, so that the next call uses the same criterion.
+/// " --criterion simulation --window N" and " --exclude P" when the request has them, so that the next
+/// call uses the same criterion and candidates.
 std::string criterion_options(const diagnosis::DiagnoseRequest& r) {
-  return r.window ? fmt::format(" --criterion {} --window {}", r.criterion, *r.window) : "";
+  std::string out = r.window ? fmt::format(" --criterion {} --window {}", r.criterion, *r.window) : "";
+  for (const std::string& pattern : r.exclude) out += " --exclude '" + pattern + "'";
+  return out;
 }
 
 int run_diagnose(const DiagnoseOptions& options_given) {
@@ -152,6 +155,9 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_flag("--auto", r.auto_select,
                 "Add several effects in one call: the best set of up to 4 effects on held-out data (or --search "
                 "forward), every set refitted jointly; --write-model writes the final model");
+  cmd->add_option("--exclude", r.exclude,
+                  "Leave candidate effects out of the ranking and the search: a name or a pattern (*, ?), e.g. "
+                  "'param:*.armature' (repeatable)");
   cmd->add_option("--search", r.search, "How --auto searches: subsets (every set of up to 4 effects) or forward")
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the report");

@@ -1,5 +1,9 @@
 #include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
 
+#include <fnmatch.h>
+
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -12,6 +16,33 @@
 
 namespace gpilqg::diagnosis {
 
+std::vector<std::string> excluded_effects(const std::vector<std::string>& patterns, const ModelSpec& model,
+                                          const std::vector<std::string>& add) {
+  const std::vector<LibraryEffect> candidates = candidate_effects(model);
+  std::vector<std::string> out;
+  for (const std::string& pattern : patterns) {
+    bool matched = false;
+    for (const LibraryEffect& effect : candidates) {
+      if (::fnmatch(pattern.c_str(), effect.name.c_str(), 0) != 0) continue;
+      matched = true;
+      if (std::find(out.begin(), out.end(), effect.name) == out.end()) out.push_back(effect.name);
+    }
+    if (!matched)
+      throw InputError(fmt::format("--exclude '{}': matches no candidate effect; expected a name or a pattern (*, ?) "
+                                   "over the candidates: {}",
+                                   pattern, candidate_names(model)));
+  }
+  for (const std::string& name : add)
+    if (std::find(out.begin(), out.end(), name) != out.end())
+      throw InputError(fmt::format("--add {}: the effect is excluded by --exclude; expected an effect that is not excluded",
+                                   name));
+  // The candidates' order, whatever the order of the patterns.
+  std::vector<std::string> ordered;
+  for (const LibraryEffect& effect : candidates)
+    if (std::find(out.begin(), out.end(), effect.name) != out.end()) ordered.push_back(effect.name);
+  return ordered;
+}
+
 DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   DiagnosisOptions d;
   if (!o.model_file.empty()) {
@@ -23,6 +54,9 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
     d.model.preset = *preset;
   }
   for (const std::string& text : o.add) d.add.push_back(parse_add_option(text, d.model));
+  std::vector<std::string> added;
+  for (const EffectRequest& e : d.add) added.push_back(e.effect);
+  d.exclude = excluded_effects(o.exclude, d.model, added);
   const auto integrator = parse_integrator(o.integrator);
   if (!integrator) throw InputError("--integrator '" + o.integrator + "': expected 'rk4' or 'euler'");
   d.integrator = *integrator;

@@ -10,6 +10,7 @@
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/input_delay.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
 namespace gpilqg::diagnosis {
@@ -84,8 +85,6 @@ Matrix shares(Matrix sensitivity) {
   return sensitivity;
 }
 
-void judge_remainder(Verdict& v, const DiagnosisOptions& o);
-
 Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   Verdict v;
   if (r.model_diverges) {
@@ -108,8 +107,7 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   }
   const RankedEffect& best = r.ranking.front();
   const EffectFit& f = best.fit;
-  const bool large = f.explained >= o.min_explained;
-  const bool significant = f.z_score >= o.min_z;
+  const EffectTestResult finding = test_effect(f, {o.min_explained, o.min_z});
   v.left = 1.0 - f.explained;
   v.gp_left = 1.0 - r.gp_explained_total;
   v.reason = fmt::format("the best candidate '{}' removes {:.1f}% of the held-out residual (z = {:.1f}); the GP removes {:.1f}%",
@@ -119,9 +117,9 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   if (simulation)
     v.reason += fmt::format(" of the one-step residual; the effects are scored on the simulation error over windows of {} "
                             "samples, so the GP's share is not required", o.window);
-  if (!large || !significant) {
+  if (!finding.accepted) {
     v.status = "unexplained";
-    v.reason += ", not a significant reduction";
+    v.reason += "; not a finding: " + finding.reason;
     return v;
   }
   if (!simulation && f.explained < o.relative_to_gp * r.gp_explained_total) {
@@ -131,30 +129,33 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   }
   v.effect = f;
   for (const auto& a : best.aliases) v.aliases.push_back(a.effect);
-  if (simulation) {
-    v.status = "explained";
-    return v;
-  }
-  judge_remainder(v, o);
+  // "explained" until the remainder test (judge_remainder) has seen what the effect leaves.
+  v.status = "explained";
   return v;
 }
 
-/// "explained" or "partly_explained" from what the proposed effects leave (v.left) against what the GP
-/// leaves (v.gp_left), shares of the diagnosed model's weighted held-out squared residual. A wrong
-/// effect can remove much of a residual (a Coulomb term alone takes 90% of what viscous friction,
-/// Coulomb friction and a constant force do together); it cannot leave as little as a flexible model
-/// of everything learnable from (x, u). What it leaves beyond that is structure it does not account
-/// for, and its interval assumes a model that the data reject.
-void judge_remainder(Verdict& v, const DiagnosisOptions& o) {
-  if (v.left <= o.explained_left_ratio * v.gp_left) {
-    v.status = "explained";
-    return;
-  }
+/// The remainder test, the same for every criterion: "explained" or "partly_explained" from what a
+/// flexible model finds in what the proposed effects leave. The flexible model is the model with the
+/// effects plus a GP of its one-step residual (fitted on the training episodes); `remainder` is the
+/// share of the effects' weighted held-out error (under the criterion) that it removes. A wrong effect
+/// can remove much of a residual (a Coulomb term alone takes 90% of what viscous friction, Coulomb
+/// friction and a constant force do together); what it leaves then still has structure, which the
+/// GP of its remainder finds. "explained" when the effects leave at most explained_left_ratio (1.5)
+/// times what the flexible model leaves, i.e. remainder <= 1 - 1 / 1.5 = 1/3. Unlike a comparison
+/// with the GP of the model without the effects, this cannot pass by default when that GP explains
+/// little: the GP is fitted to what the effects leave.
+void judge_remainder(Verdict& v, double remainder, const DiagnosisOptions& o) {
+  if (!v.effect || v.status != "explained") return;
+  v.remainder = remainder;
+  const double allowed = 1.0 - 1.0 / o.explained_left_ratio;
+  v.reason += fmt::format("; the GP of what {} leave{} removes {:.1f}% of it", v.effects.size() > 1 ? "the effects" : "the effect",
+                          v.effects.size() > 1 ? "" : "s", 100.0 * remainder);
+  if (remainder <= allowed) return;
   v.status = "partly_explained";
-  v.reason += fmt::format(": what is left is {:.1f} times what the GP leaves (at most {:g} for \"explained\"), so the "
-                          "data reject the model with {} alone; its interval assumes that model",
-                          v.gp_left > 0.0 ? v.left / v.gp_left : 0.0, o.explained_left_ratio,
-                          v.effects.empty() ? std::string("this effect") : std::string("these effects"));
+  v.reason += fmt::format(" (at most {:.1f}% for \"explained\": what is left is at most {:g} times what a flexible model "
+                          "leaves), so the data reject the model with {} alone; its interval assumes that model",
+                          100.0 * allowed, o.explained_left_ratio,
+                          v.effects.size() > 1 ? std::string("these effects") : std::string("this effect"));
 }
 
 /// The verdict once --auto has chosen its set: what the whole set leaves (each step's share is of
@@ -175,13 +176,14 @@ void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0
   if (is_new(last.effect)) v.effects.push_back(last.effect);
   for (const EffectValues& e : last.refitted)
     if (is_new(e.effect)) v.effects.push_back(e.effect);
+  // The verdict is the set's: its values and intervals are those of the set's joint fit, and the
+  // single effect's aliases are not the set's.
+  v.effect = last;
+  v.aliases.clear();
   v.reason = fmt::format("the {} effect(s) chosen by --auto ({}) remove {:.1f}% of the held-out residual; the GP removes {:.1f}%",
                          v.effects.size(), fmt::join(v.effects, ", "), 100.0 * (1.0 - left), 100.0 * (1.0 - v.gp_left));
-  if (o.criterion == FitCriterion::Simulation) {
+  if (o.criterion == FitCriterion::Simulation)
     v.reason += " of the one-step residual (the effects are scored on the simulation error)";
-    return;
-  }
-  judge_remainder(v, o);
 }
 
 /// The one-step residual of `model` on settings.data, integrated as `settings` says and driven by
@@ -364,15 +366,16 @@ void where(const DiagnosisOptions& o, const MeasurementSet& set, DiagnosisReport
 void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidates, DiagnosisReport& R) {
   R.criterion = o.criterion;
   R.window = o.window;
-  const FitContext context = criterion_context({&R.data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual},
-                                               o.criterion, o.window, &R.window_restarts);
+  FitContext context = criterion_context({&R.data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual},
+                                         o.criterion, o.window, &R.window_restarts);
+  context.excluded = o.exclude;
+  R.excluded = o.exclude;
   const std::vector<RefitEffect> present = o.auto_select ? model_effects(R.model, candidates) : std::vector<RefitEffect>{};
   if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_gain, o.progress, present, o.gp.threads);
   // The GP sees (x_t, u_t) only: the residual of an effect of the input history (input_delay) looks
   // like noise to it. An effect that removes a large and significant share of the held-out residual
   // shows that the residual is not at its floor, whatever the GP found.
-  if (R.consistent && !R.ranking.empty() && R.ranking.front().fit.explained >= o.min_explained &&
-      R.ranking.front().fit.z_score >= o.min_z)
+  if (R.consistent && !R.ranking.empty() && test_effect(R.ranking.front().fit, {o.min_explained, o.min_z}).accepted)
     R.consistent = false;
   R.verdict = decide(R, o);
   if (!o.auto_select || R.model_diverges) return;
@@ -402,7 +405,7 @@ void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidat
 /// models on the held-out episodes: sim, sim + effect, sim + GP and sim + effect + GP, with the GP's
 /// learned signal variance. Returns whether the four-model comparison exists.
 bool add(const DiagnosisOptions& o, const ModelAsGiven& given, const std::vector<LibraryEffect>& candidates,
-         const FitContext& settings, DiagnosisReport& R) {
+         const FitContext& settings, DiagnosisReport& R, ResidualGp& gp_after) {
   const Transitions& data = R.data;
   R.model_next = R.model;
   const ModelSpec* with_effect = nullptr;
@@ -421,8 +424,9 @@ bool add(const DiagnosisOptions& o, const ModelAsGiven& given, const std::vector
     base_gp = &R.gp;
     base_residual = R.residual;
     R.residual_after = residual_of_model(R.model_next, settings);
-    for (const SelectionStep& s : R.selection->steps)
-      R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + s.fit.effect;
+    // The effects of the final set, each once (a step's lead can be an effect an earlier step had).
+    for (const std::string& name : R.verdict.effects)
+      R.comparison_effect += (R.comparison_effect.empty() ? "" : " + ") + name;
   } else if (R.verdict.effect) {
     proposed = R.model.with(named(candidates, R.verdict.effect->effect), R.verdict.effect->estimate);
     R.model_next = proposed;
@@ -433,10 +437,9 @@ bool add(const DiagnosisOptions& o, const ModelAsGiven& given, const std::vector
     R.comparison_effect = R.verdict.effect->effect;
   }
   if (with_effect == nullptr) return false;
-  const ResidualGp gp_after = !o.add.empty()
-                                  ? R.gp
-                                  : fit_residual_gp(make_step_model(*with_effect, o.integrator, R.dt, o.substeps), data,
-                                                    R.residual_after, o.gp);
+  gp_after = !o.add.empty() ? R.gp
+                            : fit_residual_gp(make_step_model(*with_effect, o.integrator, R.dt, o.substeps), data,
+                                              R.residual_after, o.gp);
   R.residual_base = base_residual;
   R.relevance_base = !o.add.empty() ? shares(gp_sensitivity(given.gp, data, data.rows(false))) : R.relevance;
   R.comparison.push_back({"sim", heldout_rmse(data, base_residual), Vector()});
@@ -444,6 +447,42 @@ bool add(const DiagnosisOptions& o, const ModelAsGiven& given, const std::vector
   R.comparison.push_back({"sim+GP", heldout_rmse(data, base_residual - base_gp->mean), base_gp->signal_variance});
   R.comparison.push_back({"sim+effect+GP", heldout_rmse(data, R.residual_after - gp_after.mean), gp_after.signal_variance});
   return true;
+}
+
+/// What a flexible model removes of what `model` leaves on the held-out rows, under the criterion:
+/// the flexible model is `model` plus the mean of `gp`, the GP of its one-step residual `residual`
+/// (gp.model). One-step: 1 - sum_w (r - mu)^2 / sum_w r^2. Simulation: the same with the simulation
+/// errors of both models over the criterion's windows from measured states. Weighted with R.weights.
+double flexible_share(const ModelSpec& model, const Matrix& residual, const ResidualGp& gp, const DiagnosisOptions& o,
+                      const DiagnosisReport& R) {
+  if (o.criterion == FitCriterion::OneStep) return weighted_heldout_explained(R.data, residual, gp.mean, R.weights);
+  const std::vector<int> rows = R.data.rows(true);
+  const Matrix u = applied_controls(R.data, model.input_delay);
+  const Matrix plain = simulated_predictions(*make_step_model(model, o.integrator, R.dt, o.substeps), R.data, u, rows, o.window);
+  const Matrix flexible = simulated_predictions(*gp.model, R.data, u, rows, o.window);
+  double before = 0.0, after = 0.0;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const auto row = R.data.x_next.row(rows[k]);
+    before += (row - plain.row(static_cast<Eigen::Index>(k))).cwiseAbs2().dot(R.weights);
+    after += (row - flexible.row(static_cast<Eigen::Index>(k))).cwiseAbs2().dot(R.weights);
+  }
+  return before > 0.0 ? 1.0 - after / before : 0.0;
+}
+
+/// The remainder test of the verdict (judge_remainder) on the model it proposes: model_next with the
+/// GP of the four-model comparison, or, when --add effects were given and the verdict proposes one
+/// more, the diagnosed model with it and a GP of its residual.
+void judge_proposal(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidates, const FitContext& settings,
+                    bool compared, const ResidualGp& gp_after, DiagnosisReport& R) {
+  if (!R.verdict.effect || R.verdict.status != "explained") return;
+  if (o.add.empty() && compared) {
+    judge_remainder(R.verdict, flexible_share(R.model_next, R.residual_after, gp_after, o, R), o);
+    return;
+  }
+  const ModelSpec proposed = R.model.with(named(candidates, R.verdict.effect->effect), R.verdict.effect->estimate);
+  const Matrix residual = residual_of_model(proposed, settings);
+  const ResidualGp gp = fit_residual_gp(make_step_model(proposed, o.integrator, R.dt, o.substeps), R.data, residual, o.gp);
+  judge_remainder(R.verdict, flexible_share(proposed, residual, gp, o, R), o);
 }
 
 /// The measured inputs as `model` applies them (its input delay).
@@ -491,7 +530,9 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o)
   compare(o, set, *step, floors, R);
   where(o, set, R);
   which(o, candidates, R);
-  const bool compared = add(o, given, candidates, settings, R);
+  ResidualGp gp_after;
+  const bool compared = add(o, given, candidates, settings, R, gp_after);
+  judge_proposal(o, candidates, settings, compared, gp_after, R);
   falls(o, set, given, compared, R);
   return R;
 }

@@ -14,8 +14,10 @@
 #include <Eigen/Dense>
 
 #include "gpilqg/core/fork_join.hpp"
+#include "gpilqg/core/generalised_forces.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 
@@ -88,6 +90,12 @@ struct EffectSet {
     std::size_t e = 0;
     while (offset[e + 1] <= j) ++e;
     return effects[e]->parameters[static_cast<std::size_t>(j - offset[e])];
+  }
+  /// Every effect's value in `base` (ModelSpec::current_values): the stacked values without the set.
+  Vector null_values(const ModelSpec& base) const {
+    Vector out(size());
+    for (std::size_t e = 0; e < effects.size(); ++e) out.segment(offset[e], length(e)) = base.current_values(*effects[e]);
+    return out;
   }
   /// `base` with every effect of the set at its slice of theta (ModelSpec::with, which validates).
   ModelSpec model_at(const ModelSpec& base, const VectorCRef& theta) const {
@@ -229,8 +237,11 @@ std::pair<Vector, Vector> confidence_interval(const EffectSet& set, const Vector
       variance = variance.cwiseMax(jack * (R - 1.0) / R);
     }
   }
-  if (!variance.allFinite()) variance.setZero();
-  const Vector half = 1.96 * variance.cwiseMax(0.0).cwiseSqrt();
+  // A covariance that is not finite (a regressor of zero at theta_hat: a fit that ran away to where
+  // the data no longer see it) is no interval of zero width but an unbounded one.
+  Vector half = 1.96 * variance.cwiseMax(0.0).cwiseSqrt();
+  for (Eigen::Index j = 0; j < p; ++j)
+    if (!std::isfinite(half(j)) || !(A(j, j) > 0.0)) half(j) = std::numeric_limits<double>::infinity();
   return {estimate - half, estimate + half};
 }
 
@@ -256,11 +267,12 @@ EffectFit led_by(EffectFit fit, const EffectValues& values) {
   fit.ci_low = values.ci_low;
   fit.ci_high = values.ci_high;
   fit.smoothing = values.smoothing;
+  fit.null_value = values.null_value;
   return fit;
 }
 
 EffectValues own_values(const EffectFit& fit) {
-  return {fit.effect, fit.parameters, fit.initial, fit.estimate, fit.ci_low, fit.ci_high, fit.smoothing};
+  return {fit.effect, fit.parameters, fit.initial, fit.estimate, fit.ci_low, fit.ci_high, fit.smoothing, fit.null_value};
 }
 
 Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows) {
@@ -270,8 +282,8 @@ Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, 
 
 namespace {
 
-EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& theta_ls, const Vector& theta_hat,
-                     const Vector& ci_low, const Vector& ci_high, EffectFit fit);
+EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& null, const Vector& theta_ls,
+                     const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high, EffectFit fit);
 
 /// S(theta), or +inf where the model diverges or does not accept theta (a mass of 0, say).
 double objective_at(const EffectSet& set, const VectorCRef& theta, const FitContext& c, const std::vector<int>& rows) {
@@ -322,6 +334,69 @@ double refine_gauss_newton(const EffectSet& set, Vector& theta, const Vector& lo
 constexpr int kLinearRefinements = 2;
 constexpr int kNonlinearRefinements = 12;
 
+/// The state indices of the generalised velocities of `system` (generalised_coordinates), or every
+/// state when it has no generalised-force map. Built once per system.
+const std::vector<int>& velocity_states(const ModelSpec& model) {
+  static std::mutex guard;
+  static std::map<std::string, std::vector<int>> known;
+  const std::lock_guard<std::mutex> lock(guard);
+  auto it = known.find(model.system);
+  if (it != known.end()) return it->second;
+  const DynamicsPtr dynamics = model.build();
+  std::vector<int> states;
+  for (const GeneralisedCoordinate& q : generalised_coordinates(*dynamics)) states.push_back(q.velocity);
+  if (states.empty())
+    for (int i = 0; i < dynamics->state_dim(); ++i) states.push_back(i);
+  return known.emplace(model.system, std::move(states)).first->second;
+}
+
+/// Each parameter's scale on the data (EffectFit::scale): max(|null_j|, |m| / |J_j|) over the
+/// velocity rows of the weighted training rows, m = sqrt(w) (x_hat_{r+1} - x_r) the model's own
+/// predicted change (x_hat = x_next - residual under the criterion). Infinite where J_j is zero on
+/// them (nothing to compare with).
+Vector data_scales(const Matrix& J, const FitContext& c, const std::vector<int>& rows, const Vector& null) {
+  const std::vector<int>& velocities = velocity_states(c.model);
+  const auto n = static_cast<Eigen::Index>(c.weights.size());
+  double motion = 0.0;
+  Vector column = Vector::Zero(J.cols());
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const int r = rows[k];
+    for (int i : velocities) {
+      if (i >= n) continue;
+      const double w = c.weights(i);
+      const double change = c.data->x_next(r, i) - c.residual(r, i) - c.data->x(r, i);
+      motion += w * change * change;
+      column += J.row(static_cast<Eigen::Index>(k) * n + i).transpose().cwiseAbs2();
+    }
+  }
+  Vector scale(J.cols());
+  for (Eigen::Index j = 0; j < J.cols(); ++j)
+    scale(j) = std::max(std::abs(null(j)), column(j) > 0.0 ? std::sqrt(motion / column(j))
+                                                           : std::numeric_limits<double>::infinity());
+  return scale;
+}
+
+/// Test 1 of effect_test.hpp on a finished fit: a covariance that is not finite, or a parameter
+/// further than kRunawayFactor times its scale from its value without the effect.
+void check_identifiable(const EffectSet& set, const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high,
+                        const Vector& null, EffectFit& fit) {
+  for (Eigen::Index j = 0; j < theta_hat.size() && fit.identifiable; ++j) {
+    const EffectParameter& spec = set.parameter(j);
+    if (!std::isfinite(ci_low(j)) || !std::isfinite(ci_high(j))) {
+      fit.identifiable = false;
+      fit.not_identifiable = fmt::format("the covariance of {} = {:.4g} {} is not finite: the data do not see it there",
+                                         spec.name, theta_hat(j), spec.unit);
+    } else if (std::abs(theta_hat(j) - null(j)) > kRunawayFactor * fit.scale(j)) {
+      fit.identifiable = false;
+      fit.not_identifiable =
+          fmt::format("{} = {:.4g} {} lies {:.3g} times its scale on these data ({:.3g} {}) from its value without the "
+                      "effect ({:.4g}); more than {:g} times is a fit that ran away",
+                      spec.name, theta_hat(j), spec.unit, std::abs(theta_hat(j) - null(j)) / fit.scale(j), fit.scale(j),
+                      spec.unit, null(j), kRunawayFactor);
+    }
+  }
+}
+
 /// Steps 1-4 on the stacked parameters of `set`, from `initial`.
 EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext& c) {
   if (c.data == nullptr) throw std::invalid_argument("fit_effect: no data");
@@ -335,12 +410,15 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
   Vector theta_ls = initial, theta_hat = initial, ci_low = initial, ci_high = initial;
   EffectFit fit;
   fit.training_objective_before = weighted_model_residual(c, training).squaredNorm();
+  const Vector null = set.null_values(c.model);
 
   // 1. Linear least squares at theta_0 (a Gauss-Newton step from a warm start for a joint fit).
   const Matrix J = regressor(set, initial, c, training);
   fit.regressor = J.col(0);
+  fit.scale = data_scales(J, c, training, null);
   if (!(J.col(0).norm() > 0.0) || !J.allFinite()) {
     fit.identifiable = false;
+    fit.not_identifiable = "it does not change the predictions";
     fit.training_objective_after = weighted_residual_at(set, initial, c, training).squaredNorm();
   } else {
     const Vector r_initial = weighted_residual_at(set, initial, c, training);
@@ -353,23 +431,25 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
         refine_gauss_newton(set, theta_hat, lower, upper, c, training,
                             set.linear() ? kLinearRefinements : kNonlinearRefinements, fit.evaluations);
 
-    // 3. Interval.
+    // 3. Interval, and whether the data determine the fit.
     std::tie(ci_low, ci_high) = confidence_interval(set, theta_hat, c, training);
+    check_identifiable(set, theta_hat, ci_low, ci_high, null, fit);
   }
   // 4. Held-out scores; then each effect's slice.
   score_heldout(set, theta_hat, c, fit);
-  return finish_fit(set, initial, theta_ls, theta_hat, ci_low, ci_high, std::move(fit));
+  return finish_fit(set, initial, null, theta_ls, theta_hat, ci_low, ci_high, std::move(fit));
 }
 
 /// Each effect's slice of the stacked estimates into `fit` (the candidate) and fit.refitted (the others).
-EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& theta_ls, const Vector& theta_hat,
-                     const Vector& ci_low, const Vector& ci_high, EffectFit fit) {
+EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& null, const Vector& theta_ls,
+                     const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high, EffectFit fit) {
+  const Vector scale = fit.scale;
   for (std::size_t e = 0; e < set.effects.size(); ++e) {
     const Eigen::Index at = set.offset[e], length = set.length(e);
     const auto& smoothing = set.effects[e]->smoothing;
     EffectValues values{set.effects[e]->name,          set.effects[e]->parameters,   initial.segment(at, length),
                         theta_hat.segment(at, length), ci_low.segment(at, length), ci_high.segment(at, length),
-                        smoothing ? smoothing->width : 0.0};
+                        smoothing ? smoothing->width : 0.0,                          null.segment(at, length)};
     if (e == 0) {
       fit.effect = values.effect;
       fit.parameters = values.parameters;
@@ -379,6 +459,8 @@ EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& 
       fit.ci_low = values.ci_low;
       fit.ci_high = values.ci_high;
       fit.smoothing = values.smoothing;
+      fit.null_value = values.null_value;
+      if (scale.size() == theta_hat.size()) fit.scale = scale.segment(at, length);
     } else {
       fit.refitted.push_back(std::move(values));
     }
@@ -418,7 +500,7 @@ EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, co
   EffectFit fit;
   fit.effect = effect.name;
   fit.parameters = effect.parameters;
-  fit.initial = c.model.current_values(effect);
+  fit.initial = fit.null_value = c.model.current_values(effect);
   fit.linear_estimate = fit.estimate = fit.ci_low = fit.ci_high = values;
   if (effect.smoothing) fit.smoothing = effect.smoothing->width;
   const std::vector<int> training = c.data->rows(false);
@@ -450,6 +532,7 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_g
   std::vector<const LibraryEffect*> candidates;
   const std::vector<LibraryEffect> library = candidate_effects(context.model);
   for (const LibraryEffect& effect : library) {
+    if (std::find(context.excluded.begin(), context.excluded.end(), effect.name) != context.excluded.end()) continue;
     bool chosen = false;
     for (const RefitEffect& r : refit)
       chosen = chosen || r.effect->name == effect.name || same_physics(*system, r.effect->name, effect.name);
@@ -469,8 +552,14 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_g
       }
     }
   });
-  std::stable_sort(fits.begin(), fits.end(),
-                   [](const EffectFit& a, const EffectFit& b) { return a.explained > b.explained; });
+  // The order of standing (effect_test.hpp): identifiable fits whose interval excludes their value
+  // without them, then those whose interval holds it, each by held-out share; the fits that are not
+  // identifiable last, unranked.
+  const auto standing = [](const EffectFit& f) { return !f.identifiable ? 2 : interval_contains_null(own_values(f)) ? 1 : 0; };
+  std::stable_sort(fits.begin(), fits.end(), [&](const EffectFit& a, const EffectFit& b) {
+    const int sa = standing(a), sb = standing(b);
+    return sa != sb ? sa < sb : a.explained > b.explained;
+  });
   // Aliases: the joint fit of the pair does no better than either alone, or the same physics by
   // declaration. An effect that explains nothing alone is nobody's alias.
   const LinearisedFits joint(context, fits, refit, threads);
@@ -486,8 +575,8 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_g
     if (used[i]) continue;
     used[i] = true;
     RankedEffect entry{fits[i], {}};
-    for (std::size_t j = i + 1; j < fits.size(); ++j) {
-      if (used[j]) continue;
+    for (std::size_t j = i + 1; j < fits.size() && fits[i].identifiable; ++j) {
+      if (used[j] || !fits[j].identifiable) continue;
       if (!aliases(static_cast<int>(i), static_cast<int>(j))) continue;
       used[j] = true;
       entry.aliases.push_back(fits[j]);

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/subset_search.hpp"
 
 namespace gpilqg::diagnosis {
@@ -45,40 +46,38 @@ ModelSpec model_after(const ModelSpec& base, const EffectFit& fit, const std::ve
   return model;
 }
 
-namespace {
-
-/// True when the joint 95% interval of `v` contains `value` in every parameter.
-bool interval_contains(const EffectValues& v, const Vector& value) {
-  return (v.ci_low.array() <= value.array()).all() && (value.array() <= v.ci_high.array()).all();
+std::vector<std::string> names_of_effects(const std::vector<RefitEffect>& effects) {
+  std::vector<std::string> out;
+  for (const RefitEffect& r : effects) out.push_back(r.effect->name);
+  return out;
 }
 
-}  // namespace
-
-/// The backward check after a step. An effect chosen at an earlier step whose joint 95% interval now
-/// contains its value in M_0 (a force of 0, a gain of 1, the preset's parameter, no delay) is no
-/// longer needed: a later effect explains what it had soaked up. It is dropped and the others are
-/// refitted jointly, until none is left to drop. Effects M_0 had already are never dropped.
+/// The backward check after a step. A member of the joint fit (the lead or a refitted one) that M_0
+/// does not have and whose joint 95% interval contains its value in M_0 (a force of 0, a gain of 1,
+/// the preset's parameter, no delay) is no longer needed: another member explains what it had soaked
+/// up. It is dropped and the others are refitted jointly, until none is left to drop. Effects M_0
+/// had already are never dropped; a fit left with a single member keeps it (the test of the step
+/// then rejects it).
 EffectFit without_redundant(EffectFit fit, const FitContext& context, const FitContext& step_context,
                             const std::vector<LibraryEffect>& candidates, std::vector<std::string>& removed) {
-  const std::vector<RefitEffect> given = model_effects(context.model, candidates);
-  const auto in_m0 = [&](const std::string& name) {
-    return std::any_of(given.begin(), given.end(), [&](const RefitEffect& r) { return r.effect->name == name; });
-  };
+  const std::vector<std::string> in_m0 = names_of_effects(model_effects(context.model, candidates));
+  const auto given = [&](const std::string& name) { return std::find(in_m0.begin(), in_m0.end(), name) != in_m0.end(); };
   for (;;) {
-    const LibraryEffect* drop = nullptr;
-    for (const EffectValues& v : fit.refitted) {
-      const LibraryEffect& effect = named(candidates, v.effect);
-      if (!in_m0(v.effect) && interval_contains(v, context.model.current_values(effect))) {
-        drop = &effect;
-        break;
-      }
-    }
-    if (drop == nullptr) return fit;
-    removed.push_back(drop->name);
+    std::vector<EffectValues> members{own_values(fit)};
+    members.insert(members.end(), fit.refitted.begin(), fit.refitted.end());
+    if (members.size() < 2) return fit;
+    const auto drop = std::find_if(members.begin(), members.end(),
+                                   [&](const EffectValues& v) { return !given(v.effect) && interval_contains_null(v); });
+    if (drop == members.end()) return fit;
+    removed.push_back(drop->effect);
+    members.erase(drop);
+    // The new lead: the first member M_0 does not have, else the first.
+    const auto lead = std::find_if(members.begin(), members.end(), [&](const EffectValues& v) { return !given(v.effect); });
+    const EffectValues first = lead != members.end() ? *lead : members.front();
     std::vector<RefitEffect> keep;
-    for (const EffectValues& v : fit.refitted)
-      if (v.effect != drop->name) keep.push_back({&named(candidates, v.effect), v.estimate});
-    fit = fit_jointly(named(candidates, fit.effect), keep, step_context, fit.estimate);
+    for (const EffectValues& v : members)
+      if (v.effect != first.effect) keep.push_back({&named(candidates, v.effect), v.estimate});
+    fit = fit_jointly(named(candidates, first.effect), keep, step_context, first.estimate);
   }
 }
 
@@ -105,11 +104,9 @@ Selection select_effects(const FitContext& context, const SelectionOptions& o, s
     }
     const EffectFit& best = ranking.front().fit;
     std::vector<std::string> removed;
-    if (best.z_score < o.min_z || best.explained < o.min_explained) {
-      S.stop_reason = fmt::format(
-          "the best remaining candidate '{}' removes {:.1f}% of the held-out residual left (z = {:.1f}); adding an effect "
-          "needs at least {:.0f}% and z >= {:g}",
-          best.effect, 100.0 * best.explained, best.z_score, 100.0 * o.min_explained, o.min_z);
+    const EffectTestResult finding = test_effect(best, {o.min_explained, o.min_z}, names_of_effects(chosen));
+    if (!finding.accepted) {
+      S.stop_reason = fmt::format("the best remaining candidate '{}' is not added: {}", best.effect, finding.reason);
       S.rejected = std::move(ranking);
       break;
     }

@@ -98,6 +98,32 @@ LinearisedFits::LinearisedFits(const FitContext& c, const std::vector<EffectFit>
   cross_heldout_ = JH.transpose() * r0.heldout;
   base_heldout_ = r0.heldout.squaredNorm();
   base_train_ = r0.train.squaredNorm();
+
+  // The screening folds: the training episodes dealt in turn into K = min(5, episodes) folds.
+  std::vector<int> episodes;
+  for (int r : train) {
+    const int e = c.data->episode[static_cast<std::size_t>(r)];
+    if (std::find(episodes.begin(), episodes.end(), e) == episodes.end()) episodes.push_back(e);
+  }
+  const int K = std::min<int>(5, static_cast<int>(episodes.size()));
+  if (K < 2) return;
+  const auto n = static_cast<Eigen::Index>(c.weights.size());
+  fold_gram_.assign(static_cast<std::size_t>(K), Matrix::Zero(P, P));
+  fold_cross_.assign(static_cast<std::size_t>(K), Vector::Zero(P));
+  fold_base_.assign(static_cast<std::size_t>(K), 0.0);
+  for (std::size_t k = 0; k < train.size(); ++k) {
+    const int e = c.data->episode[static_cast<std::size_t>(train[k])];
+    const auto f = static_cast<std::size_t>((std::find(episodes.begin(), episodes.end(), e) - episodes.begin()) % K);
+    const auto rows = JT.middleRows(static_cast<Eigen::Index>(k) * n, n);
+    const auto r = r0.train.segment(static_cast<Eigen::Index>(k) * n, n);
+    fold_gram_[f].noalias() += rows.transpose() * rows;
+    fold_cross_[f].noalias() += rows.transpose() * r;
+    fold_base_[f] += r.squaredNorm();
+  }
+  for (std::size_t f = 0; f < fold_gram_.size(); ++f) {
+    rest_gram_.push_back(gram_train_ - fold_gram_[f]);
+    rest_cross_.push_back(cross_train_ - fold_cross_[f]);
+  }
 }
 
 int LinearisedFits::index(const std::string& name) const {
@@ -113,21 +139,26 @@ double LinearisedFits::training_left(const std::vector<int>& subset) const {
   return left(subset, gram_train_, cross_train_, base_train_);
 }
 
-double LinearisedFits::left(const std::vector<int>& subset, const Matrix& gram, const Vector& cross, double base) const {
+std::vector<Eigen::Index> LinearisedFits::columns_of(const std::vector<int>& subset) const {
   std::vector<Eigen::Index> cols;
   for (int e : subset)
     for (Eigen::Index j = offset_[static_cast<std::size_t>(e)]; j < offset_[static_cast<std::size_t>(e) + 1]; ++j)
       cols.push_back(j);
   for (Eigen::Index j = 0; j < refit_columns_; ++j) cols.push_back(offset_.back() + j);
+  return cols;
+}
+
+double LinearisedFits::left_of(const std::vector<Eigen::Index>& cols, const Matrix& gram_fit, const Vector& cross_fit,
+                               const Matrix& gram, const Vector& cross, double base) {
   if (cols.empty()) return base;
   const auto k = static_cast<Eigen::Index>(cols.size());
   Matrix GT(k, k), G(k, k);
   Vector bT(k), b(k);
   for (Eigen::Index a = 0; a < k; ++a) {
-    bT(a) = cross_train_(cols[static_cast<std::size_t>(a)]);
+    bT(a) = cross_fit(cols[static_cast<std::size_t>(a)]);
     b(a) = cross(cols[static_cast<std::size_t>(a)]);
     for (Eigen::Index c = 0; c < k; ++c) {
-      GT(a, c) = gram_train_(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(c)]);
+      GT(a, c) = gram_fit(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(c)]);
       G(a, c) = gram(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(c)]);
     }
   }
@@ -135,6 +166,19 @@ double LinearisedFits::left(const std::vector<int>& subset, const Matrix& gram, 
   const Vector theta = GT.completeOrthogonalDecomposition().solve(bT);
   if (!theta.allFinite()) return base;
   return std::max(0.0, base - 2.0 * theta.dot(b) + theta.dot(G * theta));
+}
+
+double LinearisedFits::left(const std::vector<int>& subset, const Matrix& gram, const Vector& cross, double base) const {
+  return left_of(columns_of(subset), gram_train_, cross_train_, gram, cross, base);
+}
+
+double LinearisedFits::screening_left(const std::vector<int>& subset) const {
+  if (fold_gram_.empty()) return training_left(subset);
+  const std::vector<Eigen::Index> cols = columns_of(subset);
+  double total = 0.0;
+  for (std::size_t f = 0; f < fold_gram_.size(); ++f)
+    total += left_of(cols, rest_gram_[f], rest_cross_[f], fold_gram_[f], fold_cross_[f], fold_base_[f]);
+  return total;
 }
 
 double LinearisedFits::gain(const std::vector<int>& subset, const std::vector<int>& reference) const {

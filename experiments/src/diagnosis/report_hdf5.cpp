@@ -1,3 +1,4 @@
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/report_hdf5.hpp"
 
 #include <chrono>
@@ -190,8 +191,11 @@ void write_ranking(Hdf5Writer& h5, const DiagnosisReport& r) {
   h5.attribute("/ranking", "window_restarts", static_cast<std::int64_t>(r.window_restarts));
   if (r.ranking.empty()) return;
   std::vector<std::string> effect, parameter, unit, aliases;
-  std::vector<double> estimate, low, high, explained, explained_ci, z, before, after;
+  std::vector<double> estimate, low, high, explained, explained_ci, z, before, after, null, identifiable, holds_null;
   for (const RankedEffect& e : r.ranking) {
+    null.push_back(e.fit.null_value.size() > 0 ? e.fit.null_value(0) : 0.0);
+    identifiable.push_back(e.fit.identifiable ? 1.0 : 0.0);
+    holds_null.push_back(interval_contains_null(own_values(e.fit)) ? 1.0 : 0.0);
     effect.push_back(e.fit.effect);
     parameter.push_back(e.fit.parameters[0].name);
     unit.push_back(e.fit.parameters[0].unit);
@@ -219,6 +223,9 @@ void write_ranking(Hdf5Writer& h5, const DiagnosisReport& r) {
   h5.write_vector("/ranking/z_score", z);
   h5.write_vector("/ranking/heldout_rmse_before", before);
   h5.write_vector("/ranking/heldout_rmse_after", after);
+  h5.write_vector("/ranking/null_value", null);
+  h5.write_vector("/ranking/identifiable", identifiable);
+  h5.write_vector("/ranking/interval_holds_null", holds_null);
 }
 
 void write_add(Hdf5Writer& h5, const DiagnosisReport& r) {
@@ -258,7 +265,7 @@ void write_selection(Hdf5Writer& h5, const DiagnosisReport& r) {
     explained.push_back(f.explained);
     z.push_back(f.z_score);
     effects.push_back(f.effect);
-    std::vector<EffectValues> values{{f.effect, f.parameters, f.initial, f.estimate, f.ci_low, f.ci_high}};
+    std::vector<EffectValues> values{own_values(f)};
     values.insert(values.end(), f.refitted.begin(), f.refitted.end());
     std::vector<std::string> names;
     std::vector<double> estimate, low, high;

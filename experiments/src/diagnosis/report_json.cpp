@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gpilqg/control/rollout.hpp"
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 
@@ -39,28 +40,37 @@ json parameters_json(const EffectFit& f, const Vector& values) {
   return out;
 }
 
-/// {"effect", "parameters", "parameter_ci95", "initial"} of an effect refitted jointly with another.
+/// An interval bound: a number, or null where the interval is unbounded (a covariance that is not finite).
+json bound_json(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+/// {"effect", "parameters", "parameter_ci95", "initial", "null_value", "interval_holds_null"} of an
+/// effect refitted jointly with another.
 json values_json(const EffectValues& v) {
-  json parameters = json::object(), ci = json::object(), initial = json::object();
+  json parameters = json::object(), ci = json::object(), initial = json::object(), null = json::object();
   for (std::size_t i = 0; i < v.parameters.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     parameters[v.parameters[i].name] = v.estimate(k);
-    ci[v.parameters[i].name] = {v.ci_low(k), v.ci_high(k)};
+    ci[v.parameters[i].name] = {bound_json(v.ci_low(k)), bound_json(v.ci_high(k))};
     initial[v.parameters[i].name] = v.initial(k);
+    if (v.null_value.size() == v.estimate.size()) null[v.parameters[i].name] = v.null_value(k);
   }
   return {{"effect", v.effect},
           {"parameters", parameters},
           {"parameter_ci95", ci},
           {"initial", initial},
+          {"null_value", null},
+          {"interval_holds_null", interval_contains_null(v)},
           {"smoothing_v0", v.smoothing > 0.0 ? json(v.smoothing) : json(nullptr)}};
 }
 
 json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
   json ci = json::object();
   for (std::size_t i = 0; i < f.parameters.size(); ++i)
-    ci[f.parameters[i].name] = {f.ci_low(static_cast<Eigen::Index>(i)), f.ci_high(static_cast<Eigen::Index>(i))};
+    ci[f.parameters[i].name] = {bound_json(f.ci_low(static_cast<Eigen::Index>(i))),
+                                bound_json(f.ci_high(static_cast<Eigen::Index>(i)))};
   json units = json::object();
   for (const auto& p : f.parameters) units[p.name] = p.unit;
+  const json scale = f.scale.size() == f.estimate.size() ? parameters_json(f, f.scale) : json::object();
   return {{"effect", f.effect},
           {"parameters", parameters_json(f, f.estimate)},
           {"parameter_ci95", ci},
@@ -72,6 +82,10 @@ json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
           {"explained_ci95", {f.explained - f.explained_ci, f.explained + f.explained_ci}},
           {"z_score", f.z_score},
           {"identifiable", f.identifiable},
+          {"not_identifiable", f.identifiable ? json(nullptr) : json(f.not_identifiable)},
+          {"null_value", f.null_value.size() == f.estimate.size() ? parameters_json(f, f.null_value) : json::object()},
+          {"interval_holds_null", interval_contains_null(own_values(f))},
+          {"scale", scale},
           {"evaluations", f.evaluations},
           {"heldout_state", r.state_names[static_cast<std::size_t>(state)]},
           {"heldout_rmse_before", f.heldout_rmse_before(state)},
@@ -168,16 +182,22 @@ nlohmann::json report_json(const DiagnosisReport& r) {
     entry["alias_fits"] = alias_fits;
     ranking.push_back(entry);
   }
-  json verdict = {{"status", r.verdict.status},           {"reason", r.verdict.reason}, {"aliases", r.verdict.aliases},
-                  {"effects", r.verdict.effects},         {"left", r.verdict.left},     {"gp_left", r.verdict.gp_left}};
+  json verdict = {{"status", r.verdict.status}, {"reason", r.verdict.reason},   {"aliases", r.verdict.aliases},
+                  {"effects", r.verdict.effects}, {"left", r.verdict.left},       {"gp_left", r.verdict.gp_left},
+                  {"remainder", r.verdict.remainder}};
   if (r.verdict.effect) {
+    // The judged effect or set: the lead's values, every member's in "members" (one joint fit).
     verdict["effect"] = r.verdict.effect->effect;
     verdict["parameters"] = parameters_json(*r.verdict.effect, r.verdict.effect->estimate);
-    verdict["explained"] = r.verdict.effect->explained;
+    verdict["explained"] = 1.0 - r.verdict.left;
+    json members = json::array({values_json(own_values(*r.verdict.effect))});
+    for (const EffectValues& v : r.verdict.effect->refitted) members.push_back(values_json(v));
+    verdict["members"] = members;
   } else {
     verdict["effect"] = nullptr;
     verdict["parameters"] = json::object();
     verdict["explained"] = r.ranking.empty() ? 0.0 : r.ranking.front().fit.explained;
+    verdict["members"] = json::array();
   }
   json comparison = json::object();
   if (!r.comparison.empty()) {
@@ -252,6 +272,7 @@ nlohmann::json report_json(const DiagnosisReport& r) {
           {"criterion", {{"name", fit_criterion_name(r.criterion)}, {"window", r.window}, {"restarts", r.window_restarts}}},
           {"ranking", ranking},
           {"verdict", verdict},
+          {"excluded", r.excluded},
           {"model", model_file_text(r.model)},
           {"added", added},
           {"refitted", refitted},

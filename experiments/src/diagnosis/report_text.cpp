@@ -5,6 +5,7 @@
 #include <fmt/ranges.h>
 
 #include "gpilqg/control/rollout.hpp"
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 
 namespace gpilqg::diagnosis {
@@ -208,6 +209,8 @@ void which_section(const DiagnosisReport& r, std::string& out) {
   const int worst = worst_state(r);
   out += fmt::format("\n3. Which effect is missing (fitted on training {0}s, scored on held-out {0}s {1})\n", unit_name(r),
                      fmt::join(r.heldout_episode_ids, ", "));
+  if (!r.excluded.empty())
+    out += fmt::format("   excluded by --exclude (never ranked, searched or proposed): {}\n", fmt::join(r.excluded, ", "));
   if (r.criterion == FitCriterion::Simulation)
     out += fmt::format("   criterion: simulation error over windows of {} samples ({:g} s) from measured states{}\n",
                        r.window, r.window * r.dt,
@@ -225,15 +228,23 @@ void which_section(const DiagnosisReport& r, std::string& out) {
   out += fmt::format("   {:<3} {:<{}} {:<{}} {:>17} {:>24}\n", "#", "effect", name_width, "parameter [95% interval]",
                      parameter_width, "explained", "held-out rmse " + r.state_names[static_cast<std::size_t>(worst)]);
   int rank = 1;
+  std::string not_identifiable;
   for (const RankedEffect& g : r.ranking) {
     const EffectFit& f = g.fit;
-    out += fmt::format("   {:<3} {:<{}} {:<{}} {:>8} +-{:>6} {:>11.3e} -> {:.3e}\n", rank++, f.effect, name_width,
+    if (!f.identifiable) {
+      not_identifiable += fmt::format("   - {}: {}\n", f.effect, f.not_identifiable);
+      continue;
+    }
+    out += fmt::format("   {:<3} {:<{}} {:<{}} {:>8} +-{:>6} {:>11.3e} -> {:.3e}{}\n", rank++, f.effect, name_width,
                        parameter_text(f, true), parameter_width, percent(f.explained), percent(f.explained_ci),
-                       f.heldout_rmse_before(worst), f.heldout_rmse_after(worst));
+                       f.heldout_rmse_before(worst), f.heldout_rmse_after(worst),
+                       interval_contains_null(own_values(f)) ? "  (interval holds its value without it)" : "");
     for (const EffectFit& a : g.aliases)
       out += fmt::format("       alias {:<{}} {:<{}} {:>8}   (cannot be told apart on these data)\n", a.effect,
                          name_width - 6, parameter_text(a, true), parameter_width, percent(a.explained));
   }
+  if (!not_identifiable.empty())
+    out += "   not identifiable on these data (not ranked):\n" + not_identifiable;
 }
 
 void selection_section(const DiagnosisReport& r, std::string& out) {
@@ -257,8 +268,8 @@ void selection_section(const DiagnosisReport& r, std::string& out) {
     for (const EffectValues& v : f.refitted) before.push_back(v.effect);
     for (const std::string& name : step.removed)
       out += fmt::format("           removed {}\n", name);
-    out += fmt::format("           removes {} +- {} of the held-out residual left (z = {:.1f}); held-out rmse:", percent(f.explained),
-                       percent(f.explained_ci), f.z_score);
+    out += fmt::format("           {}; held-out rmse:",
+                       share_text(f.explained, f.explained_ci, f.z_score, "the held-out residual left"));
     for (std::size_t i = 0; i < r.state_names.size(); ++i) {
       const auto ii = static_cast<Eigen::Index>(i);
       if (f.heldout_rmse_before(ii) > 1.05 * f.heldout_rmse_after(ii))

@@ -7,6 +7,7 @@
 #include <fmt/ranges.h>
 
 #include "gpilqg/core/system_registry.hpp"
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 #include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
@@ -24,7 +25,8 @@ bool declared_same(const SystemEntry& entry, const std::string& a, const std::st
   return false;
 }
 
-/// The `count` subsets of size k with the least linearised held-out residual, best first.
+/// The `count` subsets of size k with the least cross-validated linearised training residual
+/// (LinearisedFits::screening_left: the held-out rows do not screen), best first.
 std::vector<std::vector<int>> best_subsets(const LinearisedFits& fits, int k, int count,
                                            const std::vector<std::vector<bool>>& forbidden) {
   std::vector<std::pair<double, std::vector<int>>> best;
@@ -39,7 +41,7 @@ std::vector<std::vector<int>> best_subsets(const LinearisedFits& fits, int k, in
         allowed = !forbidden[static_cast<std::size_t>(subset[static_cast<std::size_t>(a)])]
                             [static_cast<std::size_t>(subset[static_cast<std::size_t>(b)])];
     if (allowed) {
-      const double left = fits.heldout_left(subset);
+      const double left = fits.screening_left(subset);
       if (static_cast<int>(best.size()) < count || left < best.back().first) {
         best.emplace_back(left, subset);
         std::sort(best.begin(), best.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
@@ -101,22 +103,29 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
       }
       rest.insert(rest.end(), present.begin(), present.end());
       EffectFit exact = fit_jointly(named(candidates, lead.effect), rest, accepted_context, lead.estimate);
-      if (!have || exact.explained > best.explained) best = std::move(exact);
+      // Chosen on the training rows (sets of one size, one start): the held-out rows only judge.
+      if (!have || exact.training_objective_after < best.training_objective_after) best = std::move(exact);
       have = true;
     }
     if (!have) break;
     std::vector<std::string> members{best.effect};
     for (const EffectValues& v : best.refitted) members.push_back(v.effect);
     const std::string names = fmt::format("{}", fmt::join(members, ", "));
+    const std::string left_text = "the held-out residual left";
     if (o.progress)
-      o.progress(fmt::format("best subset of {}: {} removes {:.1f}% of the held-out residual left (z = {:.1f})", k, names,
-                             100.0 * best.explained, best.z_score));
-    // 3. Accepted when it removes a significant, not negligible share of what the accepted model leaves.
-    if (best.explained < o.min_explained || best.z_score < o.min_z) {
+      o.progress(fmt::format("best subset of {}: {} {}", k, names,
+                             share_text(best.explained, best.explained_ci, best.z_score, left_text)));
+    // 3. Accepted when it is a finding against the accepted model (effect_test.hpp): identifiable,
+    // every new member's interval excluding its value without it, a significant and not negligible share.
+    const std::vector<std::string> in_m0 = names_of_effects(present);
+    const EffectTestThresholds thresholds{o.min_explained, o.min_z};
+    if (!best.identifiable || best.explained < o.min_explained || best.z_score < o.min_z) {
       last_rejection = fmt::format(
-          "the best set of {} ({}) removes {:.1f}% of the held-out residual left (z = {:.1f}); a larger set needs at "
-          "least {:.0f}% and z >= {:g}",
-          k, names, 100.0 * best.explained, best.z_score, 100.0 * o.min_explained, o.min_z);
+          "the best set of {} ({}) is not accepted: {}", k, names,
+          best.identifiable ? fmt::format("it {}; a larger set needs at least {:.0f}% and z >= {:g}",
+                                          share_text(best.explained, best.explained_ci, best.z_score, left_text),
+                                          100.0 * o.min_explained, o.min_z)
+                            : test_effect(best, thresholds, in_m0).reason);
       continue;
     }
     std::vector<std::string> removed;
@@ -141,20 +150,22 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     std::sort(kept.begin(), kept.end());
     std::vector<std::string> before = accepted;
     std::sort(before.begin(), before.end());
-    if (kept == before || best.explained < o.min_explained || best.z_score < o.min_z) {
+    const EffectTestResult finding = test_effect(best, thresholds, in_m0);
+    if (kept == before || !finding.accepted) {
       last_rejection = fmt::format(
           "the best set of {} ({}) comes to {} after dropping members whose intervals contain their values without "
-          "them, which removes {:.1f}% of the held-out residual left (z = {:.1f})",
-          k, names, fmt::join(kept, ", "), 100.0 * best.explained, best.z_score);
+          "them, which {}",
+          k, names, fmt::join(kept, ", "),
+          finding.accepted ? "is the set accepted before" : "is not accepted: " + finding.reason);
       continue;
     }
-    // Present in the previous set, absent from this one (and not dropped by the backward check).
+    // Removed: in the previously accepted set, absent from this one. A member of this size's candidate
+    // set that the backward check dropped was never in the model, so it is not "removed".
     std::vector<std::string> now{best.effect};
     for (const EffectValues& v : best.refitted) now.push_back(v.effect);
+    removed.clear();
     for (const std::string& name : accepted)
-      if (std::find(now.begin(), now.end(), name) == now.end() &&
-          std::find(removed.begin(), removed.end(), name) == removed.end())
-        removed.push_back(name);
+      if (std::find(now.begin(), now.end(), name) == now.end()) removed.push_back(name);
     // The lead of the step is an effect new in this set, when there is one.
     if (std::find(accepted.begin(), accepted.end(), best.effect) != accepted.end()) {
       for (std::size_t i = 0; i < best.refitted.size(); ++i) {

@@ -31,7 +31,18 @@ struct DiagnoseRequest {
   std::string criterion = "one-step";
   /// --window: samples per simulation window; required with "simulation", not accepted with "one-step".
   std::optional<long> window;
+  /// --exclude: candidate effects never ranked, searched or proposed, each a name or a shell pattern
+  /// over the candidates' names (`*` any text, `?` one character, `[...]` a set), e.g.
+  /// `param:*.armature` (every armature), `*:wrist*` (every effect of the wrist's joints, actuators and
+  /// bodies), `actuator_gain:*`.
+  std::vector<std::string> exclude;
 };
+
+/// The candidate effects of `model` that the --exclude patterns name, in the candidates' order.
+/// Throws InputError naming the pattern when it matches no candidate (listing them), and naming the
+/// effect when an --add effect (`add`) is excluded.
+std::vector<std::string> excluded_effects(const std::vector<std::string>& patterns, const ModelSpec& model,
+                                          const std::vector<std::string>& add = {});
 
 /// At most this many k-step horizons (each stores its windows' predictions in the report).
 inline constexpr std::size_t kMaxHorizonCount = 32;

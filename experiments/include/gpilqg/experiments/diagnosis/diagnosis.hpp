@@ -26,18 +26,15 @@
 ///    the noise floor by more than `floor_tolerance`, and no effect removes a large and significant
 ///    share of the held-out residual (explained >= min_explained, z >= min_z: the GP sees (x_t, u_t)
 ///    only, so the error of an input delay looks like noise to it). Nothing is proposed then.
-///  - otherwise, when the best alias group removes a significant share of the held-out residual
-///    (explained >= min_explained, z score >= min_z) and at least relative_to_gp (half) of what the
-///    GP (a flexible model of everything learnable) removes on the same rows: "explained" if what it
-///    leaves is at most explained_left_ratio (1.5) times what the GP leaves, "partly_explained" if it
-///    leaves more. A wrong effect can soak up much of the residual; it cannot match the GP. With
-///    --auto the same rule judges the chosen set.
-///    Under the simulation criterion (simulation_error.hpp) the effects are scored on the simulation
-///    error over windows, the GP on the one-step residual: the two shares are of different errors, so
-///    neither the GP's share nor what the GP leaves is required there (they are still named in the
-///    reason). What guards against a wrong effect then is the held-out test itself: a wrong effect
-///    that soaks up a simulation error on the training episodes does not remove a significant share
-///    of it on the held-out ones.
+///  - otherwise, when the best alias group is a finding (effect_test.hpp: identifiable, its 95%
+///    interval excludes its value without it, it removes at least min_explained of the held-out
+///    residual with z >= min_z) and, under the one-step criterion, removes at least relative_to_gp
+///    (half) of what the GP removes on the same rows: "explained" or "partly_explained" by the
+///    remainder test, the same for every criterion: the model with the effect(s) plus a GP of its
+///    residual (a flexible model) is scored under the criterion on the held-out rows; "explained"
+///    when the effects leave at most explained_left_ratio (1.5) times what it leaves. A wrong effect
+///    can soak up much of the residual; what it leaves keeps a structure the GP finds. With --auto
+///    the same rules judge the chosen set.
 ///  - "unexplained" otherwise: the residual has structure no effect of the library accounts for.
 ///
 /// Before all of these: "model_diverges" when the model's prediction diverges (not finite, or a state
@@ -95,6 +92,8 @@ struct DiagnosisOptions {
   FitCriterion criterion = FitCriterion::OneStep;
   int window = 1;                         ///< samples per window; 1 with the one-step criterion
   bool rank = true;                       ///< false: skip the ranking (faster; verdict from the GP only)
+  /// Candidates never ranked, searched or proposed (`--exclude`, resolved to names: excluded_effects).
+  std::vector<std::string> exclude;
   /// --auto: add several effects by forward selection with joint refits (effect_selection.hpp); the
   /// final model becomes model_next.
   bool auto_select = false;
@@ -147,13 +146,19 @@ struct ModelScore {
 struct Verdict {
   /// "explained", "partly_explained", "unexplained", "consistent", "model_diverges"
   std::string status;
-  std::optional<EffectFit> effect;       ///< the proposed effect ("explained" and "partly_explained")
+  /// The proposed effect ("explained" and "partly_explained"). With --auto and a chosen set, the
+  /// set's last joint fit: its lead here, the other members in effect->refitted.
+  std::optional<EffectFit> effect;
   std::vector<std::string> aliases;
   /// --auto: every effect of the chosen model beyond M_0's (empty without --auto).
   std::vector<std::string> effects;
   /// Shares of the diagnosed model's weighted held-out squared residual left by the proposed
   /// effect(s) and by the GP (1 when nothing is proposed).
   double left = 1.0, gp_left = 1.0;
+  /// The remainder test (diagnosis.cpp, judge_remainder): the share of what the proposed effect(s)
+  /// leave on the held-out rows, under the criterion, that a flexible model removes (the model with
+  /// them plus a GP of its residual); 0 when no effect is proposed.
+  double remainder = 0.0;
   std::string reason;                    ///< one sentence: why this verdict
 };
 
@@ -204,6 +209,7 @@ struct DiagnosisReport {
   /// non_finite_predictions).
   int window_restarts = 0;
   std::vector<RankedEffect> ranking;
+  std::vector<std::string> excluded;     ///< candidates left out by the user (DiagnosisOptions::exclude)
   Verdict verdict;
   /// The "add" step (present when effects were added, or when a proposal exists): the four models.
   std::vector<ModelScore> comparison;

@@ -63,6 +63,9 @@ struct FitContext {
   /// over windows of W rows started from measured states. criterion_context sets it with the
   /// residual and the batch.
   int window = 1;
+  /// Candidates left out of every ranking and search (`--exclude`): effects the user declares
+  /// physically meaningless for these data (an armature when torques are measured after the gearbox).
+  std::vector<std::string> excluded = {};
 };
 
 /// The model integrated as configured.
@@ -87,6 +90,9 @@ struct EffectValues {
   Vector estimate;         ///< the joint estimate
   Vector ci_low, ci_high;  ///< 95% interval from the joint covariance
   double smoothing = 0.0;  ///< Coulomb friction: its smoothing velocity v0 (LibraryEffect::smoothing); else 0
+  /// The value without the effect: its value in the model it is added to (a force 0, a gain 1, the
+  /// model's parameter, no delay); the null hypothesis of its interval test (effect_test.hpp).
+  Vector null_value = {};
 };
 
 struct EffectFit {
@@ -95,8 +101,17 @@ struct EffectFit {
   Vector initial;            ///< theta_0
   Vector linear_estimate;    ///< theta_LS
   Vector estimate;           ///< theta_hat (NLopt)
-  Vector ci_low, ci_high;    ///< 95% interval of theta_hat
+  Vector ci_low, ci_high;    ///< 95% interval of theta_hat (infinite when the covariance is not finite)
   double smoothing = 0.0;    ///< Coulomb friction: its smoothing velocity v0 (LibraryEffect::smoothing); else 0
+  /// The value without the effect, in the model it is added to (EffectValues::null_value).
+  Vector null_value;
+  /// Each parameter's scale on these data: max(|null_value_j|, |m| / |J_j|), with m the model's own
+  /// weighted predicted change of the velocities over the training rows and J_j the weighted
+  /// regressor of parameter j on the same rows: the change of theta_j that moves the predictions as
+  /// much as the model itself moves them. A force is then measured against the forces the model
+  /// applies, an armature against the joint's inertia, a mass against the mass. A parameter further
+  /// than kRunawayFactor times this from null_value is not identifiable (effect_test.hpp).
+  Vector scale;
   int evaluations = 0;       ///< evaluations of the residual in step 2
   double training_objective_before = 0.0;  ///< S(theta_0)
   double training_objective_after = 0.0;   ///< S(theta_hat)
@@ -106,7 +121,10 @@ struct EffectFit {
   double explained_ci = 0.0;   ///< half-width of its 95% interval
   double z_score = 0.0;        ///< mean reduction / its batch-means standard error
   Vector regressor;            ///< weighted J at theta_0 over the training rows (first parameter), for aliasing
-  bool identifiable = true;    ///< false when the effect does not change the predictions at all
+  /// False when the data do not determine the fit: the effect does not change the predictions, its
+  /// covariance is not finite, or a parameter of the set ran away (effect_test.hpp, test 1).
+  bool identifiable = true;
+  std::string not_identifiable;  ///< why, in one clause, when !identifiable
   /// Effects refitted jointly with this one (fit_jointly), with their new values; empty for a fit of
   /// one effect alone. The scores above (objective, held-out RMSE, explained) are those of the set.
   std::vector<EffectValues> refitted;
@@ -158,7 +176,10 @@ struct RankedEffect {
   std::vector<EffectFit> aliases;
 };
 
-/// Fits every candidate effect and ranks the alias groups by held-out explained fraction. Two effects
+/// Fits every candidate effect and ranks the alias groups in the order of their standing
+/// (effect_test.hpp): the identifiable fits whose 95% interval excludes their value without them by
+/// held-out explained fraction, then the identifiable ones whose interval holds it, then, unranked and
+/// in no alias group, the fits that are not identifiable (EffectFit::identifiable). Two effects
 /// are aliases when their joint fit cannot separate them: the pair, fitted together on the training
 /// rows, removes less than `alias_gain` of the held-out residual that either leaves alone (each alone
 /// does what both do; linearised_fits.hpp), or the system declares them the same physics. Grouping is

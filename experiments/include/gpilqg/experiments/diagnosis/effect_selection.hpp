@@ -88,12 +88,16 @@ struct Selection {
   std::string stop_reason;                ///< one sentence
 };
 
+/// The names of `effects`.
+std::vector<std::string> names_of_effects(const std::vector<RefitEffect>& effects);
+
 /// M_0 (`base`) with the effect of `fit` and those it refitted at their joint estimates.
 ModelSpec model_after(const ModelSpec& base, const EffectFit& fit, const std::vector<LibraryEffect>& candidates);
 
-/// The backward check: while an effect of fit.refitted that M_0 (context.model) does not have has a
-/// joint 95% interval containing its value in M_0, it is dropped (its name appended to `removed`) and
-/// the rest refitted jointly on `step_context`.
+/// The backward check: while a member of the joint fit (its lead or an effect of fit.refitted) that
+/// M_0 (context.model) does not have has a joint 95% interval containing its value in M_0, it is
+/// dropped (its name appended to `removed`) and the rest refitted jointly on `step_context`, led by
+/// the first member M_0 does not have. A fit of a single member is returned as it is.
 EffectFit without_redundant(EffectFit fit, const FitContext& context, const FitContext& step_context,
                             const std::vector<LibraryEffect>& candidates, std::vector<std::string>& removed);
 

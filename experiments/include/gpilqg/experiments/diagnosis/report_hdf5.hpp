@@ -15,7 +15,7 @@
 ///   /where/bins/<input>/{edges (B + 1), rmse (n x B), count (B)}
 ///   /where/cross_correlation/{lags (2L + 1), values (n x m x (2L + 1)), band (n x m)}
 ///   /ranking/{estimate, ci_low, ci_high, explained, explained_ci, z_score, heldout_rmse_before,
-///             heldout_rmse_after (G)}  attrs: heldout_state, effect, parameter_name, unit, aliases (G strings,
+///             heldout_rmse_after, null_value, identifiable (1/0), interval_holds_null (1/0) (G)}  attrs: heldout_state, effect, parameter_name, unit, aliases (G strings,
 ///             aliases comma-separated), criterion ("one-step" or "simulation"), window (int samples per
 ///             window, 1 for one-step), window_restarts (int, simulation_error.hpp)
 ///   /add/{heldout_rmse (4 x n, rows as attribute model), signal_variance (2 x n: sim+GP, sim+effect+GP),

@@ -1,0 +1,64 @@
+#pragma once
+/// @file effect_test.hpp
+/// The one test that decides whether a fitted effect, or a set of effects fitted jointly, is a
+/// finding. Every place that accepts an effect uses it: the verdict, each step of `--auto` (both
+/// searches), the backward check, and the evidence that a residual the GP calls noise is not at its
+/// floor (an input delay).
+///
+/// An effect (or a set) is accepted when all three hold:
+///
+///  1. **Identifiable.** The data determine its parameters: the regressor is not zero, the
+///     Gauss-Newton covariance is finite, and no parameter moved further from its value without the
+///     effect than kRunawayFactor (100) times its scale on these data (EffectFit::scale). An
+///     armature of 2.7e21 kg m^2 on a wrist, or a link of 318 kg on an arm of 3 kg links, is a fit
+///     that ran away along a direction the data barely see; its z score and zero-width interval say
+///     nothing. Such fits are reported as not identifiable and never ranked.
+///  2. **Its interval excludes the value without it.** The null hypothesis of an effect is the value
+///     it has in the model it is added to (EffectFit::null_value: a force of 0, a gain of 1, the
+///     model's own parameter, no delay). An effect whose 95% interval contains that value in every
+///     parameter is not significant, whatever its held-out z score: the training data do not
+///     distinguish it from its absence. For a set, every member the model does not have must pass.
+///  3. **It removes a large and significant share of the held-out residual:** explained >=
+///     min_explained with a batch-means z >= min_z (effect_fit.hpp, step 4).
+///
+/// Test 3 is on the held-out rows, tests 1 and 2 on the training rows; together they guard against
+/// an effect that soaks up the training residual along a direction that happens to help on the
+/// held-out rows (a heavy armature on a light joint: the held-out error falls because every torque
+/// error is divided by a larger inertia, yet the interval holds 0).
+
+#include <string>
+#include <vector>
+
+#include "gpilqg/experiments/diagnosis/effect_fit.hpp"
+
+namespace gpilqg::diagnosis {
+
+/// A parameter that moved further than this many times its scale on the data is not identifiable.
+inline constexpr double kRunawayFactor = 100.0;
+
+/// The thresholds of test 3.
+struct EffectTestThresholds {
+  double min_explained = 0.1;
+  double min_z = 3.0;
+};
+
+/// The outcome of the test, with one sentence saying why (empty when accepted).
+struct EffectTestResult {
+  bool accepted = false;
+  std::string reason;
+};
+
+/// True when v's 95% interval contains v.null_value in every parameter (test 2 fails).
+bool interval_contains_null(const EffectValues& v);
+
+/// Tests 1-3 on `fit` (a single effect, or the lead of a joint fit with its members in fit.refitted).
+/// Test 2 skips the members named in `already_in_model`: effects the model had before the search are
+/// refitted with the new ones, not tested.
+EffectTestResult test_effect(const EffectFit& fit, const EffectTestThresholds& thresholds,
+                             const std::vector<std::string>& already_in_model = {});
+
+/// "removes 12.3% +- 4.1% of <what> (z = 5.2)", or, when the share is not positive, "removes nothing
+/// of <what> (it adds 0.04%, z = -1.2)": never a "-0.0%".
+std::string share_text(double explained, double explained_ci, double z, const std::string& what);
+
+}  // namespace gpilqg::diagnosis

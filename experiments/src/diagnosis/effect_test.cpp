@@ -1,0 +1,66 @@
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace gpilqg::diagnosis {
+
+bool interval_contains_null(const EffectValues& v) {
+  if (v.null_value.size() != v.estimate.size() || v.ci_low.size() != v.estimate.size()) return false;
+  return (v.ci_low.array() <= v.null_value.array()).all() && (v.null_value.array() <= v.ci_high.array()).all();
+}
+
+namespace {
+
+bool listed(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::string interval_reason(const EffectValues& v) {
+  std::string values;
+  for (Eigen::Index j = 0; j < v.estimate.size(); ++j)
+    values += fmt::format("{}{} = {:.4g} [{:.4g}, {:.4g}] holds {:.4g}", j == 0 ? "" : ", ",
+                          v.parameters[static_cast<std::size_t>(j)].name, v.estimate(j), v.ci_low(j), v.ci_high(j),
+                          v.null_value(j));
+  return fmt::format("the 95% interval of '{}' contains its value without it ({}): not distinguishable from its absence",
+                     v.effect, values);
+}
+
+}  // namespace
+
+EffectTestResult test_effect(const EffectFit& fit, const EffectTestThresholds& t,
+                             const std::vector<std::string>& already_in_model) {
+  EffectTestResult result;
+  if (!fit.identifiable) {
+    result.reason = fmt::format("'{}' is not identifiable on these data{}", fit.effect,
+                                fit.not_identifiable.empty() ? std::string() : ": " + fit.not_identifiable);
+    return result;
+  }
+  std::vector<EffectValues> members{own_values(fit)};
+  members.insert(members.end(), fit.refitted.begin(), fit.refitted.end());
+  for (const EffectValues& v : members) {
+    if (listed(already_in_model, v.effect) || !interval_contains_null(v)) continue;
+    result.reason = interval_reason(v);
+    return result;
+  }
+  if (fit.explained < t.min_explained || fit.z_score < t.min_z) {
+    result.reason = fmt::format("{}; a finding needs at least {:.0f}% and z >= {:g}",
+                                share_text(fit.explained, fit.explained_ci, fit.z_score, "the held-out residual"),
+                                100.0 * t.min_explained, t.min_z);
+    return result;
+  }
+  result.accepted = true;
+  return result;
+}
+
+std::string share_text(double explained, double explained_ci, double z, const std::string& what) {
+  // A share that rounds to +0.0% or below removes nothing worth a number.
+  if (explained < 0.0005)
+    return fmt::format("removes nothing of {} (it {} {:.2g}%, z = {:.1f})", what, explained < 0.0 ? "adds" : "removes",
+                       100.0 * std::abs(explained), z);
+  return fmt::format("removes {:.1f}% +- {:.1f}% of {} (z = {:.1f})", 100.0 * explained, 100.0 * explained_ci, what, z);
+}
+
+}  // namespace gpilqg::diagnosis
