@@ -211,9 +211,10 @@ void choose_dt(const RawLog& log, const LogMap& map, const std::vector<Vector>& 
 }
 
 /// 3b. The gap limit (the map's max_gap, else 3 dt; at least dt) and every episode split at the steps
-/// longer than it (split_at_gaps), with the smallest and largest step left within the pieces.
-std::vector<std::vector<SampleRange>> split_episodes(const LogMap& map, const std::vector<Vector>& group_times,
-                                                     ImportReport& report) {
+/// longer than it (split_at_gaps), with the smallest and largest step left within the pieces, each
+/// gap and each record's count of pieces.
+std::vector<std::vector<SampleRange>> split_episodes(const LogMap& map, const std::vector<RowGroup>& groups,
+                                                     const std::vector<Vector>& group_times, ImportReport& report) {
   report.max_gap_from_map = map.max_gap.has_value();
   report.average_controls = map.average_controls;
   report.max_gap = map.max_gap.value_or(3.0 * report.dt);
@@ -223,9 +224,13 @@ std::vector<std::vector<SampleRange>> split_episodes(const LogMap& map, const st
   std::vector<std::vector<SampleRange>> pieces;
   report.step_min = INFINITY;
   report.step_max = 0.0;
-  for (const Vector& t : group_times) {
+  for (std::size_t g = 0; g < group_times.size(); ++g) {
+    const Vector& t = group_times[g];
     pieces.push_back(split_at_gaps(t, report.max_gap));
     report.gaps += static_cast<long>(pieces.back().size()) - 1;
+    report.records.push_back({groups[g].episode, t.size(), static_cast<long>(pieces.back().size()), 0});
+    for (std::size_t p = 1; p < pieces.back().size(); ++p)
+      report.gap_list.push_back({groups[g].episode, t(pieces.back()[p - 1].end - 1), t(pieces.back()[p].begin)});
     for (const SampleRange& r : pieces.back())
       for (long i = r.begin + 1; i < r.end; ++i) {
         report.step_min = std::min(report.step_min, t(i) - t(i - 1));
@@ -331,14 +336,17 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
   list_columns(log, map, system, report);
   const std::vector<Vector> group_times = episode_times(log, map, groups, columns.t);
   choose_dt(log, map, group_times, report);
-  const std::vector<std::vector<SampleRange>> pieces = split_episodes(map, group_times, report);
+  const std::vector<std::vector<SampleRange>> pieces = split_episodes(map, groups, group_times, report);
   check_resampled_size(map, group_times, pieces, rows, report);
 
   const std::optional<SavitzkyGolayDerivative> differentiator = velocity_estimator(report);
   const long min_samples = differentiator ? differentiator->window() : 2;
-  for (std::size_t g = 0; g < groups.size(); ++g)
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const std::size_t written_before = result.set.episodes.size();
     for (const SampleRange& r : pieces[g])
       resample_piece(groups[g], group_times[g], r, columns, map, system, differentiator, min_samples, result);
+    report.records[g].episodes = static_cast<long>(result.set.episodes.size() - written_before);
+  }
   if (result.set.episodes.empty())
     throw DataError(log.file, log.location(map.time.column),
                     fmt::format("no piece of the log is long enough: all {} rows dropped ({} pieces after splitting at "

@@ -204,8 +204,8 @@ TEST(RawLog, Hdf5VectorsAreColumnsNamedByPath) {
 RawLog cartpole_log(int rows, double dt) {
   RawLog log;
   log.file = "memory.csv";
-  LogColumn t{"ms", {}, ""}, x{"x", {}, ""}, xd{"xd", {}, ""}, th{"th_deg", {}, ""}, thd{"thd", {}, ""}, f{"f", {}, ""},
-      extra{"battery", {}, ""};
+  LogColumn t{"ms", {}}, x{"x", {}}, xd{"xd", {}}, th{"th_deg", {}}, thd{"thd", {}}, f{"f", {}},
+      extra{"battery", {}};
   for (int i = 0; i < rows; ++i) {
     const double time = i * dt;
     t.values.push_back(1000.0 * time);
@@ -283,6 +283,16 @@ TEST(ImportLog, GapsSplitEpisodesAndShortPiecesAreDroppedAndCounted) {
   EXPECT_EQ(r.report.rows_read, 14);
   EXPECT_EQ(r.report.rows_used + r.report.rows_dropped, 14);
   EXPECT_TRUE(r.report.dropped.empty());
+  // Each gap from the last sample before it to the first after: rows 9 -> 25 and 26 -> 38.
+  ASSERT_EQ(r.report.gap_list.size(), 2u);
+  EXPECT_NEAR(r.report.gap_list[0].t_start, 9 * 0.02, 1e-12);
+  EXPECT_NEAR(r.report.gap_list[0].length(), 16 * 0.02, 1e-12);
+  EXPECT_NEAR(r.report.gap_list[1].t_start, 26 * 0.02, 1e-12);
+  EXPECT_NEAR(r.report.gap_list[1].length(), 12 * 0.02, 1e-12);
+  ASSERT_EQ(r.report.records.size(), 1u);  // no episode column: the log is one record, cut in 3
+  EXPECT_EQ(r.report.records[0].rows, 14);
+  EXPECT_EQ(r.report.records[0].pieces, 3);
+  EXPECT_EQ(r.report.records[0].episodes, 3);
   // With the velocity estimator (window 5), the 2-row pieces are too short and are dropped.
   LogMap estimating = cartpole_map(false);
   estimating.max_gap = 0.1;
@@ -291,6 +301,8 @@ TEST(ImportLog, GapsSplitEpisodesAndShortPiecesAreDroppedAndCounted) {
   EXPECT_EQ(d.report.rows_dropped, 4);
   ASSERT_EQ(d.report.dropped.size(), 2u);
   EXPECT_NE(d.report.dropped[0].reason.find("expected at least 5"), std::string::npos) << d.report.dropped[0].reason;
+  EXPECT_EQ(d.report.records[0].pieces, 3);
+  EXPECT_EQ(d.report.records[0].episodes, 1);
 }
 
 std::string import_error(const RawLog& log, const LogMap& map) {

@@ -7,7 +7,8 @@
 /// 1. the mapped columns are scaled to SI (units.hpp); every other column is ignored and reported;
 /// 2. rows are grouped by the episode column (in order of first appearance; one episode without it),
 ///    and time must increase strictly within each group;
-/// 3. each group is split where two consecutive samples are more than max_gap apart;
+/// 3. each group (a record) is split where two consecutive samples are more than max_gap apart, and
+///    every such gap is listed in the report with what it made of its record;
 /// 4. each piece is resampled onto t_0 + k dt (resampling.hpp): states linearly, controls held (or
 ///    averaged over each step when the map asks for it);
 /// 5. velocities the log lacks (`<q>_dot` for a mapped `<q>`) are estimated from the resampled
@@ -81,6 +82,23 @@ struct DroppedPiece {
   std::string reason;
 };
 
+/// A step longer than max_gap between two samples of one record: where the record was cut.
+struct SplitGap {
+  long source_episode = 0;
+  double t_start = 0.0;  ///< [s], log time of the last sample before the gap
+  double t_end = 0.0;    ///< [s], log time of the first sample after it
+  double length() const { return t_end - t_start; }
+};
+
+/// A record of the log (the rows of one episode value, or the whole log without an episode column)
+/// and what max_gap made of it, so a report can say when one recording became many episodes.
+struct LogRecord {
+  long source_episode = 0;
+  long rows = 0;
+  long pieces = 1;    ///< after splitting at its gaps: 1 + the gaps in it
+  long episodes = 0;  ///< pieces written; the others were dropped as too short
+};
+
 /// An episode written, and where it came from.
 struct ImportedEpisode {
   long id = 0;
@@ -108,6 +126,8 @@ struct ImportReport {
   double step_min = 0.0;     ///< smallest logged step within a piece [s]
   double step_max = 0.0;     ///< largest logged step within a piece (<= max_gap) [s]
   long gaps = 0;             ///< steps longer than max_gap, each starting a new piece
+  std::vector<SplitGap> gap_list;  ///< every one of them, in log order
+  std::vector<LogRecord> records;  ///< the log's records in order of first appearance
   std::vector<ColumnMapping> columns;  ///< time, episode, states and controls as mapped
   std::vector<std::string> ignored_columns;  ///< log columns the map does not use
   /// The estimated velocities as {target, position column's target}, e.g. {"x_dot", "x"}.
