@@ -11,6 +11,7 @@
 #include <set>
 
 #include "gpilqg/core/limits.hpp"
+#include "gpilqg/core/map_patterns.hpp"
 #include "gpilqg/core/resampling.hpp"
 #include "gpilqg/core/savitzky_golay.hpp"
 
@@ -37,7 +38,10 @@ const char* format_name(LogFormat format) {
 Vector mapped_values(const RawLog& log, const ColumnMapping& mapping, long rows, const std::string& time_column) {
   const LogColumn* column = log.find(mapping.column);
   if (column == nullptr)
-    map_error(mapping.origin, fmt::format("column '{}' is not in {}", mapping.column, log.file.string()),
+    map_error(mapping.origin,
+              fmt::format("column '{}'{} is not in {}", mapping.column,
+                          mapping.pattern.empty() ? "" : fmt::format(" (the pattern {} for '{}')", mapping.pattern, mapping.target),
+                          log.file.string()),
               fmt::format("one of its columns: {}", log.column_names()));
   if (!column->unusable.empty())
     throw DataError(log.file, log.location(column->name),
@@ -320,7 +324,8 @@ void resample_piece(const RowGroup& group, const Vector& t_group, const SampleRa
 
 }  // namespace
 
-ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignature& system) {
+ImportResult import_log(const RawLog& log, const LogMap& written_map, const SystemSignature& system) {
+  const LogMap map = expand_patterns(written_map, system);
   ImportResult result;
   ImportReport& report = result.report;
   report.log = log.file;

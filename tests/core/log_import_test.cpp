@@ -204,8 +204,8 @@ TEST(RawLog, Hdf5VectorsAreColumnsNamedByPath) {
 RawLog cartpole_log(int rows, double dt) {
   RawLog log;
   log.file = "memory.csv";
-  LogColumn t{"ms", {}}, x{"x", {}}, xd{"xd", {}}, th{"th_deg", {}}, thd{"thd", {}}, f{"f", {}},
-      extra{"battery", {}};
+  LogColumn t{"ms", {}, ""}, x{"x", {}, ""}, xd{"xd", {}, ""}, th{"th_deg", {}, ""}, thd{"thd", {}, ""}, f{"f", {}, ""},
+      extra{"battery", {}, ""};
   for (int i = 0; i < rows; ++i) {
     const double time = i * dt;
     t.values.push_back(1000.0 * time);
@@ -223,16 +223,16 @@ RawLog cartpole_log(int rows, double dt) {
 LogMap cartpole_map(bool with_velocities) {
   LogMap map;
   map.file = "map.toml";
-  map.time = {"time", "ms", "ms", 1e-3, {"map.toml", 2, "time.column"}};
-  map.states = {{"x", "x", "", 1.0, {"map.toml", 5, "states.x.column"}},
-                {"theta", "th_deg", "deg", std::numbers::pi / 180.0, {"map.toml", 6, "states.theta.column"}}};
+  map.time = {"time", "ms", "ms", 1e-3, {"map.toml", 2, "time.column"}, ""};
+  map.states = {{"x", "x", "", 1.0, {"map.toml", 5, "states.x.column"}, ""},
+                {"theta", "th_deg", "deg", std::numbers::pi / 180.0, {"map.toml", 6, "states.theta.column"}, ""}};
   if (with_velocities) {
-    map.states.push_back({"x_dot", "xd", "", 1.0, {"map.toml", 7, "states.x_dot.column"}});
-    map.states.push_back({"theta_dot", "thd", "", 1.0, {"map.toml", 8, "states.theta_dot.column"}});
+    map.states.push_back({"x_dot", "xd", "", 1.0, {"map.toml", 7, "states.x_dot.column"}, ""});
+    map.states.push_back({"theta_dot", "thd", "", 1.0, {"map.toml", 8, "states.theta_dot.column"}, ""});
   } else {
     map.velocities = VelocityEstimator{5, 2, {"map.toml", 11, "velocities"}};
   }
-  map.controls = {{"force", "f", "", 1.0, {"map.toml", 10, "controls.force.column"}}};
+  map.controls = {{"force", "f", "", 1.0, {"map.toml", 10, "controls.force.column"}, ""}};
   map.states_section = {"map.toml", 4, "states"};
   map.controls_section = {"map.toml", 9, "controls"};
   return map;
@@ -335,7 +335,7 @@ TEST(ImportLog, ErrorsNameTheMapLineOrTheLogRow) {
   EXPECT_NE(e4.find("map.toml:line 4: field 'states': state 'theta_dot' has no column and no estimator"), std::string::npos) << e4;
 
   LogMap twice = cartpole_map(true);
-  twice.controls.push_back({"force", "x", "", 1.0, {"map.toml", 12, "controls.force.column"}});
+  twice.controls.push_back({"force", "x", "", 1.0, {"map.toml", 12, "controls.force.column"}, ""});
   EXPECT_NE(import_error(cartpole_log(10, 0.02), twice).find("map.toml:line 12"), std::string::npos);
 
   LogMap foreign = cartpole_map(true);

@@ -45,6 +45,9 @@ struct ColumnMapping {
   std::string unit;    ///< as written in the map; empty: the SI unit
   double scale = 1.0;  ///< value in SI = scale * logged value
   MapOrigin origin;    ///< of the `column` entry
+  /// The pattern entry this mapping was expanded from, as written ("'q{i}' = 'pos{i}'",
+  /// map_patterns.hpp); empty for an explicit entry.
+  std::string pattern;
 };
 
 /// Settings of the velocity estimator for `<q>_dot` states without a column.
@@ -67,6 +70,10 @@ struct LogMap {
   bool average_controls = false;
   std::vector<ColumnMapping> states;
   std::vector<ColumnMapping> controls;
+  /// Entries of [states] and [controls] whose target holds the placeholder {i} (map_patterns.hpp):
+  /// `target` and `column` as written. import_log expands them over the system's names.
+  std::vector<ColumnMapping> state_patterns;
+  std::vector<ColumnMapping> control_patterns;
   std::optional<VelocityEstimator> velocities;
   MapOrigin states_section;    ///< where [states] is (for "state 'x' has no column")
   MapOrigin controls_section;  ///< where [controls] is
@@ -145,7 +152,8 @@ struct ImportResult {
   ImportReport report;
 };
 
-/// Imports `log` by `map` for `system`. Throws DataError naming:
+/// Imports `log` by `map` for `system`, after expanding the map's patterns over the system's names
+/// (map_patterns.hpp). Throws DataError naming:
 /// - the map's file, line and field: a target that is not a state or control of the system, a state
 ///   or control without a column (and, for a velocity, no [velocities] estimator), a column the log
 ///   does not have (listing those it has), a column that cannot be used (text, matrix; with why);
