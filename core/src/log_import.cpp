@@ -11,6 +11,7 @@
 #include <set>
 
 #include "gpilqg/core/limits.hpp"
+#include "gpilqg/core/map_patterns.hpp"
 #include "gpilqg/core/resampling.hpp"
 #include "gpilqg/core/savitzky_golay.hpp"
 
@@ -37,7 +38,10 @@ const char* format_name(LogFormat format) {
 Vector mapped_values(const RawLog& log, const ColumnMapping& mapping, long rows, const std::string& time_column) {
   const LogColumn* column = log.find(mapping.column);
   if (column == nullptr)
-    map_error(mapping.origin, fmt::format("column '{}' is not in {}", mapping.column, log.file.string()),
+    map_error(mapping.origin,
+              fmt::format("column '{}'{} is not in {}", mapping.column,
+                          mapping.pattern.empty() ? "" : fmt::format(" (the pattern {} for '{}')", mapping.pattern, mapping.target),
+                          log.file.string()),
               fmt::format("one of its columns: {}", log.column_names()));
   if (!column->unusable.empty())
     throw DataError(log.file, log.location(column->name),
@@ -211,9 +215,10 @@ void choose_dt(const RawLog& log, const LogMap& map, const std::vector<Vector>& 
 }
 
 /// 3b. The gap limit (the map's max_gap, else 3 dt; at least dt) and every episode split at the steps
-/// longer than it (split_at_gaps), with the smallest and largest step left within the pieces.
-std::vector<std::vector<SampleRange>> split_episodes(const LogMap& map, const std::vector<Vector>& group_times,
-                                                     ImportReport& report) {
+/// longer than it (split_at_gaps), with the smallest and largest step left within the pieces, each
+/// gap and each record's count of pieces.
+std::vector<std::vector<SampleRange>> split_episodes(const LogMap& map, const std::vector<RowGroup>& groups,
+                                                     const std::vector<Vector>& group_times, ImportReport& report) {
   report.max_gap_from_map = map.max_gap.has_value();
   report.average_controls = map.average_controls;
   report.max_gap = map.max_gap.value_or(3.0 * report.dt);
@@ -223,9 +228,13 @@ std::vector<std::vector<SampleRange>> split_episodes(const LogMap& map, const st
   std::vector<std::vector<SampleRange>> pieces;
   report.step_min = INFINITY;
   report.step_max = 0.0;
-  for (const Vector& t : group_times) {
+  for (std::size_t g = 0; g < group_times.size(); ++g) {
+    const Vector& t = group_times[g];
     pieces.push_back(split_at_gaps(t, report.max_gap));
     report.gaps += static_cast<long>(pieces.back().size()) - 1;
+    report.records.push_back({groups[g].episode, t.size(), static_cast<long>(pieces.back().size()), 0});
+    for (std::size_t p = 1; p < pieces.back().size(); ++p)
+      report.gap_list.push_back({groups[g].episode, t(pieces.back()[p - 1].end - 1), t(pieces.back()[p].begin)});
     for (const SampleRange& r : pieces.back())
       for (long i = r.begin + 1; i < r.end; ++i) {
         report.step_min = std::min(report.step_min, t(i) - t(i - 1));
@@ -315,7 +324,8 @@ void resample_piece(const RowGroup& group, const Vector& t_group, const SampleRa
 
 }  // namespace
 
-ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignature& system) {
+ImportResult import_log(const RawLog& log, const LogMap& written_map, const SystemSignature& system) {
+  const LogMap map = expand_patterns(written_map, system);
   ImportResult result;
   ImportReport& report = result.report;
   report.log = log.file;
@@ -331,14 +341,17 @@ ImportResult import_log(const RawLog& log, const LogMap& map, const SystemSignat
   list_columns(log, map, system, report);
   const std::vector<Vector> group_times = episode_times(log, map, groups, columns.t);
   choose_dt(log, map, group_times, report);
-  const std::vector<std::vector<SampleRange>> pieces = split_episodes(map, group_times, report);
+  const std::vector<std::vector<SampleRange>> pieces = split_episodes(map, groups, group_times, report);
   check_resampled_size(map, group_times, pieces, rows, report);
 
   const std::optional<SavitzkyGolayDerivative> differentiator = velocity_estimator(report);
   const long min_samples = differentiator ? differentiator->window() : 2;
-  for (std::size_t g = 0; g < groups.size(); ++g)
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const std::size_t written_before = result.set.episodes.size();
     for (const SampleRange& r : pieces[g])
       resample_piece(groups[g], group_times[g], r, columns, map, system, differentiator, min_samples, result);
+    report.records[g].episodes = static_cast<long>(result.set.episodes.size() - written_before);
+  }
   if (result.set.episodes.empty())
     throw DataError(log.file, log.location(map.time.column),
                     fmt::format("no piece of the log is long enough: all {} rows dropped ({} pieces after splitting at "

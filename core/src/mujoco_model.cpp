@@ -18,6 +18,7 @@
 
 #include "gpilqg/core/input_file.hpp"
 #include "gpilqg/core/measurements.hpp"
+#include "mujoco_actuator_units.hpp"
 #include "mujoco_model_files.hpp"
 #include "urdf_actuators.hpp"
 
@@ -210,7 +211,7 @@ void MujocoModel::read_names() {
   }
   for (int j = 0; j < m_->njnt; ++j)
     states_.push_back({object_name(m_, mjOBJ_JOINT, j) + "_dot", m_->jnt_type[j] == mjJNT_SLIDE ? "m/s" : "rad/s"});
-  for (int a = 0; a < m_->nu; ++a) controls_.push_back({object_name(m_, mjOBJ_ACTUATOR, a), "-"});
+  for (int a = 0; a < m_->nu; ++a) controls_.push_back({object_name(m_, mjOBJ_ACTUATOR, a), actuator_control_unit(m_, a)});
   if (gains_.size() != m_->nu) gains_ = Vector::Ones(m_->nu);
 }
 

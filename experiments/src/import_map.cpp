@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <fmt/format.h>
 
+#include "gpilqg/core/map_patterns.hpp"
 #include "gpilqg/core/units.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
@@ -87,10 +88,22 @@ LogMap read_import_map(const std::filesystem::path& file) {
     if (!root.get(section)->is_table())
       fields.fail(section, fmt::format("expected a table [{}] of NAME = \"column\" entries", section));
     const toml::table* table = root.get(section)->as_table();
-    std::vector<ColumnMapping>& list = std::string(section) == "states" ? map.states : map.controls;
+    const bool states = std::string(section) == "states";
     for (const auto& [key, node] : *table) {
       const std::string target(key.str());
-      list.push_back(read_mapping(fields, &node, file, std::string(section) + "." + toml_key(target), target, true));
+      const std::string path = std::string(section) + "." + toml_key(target);
+      ColumnMapping mapping = read_mapping(fields, &node, file, path, target, true);
+      if (!is_pattern(target)) {
+        (states ? map.states : map.controls).push_back(std::move(mapping));
+        continue;
+      }
+      mapping.origin.field = path;  // errors about a pattern name its entry
+      mapping.origin.line = line_of(&node);
+      if (const auto problem = pattern_syntax_problem(target, mapping.column))
+        fields.fail(path, fmt::format("{}; expected a pattern such as \"q{{i}}\" = \"pos{{i}}\" ({{i}}: a whole number; "
+                                      "{{i+K}} or {{i-K}} in the column shift it by K)",
+                                      *problem));
+      (states ? map.state_patterns : map.control_patterns).push_back(std::move(mapping));
     }
   }
   map.states_section = section_origin(root, file, "states");

@@ -223,16 +223,16 @@ RawLog cartpole_log(int rows, double dt) {
 LogMap cartpole_map(bool with_velocities) {
   LogMap map;
   map.file = "map.toml";
-  map.time = {"time", "ms", "ms", 1e-3, {"map.toml", 2, "time.column"}};
-  map.states = {{"x", "x", "", 1.0, {"map.toml", 5, "states.x.column"}},
-                {"theta", "th_deg", "deg", std::numbers::pi / 180.0, {"map.toml", 6, "states.theta.column"}}};
+  map.time = {"time", "ms", "ms", 1e-3, {"map.toml", 2, "time.column"}, ""};
+  map.states = {{"x", "x", "", 1.0, {"map.toml", 5, "states.x.column"}, ""},
+                {"theta", "th_deg", "deg", std::numbers::pi / 180.0, {"map.toml", 6, "states.theta.column"}, ""}};
   if (with_velocities) {
-    map.states.push_back({"x_dot", "xd", "", 1.0, {"map.toml", 7, "states.x_dot.column"}});
-    map.states.push_back({"theta_dot", "thd", "", 1.0, {"map.toml", 8, "states.theta_dot.column"}});
+    map.states.push_back({"x_dot", "xd", "", 1.0, {"map.toml", 7, "states.x_dot.column"}, ""});
+    map.states.push_back({"theta_dot", "thd", "", 1.0, {"map.toml", 8, "states.theta_dot.column"}, ""});
   } else {
     map.velocities = VelocityEstimator{5, 2, {"map.toml", 11, "velocities"}};
   }
-  map.controls = {{"force", "f", "", 1.0, {"map.toml", 10, "controls.force.column"}}};
+  map.controls = {{"force", "f", "", 1.0, {"map.toml", 10, "controls.force.column"}, ""}};
   map.states_section = {"map.toml", 4, "states"};
   map.controls_section = {"map.toml", 9, "controls"};
   return map;
@@ -283,6 +283,16 @@ TEST(ImportLog, GapsSplitEpisodesAndShortPiecesAreDroppedAndCounted) {
   EXPECT_EQ(r.report.rows_read, 14);
   EXPECT_EQ(r.report.rows_used + r.report.rows_dropped, 14);
   EXPECT_TRUE(r.report.dropped.empty());
+  // Each gap from the last sample before it to the first after: rows 9 -> 25 and 26 -> 38.
+  ASSERT_EQ(r.report.gap_list.size(), 2u);
+  EXPECT_NEAR(r.report.gap_list[0].t_start, 9 * 0.02, 1e-12);
+  EXPECT_NEAR(r.report.gap_list[0].length(), 16 * 0.02, 1e-12);
+  EXPECT_NEAR(r.report.gap_list[1].t_start, 26 * 0.02, 1e-12);
+  EXPECT_NEAR(r.report.gap_list[1].length(), 12 * 0.02, 1e-12);
+  ASSERT_EQ(r.report.records.size(), 1u);  // no episode column: the log is one record, cut in 3
+  EXPECT_EQ(r.report.records[0].rows, 14);
+  EXPECT_EQ(r.report.records[0].pieces, 3);
+  EXPECT_EQ(r.report.records[0].episodes, 3);
   // With the velocity estimator (window 5), the 2-row pieces are too short and are dropped.
   LogMap estimating = cartpole_map(false);
   estimating.max_gap = 0.1;
@@ -291,6 +301,8 @@ TEST(ImportLog, GapsSplitEpisodesAndShortPiecesAreDroppedAndCounted) {
   EXPECT_EQ(d.report.rows_dropped, 4);
   ASSERT_EQ(d.report.dropped.size(), 2u);
   EXPECT_NE(d.report.dropped[0].reason.find("expected at least 5"), std::string::npos) << d.report.dropped[0].reason;
+  EXPECT_EQ(d.report.records[0].pieces, 3);
+  EXPECT_EQ(d.report.records[0].episodes, 1);
 }
 
 std::string import_error(const RawLog& log, const LogMap& map) {
@@ -323,7 +335,7 @@ TEST(ImportLog, ErrorsNameTheMapLineOrTheLogRow) {
   EXPECT_NE(e4.find("map.toml:line 4: field 'states': state 'theta_dot' has no column and no estimator"), std::string::npos) << e4;
 
   LogMap twice = cartpole_map(true);
-  twice.controls.push_back({"force", "x", "", 1.0, {"map.toml", 12, "controls.force.column"}});
+  twice.controls.push_back({"force", "x", "", 1.0, {"map.toml", 12, "controls.force.column"}, ""});
   EXPECT_NE(import_error(cartpole_log(10, 0.02), twice).find("map.toml:line 12"), std::string::npos);
 
   LogMap foreign = cartpole_map(true);

@@ -68,6 +68,7 @@ TEST(UrdfRobot, EachJointGetsAMotorBoundedByItsEffortLimit) {
   EXPECT_EQ(arm->name(), "two_link_arm_urdf");
   EXPECT_EQ(names_of(arm->states()), (std::vector<std::string>{"shoulder", "elbow", "shoulder_dot", "elbow_dot"}));
   EXPECT_EQ(names_of(arm->controls()), (std::vector<std::string>{"shoulder_motor", "elbow_motor"}));
+  for (const Quantity& motor : arm->controls()) EXPECT_EQ(motor.unit, "N m") << motor.name;  // torques on hinges
   const auto [lower, upper] = arm->control_limits();
   EXPECT_MATRIX_NEAR(lower, (Vector(2) << -8.0, -3.0).finished(), 0.0);
   EXPECT_MATRIX_NEAR(upper, (Vector(2) << 8.0, 3.0).finished(), 0.0);
@@ -108,6 +109,10 @@ TEST(UrdfRobot, EffortZeroLeavesAJointPassiveAndNoEffortLeavesTheMotorUnbounded)
   const auto one = MujocoSystem::load(
       write_urdf(dir, R"(<limit lower="-1" upper="1" effort="0" velocity="1"/>)", "").string());
   EXPECT_EQ(names_of(one->controls()), (std::vector<std::string>{"spin_motor"}));
+  EXPECT_EQ(one->controls()[0].unit, "N m");  // the wheel's continuous joint: a torque
+  const auto both = MujocoSystem::load(write_urdf(dir, R"(<limit lower="-1" upper="1" effort="5" velocity="1"/>)", "").string());
+  EXPECT_EQ(names_of(both->controls()), (std::vector<std::string>{"slide_motor", "spin_motor"}));
+  EXPECT_EQ(both->controls()[0].unit, "N");  // the prismatic joint: a force
   const auto [lower, upper] = one->control_limits();
   EXPECT_TRUE(std::isinf(lower(0)) && std::isinf(upper(0)));
 

@@ -7,7 +7,8 @@
 /// 1. the mapped columns are scaled to SI (units.hpp); every other column is ignored and reported;
 /// 2. rows are grouped by the episode column (in order of first appearance; one episode without it),
 ///    and time must increase strictly within each group;
-/// 3. each group is split where two consecutive samples are more than max_gap apart;
+/// 3. each group (a record) is split where two consecutive samples are more than max_gap apart, and
+///    every such gap is listed in the report with what it made of its record;
 /// 4. each piece is resampled onto t_0 + k dt (resampling.hpp): states linearly, controls held (or
 ///    averaged over each step when the map asks for it);
 /// 5. velocities the log lacks (`<q>_dot` for a mapped `<q>`) are estimated from the resampled
@@ -44,6 +45,9 @@ struct ColumnMapping {
   std::string unit;    ///< as written in the map; empty: the SI unit
   double scale = 1.0;  ///< value in SI = scale * logged value
   MapOrigin origin;    ///< of the `column` entry
+  /// The pattern entry this mapping was expanded from, as written ("'q{i}' = 'pos{i}'",
+  /// map_patterns.hpp); empty for an explicit entry.
+  std::string pattern;
 };
 
 /// Settings of the velocity estimator for `<q>_dot` states without a column.
@@ -66,6 +70,10 @@ struct LogMap {
   bool average_controls = false;
   std::vector<ColumnMapping> states;
   std::vector<ColumnMapping> controls;
+  /// Entries of [states] and [controls] whose target holds the placeholder {i} (map_patterns.hpp):
+  /// `target` and `column` as written. import_log expands them over the system's names.
+  std::vector<ColumnMapping> state_patterns;
+  std::vector<ColumnMapping> control_patterns;
   std::optional<VelocityEstimator> velocities;
   MapOrigin states_section;    ///< where [states] is (for "state 'x' has no column")
   MapOrigin controls_section;  ///< where [controls] is
@@ -79,6 +87,23 @@ struct DroppedPiece {
   double t_end = 0.0;
   long rows = 0;
   std::string reason;
+};
+
+/// A step longer than max_gap between two samples of one record: where the record was cut.
+struct SplitGap {
+  long source_episode = 0;
+  double t_start = 0.0;  ///< [s], log time of the last sample before the gap
+  double t_end = 0.0;    ///< [s], log time of the first sample after it
+  double length() const { return t_end - t_start; }
+};
+
+/// A record of the log (the rows of one episode value, or the whole log without an episode column)
+/// and what max_gap made of it, so a report can say when one recording became many episodes.
+struct LogRecord {
+  long source_episode = 0;
+  long rows = 0;
+  long pieces = 1;    ///< after splitting at its gaps: 1 + the gaps in it
+  long episodes = 0;  ///< pieces written; the others were dropped as too short
 };
 
 /// An episode written, and where it came from.
@@ -108,6 +133,8 @@ struct ImportReport {
   double step_min = 0.0;     ///< smallest logged step within a piece [s]
   double step_max = 0.0;     ///< largest logged step within a piece (<= max_gap) [s]
   long gaps = 0;             ///< steps longer than max_gap, each starting a new piece
+  std::vector<SplitGap> gap_list;  ///< every one of them, in log order
+  std::vector<LogRecord> records;  ///< the log's records in order of first appearance
   std::vector<ColumnMapping> columns;  ///< time, episode, states and controls as mapped
   std::vector<std::string> ignored_columns;  ///< log columns the map does not use
   /// The estimated velocities as {target, position column's target}, e.g. {"x_dot", "x"}.
@@ -125,7 +152,8 @@ struct ImportResult {
   ImportReport report;
 };
 
-/// Imports `log` by `map` for `system`. Throws DataError naming:
+/// Imports `log` by `map` for `system`, after expanding the map's patterns over the system's names
+/// (map_patterns.hpp). Throws DataError naming:
 /// - the map's file, line and field: a target that is not a state or control of the system, a state
 ///   or control without a column (and, for a velocity, no [velocities] estimator), a column the log
 ///   does not have (listing those it has), a column that cannot be used (text, matrix; with why);

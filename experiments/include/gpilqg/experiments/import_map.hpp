@@ -18,6 +18,7 @@
 /// theta = { column = "angle_deg", unit = "deg" }
 /// [controls]
 /// force = "force_N"                # shorthand for { column = "force_N" }, unit SI
+/// # "tau{i}" = "effort{i}"         # a pattern: every control tau<number> (map_patterns.hpp)
 /// [velocities]                     # estimates x_dot, theta_dot from x, theta when not in [states]
 /// method = "savitzky_golay"
 /// window = 7
@@ -35,8 +36,9 @@ namespace gpilqg {
 /// syntax (a key written twice included), unknown sections or keys, a missing [time], [states] or
 /// [controls], a missing or non-string column, a unit not in the unit table (units.hpp, listing it),
 /// a time unit that is not a time, a non-positive dt or max_gap, max_gap < dt, an unknown velocity
-/// method and a window or order out of range. Which targets exist and which columns the log has are
-/// checked by import_log, which names the map's line for those too.
+/// method, a window or order out of range, and a malformed pattern (map_patterns.hpp). Entries whose
+/// name holds a brace are kept as patterns. Which targets exist, what the patterns match and which
+/// columns the log has are checked by import_log, which names the map's line for those too.
 LogMap read_import_map(const std::filesystem::path& file);
 
 }  // namespace gpilqg
