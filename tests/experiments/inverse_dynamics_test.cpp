@@ -404,31 +404,53 @@ void simulate_world(const Dynamics& world, double dt, int T, int episode, Matrix
   }
 }
 
-TEST(InverseDynamicsResidual, NoiseFreeWorldWithHiddenFrictionGivesTheFrictionAsResidual) {
+/// The arm as the model and the world with the hidden forces.
+struct HiddenFrictionWorld {
   ModelSpec model;
-  model.system = arm_path();
-  ModelSpec world = model;
-  world.forces.push_back({"joint_viscous_damping:shoulder", Vector::Constant(1, kShoulderDamping)});
-  world.forces.push_back({"joint_coulomb_friction:elbow", Vector::Constant(1, kElbowFriction)});
-  world.smoothing["joint_coulomb_friction:elbow"] = kElbowSmoothing;
-  const DynamicsPtr world_dynamics = world.build();
+  DynamicsPtr world;
+  std::vector<Matrix> states, controls;  ///< three episodes of 3 s at 500 Hz
+  double dt = 0.002;  ///< the elbow's friction turns within v0 = 0.1 rad/s, a few milliseconds at these speeds
+};
 
-  // 500 Hz: the elbow's friction turns within v0 = 0.1 rad/s, a few milliseconds at these speeds.
-  const double dt = 0.002;
-  std::vector<Matrix> states, controls;
-  for (int e = 0; e < 3; ++e) {
-    Matrix x, u;
-    simulate_world(*world_dynamics, dt, 1501, e, x, u);
-    states.push_back(x);
-    controls.push_back(u);
-  }
-  const Transitions data = transitions_of(states, controls, dt);
+const HiddenFrictionWorld& hidden_friction_world() {
+  static const HiddenFrictionWorld w = [] {
+    HiddenFrictionWorld w;
+    w.model.system = arm_path();
+    ModelSpec world = w.model;
+    world.forces.push_back({"joint_viscous_damping:shoulder", Vector::Constant(1, kShoulderDamping)});
+    world.forces.push_back({"joint_coulomb_friction:elbow", Vector::Constant(1, kElbowFriction)});
+    world.smoothing["joint_coulomb_friction:elbow"] = kElbowSmoothing;
+    w.world = world.build();
+    for (int e = 0; e < 3; ++e) {
+      Matrix x, u;
+      simulate_world(*w.world, w.dt, 1501, e, x, u);
+      w.states.push_back(x);
+      w.controls.push_back(u);
+    }
+    return w;
+  }();
+  return w;
+}
+
+/// IDIM-LS on the residual: b and tau by linear least squares, each on its own joint's column.
+Vector friction_by_least_squares(const Transitions& data, const Matrix& r) {
+  const Vector shoulder_basis = -data.x.col(2);
+  const Vector elbow_basis = -(data.x.col(3) / kElbowSmoothing).array().tanh().matrix();
+  return (Vector(2) << shoulder_basis.dot(r.col(0)) / shoulder_basis.squaredNorm(),
+          elbow_basis.dot(r.col(1)) / elbow_basis.squaredNorm())
+      .finished();
+}
+
+TEST(InverseDynamicsResidual, NoiseFreeWorldWithHiddenFrictionGivesTheFrictionAsResidual) {
+  const HiddenFrictionWorld& w = hidden_friction_world();
+  const ModelSpec& model = w.model;
+  const Transitions data = transitions_of(w.states, w.controls, w.dt);
   const std::vector<int> rows = data.rows(false);
 
   // With the world's true accelerations the residual is the hidden force, exactly.
   Matrix true_qdd(data.size(), 2);
   for (int t = 0; t < data.size(); ++t) {
-    const Vector xdot = world_dynamics->f(data.x.row(t).transpose(), data.u.row(t).transpose());
+    const Vector xdot = w.world->f(data.x.row(t).transpose(), data.u.row(t).transpose());
     true_qdd.row(t) = xdot.tail(2).transpose();
   }
   const Matrix exact = generalised_force_residual(model, data, true_qdd, rows);
@@ -438,7 +460,7 @@ TEST(InverseDynamicsResidual, NoiseFreeWorldWithHiddenFrictionGivesTheFrictionAs
 
   // With the estimated accelerations: the hidden force within the estimate's error.
   const AccelerationEstimate estimate =
-      estimate_accelerations(data, force_components(*model.build()).velocity_states(), dt);
+      estimate_accelerations(data, force_components(*model.build()).velocity_states(), w.dt);
   const Matrix r = generalised_force_residual(model, data, estimate.qdd, rows);
   const Vector error_rms = ((r - hidden).colwise().squaredNorm() / data.size()).cwiseSqrt().transpose();
   const Vector hidden_rms = (hidden.colwise().squaredNorm() / data.size()).cwiseSqrt().transpose();
@@ -450,14 +472,37 @@ TEST(InverseDynamicsResidual, NoiseFreeWorldWithHiddenFrictionGivesTheFrictionAs
   EXPECT_LT(error_rms(1), 0.02 * hidden_rms(1));
 
   // IDIM-LS on the residual: the friction parameters by linear least squares, each on its own joint.
-  const Vector shoulder_basis = -data.x.col(2);
-  const Vector elbow_basis = -(data.x.col(3) / kElbowSmoothing).array().tanh().matrix();
-  const double b = shoulder_basis.dot(r.col(0)) / shoulder_basis.squaredNorm();
-  const double tau = elbow_basis.dot(r.col(1)) / elbow_basis.squaredNorm();
+  const Vector theta = friction_by_least_squares(data, r);
+  const double b = theta(0), tau = theta(1);
   std::printf("least squares on the residual: b = %.4f (true %.4f), tau = %.4f (true %.4f)\n", b, kShoulderDamping, tau,
               kElbowFriction);
   EXPECT_NEAR(b, kShoulderDamping, 0.01 * kShoulderDamping);
   EXPECT_NEAR(tau, kElbowFriction, 0.01 * kElbowFriction);
+}
+
+TEST(InverseDynamicsResidual, NoisyVelocitiesGiveTheFrictionByLeastSquaresOnTheResidual) {
+  // The same record with white noise of 0.02 rad/s on the measured velocities (and 1e-4 rad on the
+  // angles): the window rule smooths, and least squares on the residual finds the hidden friction.
+  const HiddenFrictionWorld& w = hidden_friction_world();
+  std::mt19937 rng(5);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<Matrix> noisy = w.states;
+  for (Matrix& x : noisy)
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      for (Eigen::Index j = 0; j < 4; ++j) x(i, j) += (j < 2 ? 1e-4 : 0.02) * gauss(rng);
+  const Transitions data = transitions_of(noisy, w.controls, w.dt);
+  const AccelerationEstimate estimate =
+      estimate_accelerations(data, force_components(*w.model.build()).velocity_states(), w.dt);
+  const Matrix r = generalised_force_residual(w.model, data, estimate.qdd, data.rows(false));
+  const Vector theta = friction_by_least_squares(data, r);
+  std::printf("windows %d, %d (sigma_hat %.4f, %.4f rad/s); b = %.4f (true %.4f), tau = %.4f (true %.4f)\n",
+              estimate.windows[0].window, estimate.windows[1].window, estimate.windows[0].noise_std,
+              estimate.windows[1].noise_std, theta(0), kShoulderDamping, theta(1), kElbowFriction);
+  EXPECT_NEAR(estimate.windows[0].noise_std, 0.02, 0.002);
+  EXPECT_NEAR(estimate.windows[1].noise_std, 0.02, 0.002);
+  EXPECT_GT(estimate.windows[0].window, 3);
+  EXPECT_NEAR(theta(0), kShoulderDamping, 0.05 * kShoulderDamping);
+  EXPECT_NEAR(theta(1), kElbowFriction, 0.05 * kElbowFriction);
 }
 
 }  // namespace
