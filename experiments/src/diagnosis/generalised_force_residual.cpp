@@ -1,0 +1,124 @@
+#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+
+#include <stdexcept>
+
+#include <Eigen/QR>
+#include <fmt/format.h>
+
+#include "gpilqg/core/effects.hpp"
+
+namespace gpilqg::diagnosis {
+
+namespace {
+
+/// The system whose generalised-force map `model` uses: itself, or the base of an EffectDynamics
+/// (effects add forces through the base's map), or null.
+const Dynamics* force_map_owner(const Dynamics& model) {
+  const Dynamics* system = &model;
+  while (dynamic_cast<const GeneralisedForceInput*>(system) == nullptr) {
+    const auto* decorated = dynamic_cast<const EffectDynamics*>(system);
+    if (decorated == nullptr) return nullptr;
+    system = &decorated->base();
+  }
+  return system;
+}
+
+const Dynamics& require_force_map(const Dynamics& model) {
+  const Dynamics* owner = force_map_owner(model);
+  if (owner == nullptr)
+    throw std::invalid_argument(fmt::format(
+        "inverse-dynamics residual: system '{}' has no generalised-force map (its equations do not accept extra "
+        "generalised forces), so it has no force residual", model.name()));
+  return *owner;
+}
+
+}  // namespace
+
+std::vector<int> ForceComponents::velocity_states() const {
+  std::vector<int> out;
+  out.reserve(coordinates.size());
+  for (const GeneralisedCoordinate& c : coordinates) out.push_back(c.velocity);
+  return out;
+}
+
+ForceComponents force_components(const Dynamics& model) {
+  const Dynamics& owner = require_force_map(model);
+  ForceComponents out;
+  out.forces = dynamic_cast<const GeneralisedForceInput&>(owner).generalised_forces();
+  const std::vector<GeneralisedCoordinate> coordinates = generalised_coordinates(owner);
+  out.coordinates.resize(out.forces.size());
+  std::vector<bool> found(out.forces.size(), false);
+  for (const GeneralisedCoordinate& c : coordinates) {
+    out.coordinates[static_cast<std::size_t>(c.component)] = c;
+    found[static_cast<std::size_t>(c.component)] = true;
+  }
+  for (std::size_t i = 0; i < found.size(); ++i)
+    if (!found[i])
+      throw std::invalid_argument(fmt::format(
+          "inverse-dynamics residual: force component '{}' of system '{}' acts on no coordinate with a velocity "
+          "state, so its acceleration cannot be measured", out.forces[i].name, model.name()));
+  return out;
+}
+
+Matrix generalised_force_residual(const Dynamics& model, const Transitions& data, const Matrix& applied_u,
+                                  const Matrix& accelerations, const std::vector<int>& rows) {
+  const Dynamics& owner = require_force_map(model);
+  const auto& map = dynamic_cast<const GeneralisedForceInput&>(owner);
+  const ForceComponents components = force_components(model);
+  const auto k = static_cast<Eigen::Index>(components.forces.size());
+  const int n = model.state_dim();
+  if (data.x.cols() != n)
+    throw std::invalid_argument(fmt::format("inverse-dynamics residual: the data have {} states; system '{}' has {}",
+                                            data.x.cols(), model.name(), n));
+  if (applied_u.rows() != data.size() || applied_u.cols() != model.control_dim())
+    throw std::invalid_argument(fmt::format(
+        "inverse-dynamics residual: the applied controls are {} x {}; expected {} x {} (one row per transition)",
+        applied_u.rows(), applied_u.cols(), data.size(), model.control_dim()));
+  if (accelerations.rows() != data.size() || accelerations.cols() != k)
+    throw std::invalid_argument(fmt::format(
+        "inverse-dynamics residual: the accelerations are {} x {}; expected {} x {} (one row per transition, one "
+        "column per force component)", accelerations.rows(), accelerations.cols(), data.size(), k));
+  const std::vector<int> velocity = components.velocity_states();
+
+  const auto model_workspace = model.make_workspace();
+  const auto map_workspace = owner.make_workspace();
+  Vector x(n);
+  Vector u(model.control_dim());
+  Vector xdot(n);
+  Matrix W(n, k);
+  Matrix W_v(k, k);
+  Vector e(k);
+  Eigen::ColPivHouseholderQR<Matrix> factor(k, k);
+  Matrix out(static_cast<Eigen::Index>(rows.size()), k);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const int t = rows[i];
+    if (t < 0 || t >= data.size())
+      throw std::invalid_argument(
+          fmt::format("inverse-dynamics residual: row {}; the data have {} transitions", t, data.size()));
+    x = data.x.row(t).transpose();
+    u = applied_u.row(t).transpose();
+    model.evaluate(x, u, xdot, nullptr, *model_workspace);
+    map.generalised_force_map(x, W, nullptr, *map_workspace);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      const int v = velocity[static_cast<std::size_t>(c)];
+      W_v.row(c) = W.row(v);
+      e(c) = accelerations(t, c) - xdot(v);
+    }
+    factor.compute(W_v);
+    if (factor.rank() < k || !e.allFinite())
+      throw std::invalid_argument(fmt::format(
+          "inverse-dynamics residual: at row {} (episode {}, t = {}) the model's {}; no force residual there", t,
+          data.episode[static_cast<std::size_t>(t)], data.t.size() > t ? data.t(t) : 0.0,
+          e.allFinite() ? "generalised-force map is singular" : "acceleration or the measured one is not finite"));
+    out.row(static_cast<Eigen::Index>(i)) = factor.solve(e).transpose();
+  }
+  return out;
+}
+
+Matrix generalised_force_residual(const ModelSpec& model, const Transitions& data, const Matrix& accelerations,
+                                  const std::vector<int>& rows) {
+  const DynamicsPtr system = model.build();
+  return generalised_force_residual(*system, data, applied_controls(data, model.input_delay), accelerations, rows);
+}
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,509 @@
+// The building blocks of the inverse-dynamics residual: the zero-phase acceleration estimate with its
+// window chosen from the data (derivative_window.hpp, accelerations.hpp) and the generalised-force
+// residual of a model (generalised_force_residual.hpp). Each is checked against something
+// independent: analytic derivatives of polynomials and sinusoids (and the error of every window of
+// the grid against the true derivative, to judge the rule's choice), the cart-pole's textbook
+// inverse dynamics written out here, MuJoCo's own inverse dynamics (mj_inverse), and the hidden
+// friction of a simulated world, written out here.
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include <Eigen/QR>
+
+#include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/savitzky_golay.hpp"
+#include "gpilqg/experiments/diagnosis/accelerations.hpp"
+#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+#include "test_support.hpp"
+
+namespace gpilqg {
+namespace {
+
+using namespace diagnosis;
+
+/// Transitions of episodes given as sampled states (T x n each) and controls (T x m each), every
+/// episode at step dt: the rows x_t -> x_{t+1} of make_transitions.
+Transitions transitions_of(const std::vector<Matrix>& states, const std::vector<Matrix>& controls, double dt) {
+  Transitions out;
+  Eigen::Index rows = 0;
+  for (const Matrix& x : states) rows += x.rows() - 1;
+  const Eigen::Index n = states.front().cols(), m = controls.front().cols();
+  out.x.resize(rows, n);
+  out.u.resize(rows, m);
+  out.x_next.resize(rows, n);
+  out.t.resize(rows);
+  Eigen::Index row = 0;
+  for (std::size_t e = 0; e < states.size(); ++e) {
+    const Eigen::Index steps = states[e].rows() - 1;
+    out.x.middleRows(row, steps) = states[e].topRows(steps);
+    out.x_next.middleRows(row, steps) = states[e].bottomRows(steps);
+    out.u.middleRows(row, steps) = controls[e].topRows(steps);
+    for (Eigen::Index s = 0; s < steps; ++s) {
+      out.t(row + s) = static_cast<double>(s) * dt;
+      out.episode.push_back(static_cast<int>(e));
+      out.heldout.push_back(false);
+    }
+    row += steps;
+  }
+  return out;
+}
+
+/// One state column sampled from `signal` at T samples of step dt, plus white noise of std `noise`.
+Matrix sampled(const std::function<double(double)>& signal, int T, double dt, double noise, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  Matrix x(T, 1);
+  for (int i = 0; i < T; ++i) x(i, 0) = signal(i * dt) + noise * gauss(rng);
+  return x;
+}
+
+// --- The acceleration estimate -------------------------------------------------------------------
+
+TEST(InverseDynamicsAccelerations, ExactForPolynomialsOfTheFilterOrderAtEverySampleIncludingTheEnds) {
+  for (const int order : {2, 3}) {
+    // v(t) = 0.3 - 1.2 t + 0.7 t^2 (+ 0.9 t^3 for order 3): qdd = -1.2 + 1.4 t (+ 2.7 t^2), two episodes.
+    const double cubic = order == 3 ? 0.9 : 0.0;
+    const auto v = [&](double t) { return 0.3 - 1.2 * t + 0.7 * t * t + cubic * t * t * t; };
+    const auto a = [&](double t) { return -1.2 + 1.4 * t + 3.0 * cubic * t * t; };
+    const double dt = 0.01;
+    const Transitions data = transitions_of({sampled(v, 150, dt, 0.0, 1), sampled(v, 90, dt, 0.0, 2)},
+                                            {Matrix::Zero(150, 1), Matrix::Zero(90, 1)}, dt);
+    const AccelerationEstimate estimate = estimate_accelerations(data, {0}, dt, order);
+    ASSERT_EQ(estimate.qdd.rows(), data.size());
+    for (int r = 0; r < data.size(); ++r) EXPECT_NEAR(estimate.qdd(r, 0), a(data.t(r)), 1e-8) << "order " << order << " row " << r;
+  }
+}
+
+TEST(InverseDynamicsAccelerations, ZeroLagOnANoisySinusoidWhereACausalWindowWouldLag) {
+  // v = sin(omega t) at 100 Hz with noise 1% of the amplitude: the rule takes a long window, over which
+  // a causal (one-sided) fit would lag by about h dt, a phase of omega h dt. The centred fit's estimate,
+  // projected on cos and sin over the interior samples, has no sin part beyond the noise.
+  const double dt = 0.01, omega = 2.0 * M_PI * 0.5;
+  const int T = 2001;
+  const Transitions data = transitions_of({sampled([&](double t) { return std::sin(omega * t); }, T, dt, 0.01, 3)},
+                                          {Matrix::Zero(T, 1)}, dt);
+  const AccelerationEstimate estimate = estimate_accelerations(data, {0}, dt);
+  const int h = estimate.windows[0].window / 2;
+  EXPECT_GT(omega * h * dt, 0.1) << "window " << estimate.windows[0].window << ": too short to show a lag";
+  Matrix basis(data.size() - 2 * h, 2);
+  Vector y(basis.rows());
+  for (Eigen::Index r = 0; r < basis.rows(); ++r) {
+    const double t = data.t(r + h);
+    basis(r, 0) = std::cos(omega * t);
+    basis(r, 1) = std::sin(omega * t);
+    y(r) = estimate.qdd(r + h, 0);
+  }
+  const Vector ab = basis.colPivHouseholderQr().solve(y);
+  const double phase = std::atan2(-ab(1), ab(0));  // the estimate is |a| cos(omega t - phase)
+  EXPECT_LT(std::abs(phase), 0.01) << "window " << estimate.windows[0].window;
+  // The amplitude: the frequency response of the antisymmetric weights, sum_j c_j sin(omega j dt) / dt,
+  // slightly below omega (the bias the window rule accepts for less noise).
+  const SavitzkyGolayDerivative filter(estimate.windows[0].window, 2);
+  const Vector& c = filter.weights(h);
+  double response = 0.0;
+  for (int j = -h; j <= h; ++j) response += c(j + h) * std::sin(omega * j * dt) / dt;
+  EXPECT_NEAR(ab(0), response, 0.002 * omega);
+  std::printf("window %d: phase %.2e rad (a causal window: %.2f rad), amplitude %.4f, response %.4f, omega %.4f\n",
+              estimate.windows[0].window, phase, omega * h * dt, ab(0), response, omega);
+}
+
+/// The mean squared error of the derivative of `signal` against `derivative` over the interior
+/// samples at least `margin` from the ends, for a window w of order 2.
+double actual_mse(const Vector& samples, const std::function<double(double)>& derivative, double dt, int window,
+                  int margin) {
+  const Vector d = SavitzkyGolayDerivative(window, 2).differentiate(samples, dt);
+  double sum = 0.0;
+  for (Eigen::Index i = margin; i + margin < samples.size(); ++i) sum += std::pow(d(i) - derivative(i * dt), 2);
+  return sum / static_cast<double>(samples.size() - 2 * margin);
+}
+
+struct WindowCase {
+  double frequency;  ///< [Hz] of the slower component
+  double noise;      ///< std of the white noise on the samples
+  double dt;
+};
+
+struct WindowOutcome {
+  DerivativeWindow chosen;
+  double chosen_mse = 0.0;  ///< its true mean squared error
+  double best_mse = 0.0;    ///< the least true mean squared error of any window from 3 to 301
+  int best_window = 0;
+};
+
+/// A velocity of two incommensurate sinusoids over 10 s: the rule's choice and, against the true
+/// derivative, its error and that of the best window in hindsight.
+WindowOutcome window_for(const WindowCase& c) {
+  const double w1 = 2.0 * M_PI * c.frequency, w2 = 2.7 * w1;
+  const auto v = [&](double t) { return std::sin(w1 * t) + 0.5 * std::sin(w2 * t + 1.0); };
+  const auto a = [&](double t) { return w1 * std::cos(w1 * t) + 0.5 * w2 * std::cos(w2 * t + 1.0); };
+  const int T = static_cast<int>(std::lround(10.0 / c.dt)) + 1;
+  const Vector y = sampled(v, T, c.dt, c.noise, 11).col(0);
+  WindowOutcome out;
+  out.chosen = choose_derivative_window({y}, c.dt);
+  const int margin = 150;
+  out.chosen_mse = actual_mse(y, a, c.dt, out.chosen.window, margin);
+  out.best_mse = std::numeric_limits<double>::infinity();
+  for (int h = 1; h <= margin; h += std::max(1, h / 10)) {  // every window to 21, then 10% apart
+    const int w = 2 * h + 1;
+    const double mse = actual_mse(y, a, c.dt, w, margin);
+    if (mse < out.best_mse) {
+      out.best_mse = mse;
+      out.best_window = w;
+    }
+  }
+  return out;
+}
+
+TEST(InverseDynamicsAccelerations, WindowRuleIsNearTheBestWindowInHindsightAndFollowsNoiseSpeedAndRate) {
+  const WindowOutcome base = window_for({1.0, 0.01, 0.01});
+  const WindowOutcome noisier = window_for({1.0, 0.05, 0.01});
+  const WindowOutcome faster = window_for({3.0, 0.01, 0.01});
+  const WindowOutcome fast_rate = window_for({1.0, 0.01, 0.001});
+  const WindowOutcome clean = window_for({1.0, 0.0, 0.01});
+  for (const WindowOutcome* o : {&base, &noisier, &faster, &fast_rate, &clean}) {
+    std::printf("window %3d (%.3f s), sigma_hat %.3e, estimated rms %.4g, true rms %.4g; best window %3d, rms %.4g; "
+                "mse ratio %.4f\n", o->chosen.window, o->chosen.window * (o == &fast_rate ? 0.001 : 0.01),
+                o->chosen.noise_std, std::sqrt(o->chosen.risk), std::sqrt(o->chosen_mse), o->best_window,
+                std::sqrt(o->best_mse), o->chosen_mse / o->best_mse);
+    // Near the optimum: the true mean squared error within 1.1 times the best window's.
+    EXPECT_LE(o->chosen_mse, 1.1 * o->best_mse) << "window " << o->chosen.window << ", best " << o->best_window;
+  }
+  EXPECT_GT(noisier.chosen.window, base.chosen.window);
+  EXPECT_LT(faster.chosen.window, base.chosen.window);
+  EXPECT_LT(clean.chosen.window, base.chosen.window);
+  // The same signal and noise per sample at 1 kHz: theory (derivative_window.hpp) says a span 10^(1/7)
+  // = 1.39 times shorter; roughly the same time, and ten times the samples' rate does not mean ten
+  // times the samples.
+  const double span_100 = (base.chosen.window - 1) * 0.01, span_1000 = (fast_rate.chosen.window - 1) * 0.001;
+  EXPECT_GT(span_100 / span_1000, 1.0);
+  EXPECT_LT(span_100 / span_1000, 2.0);
+  // The noise estimate from differences, against the noise put in.
+  EXPECT_NEAR(base.chosen.noise_std, 0.01, 0.001);
+  EXPECT_NEAR(noisier.chosen.noise_std, 0.05, 0.005);
+}
+
+TEST(InverseDynamicsAccelerations, ShortEpisodesAndWrongStepsAreClearErrors) {
+  const double dt = 0.01;
+  const auto v = [](double t) { return t; };
+  const Transitions data = transitions_of({sampled(v, 50, dt, 0.0, 1), sampled(v, 4, dt, 0.0, 2)},
+                                          {Matrix::Zero(50, 1), Matrix::Zero(4, 1)}, dt);
+  try {
+    estimate_accelerations(data, {0}, dt);
+    ADD_FAILURE() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("episode 1 (rows 49 to 51) has 4 consecutive samples"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("needs at least 5"), std::string::npos) << e.what();
+  }
+  const Transitions long_enough = transitions_of({sampled(v, 50, dt, 0.0, 1)}, {Matrix::Zero(50, 1)}, dt);
+  EXPECT_THROW(estimate_accelerations(long_enough, {0}, 0.02), std::invalid_argument);  // t says 0.01
+  EXPECT_THROW(estimate_accelerations(long_enough, {1}, dt), std::invalid_argument);     // no column 1
+}
+
+// --- The residual on the cart-pole, against its textbook inverse dynamics ------------------------
+
+/// M(q) qdd - h(q, qdot, k u) of the cart-pole written out (Tedrake, Underactuated Robotics, ch. 3;
+/// theta = 0 hanging): (mc + mp) x_dd + mp l c th_dd - mp l s th_d^2 = k u + Q_x and
+/// mp l c x_dd + mp l^2 th_dd + mp g l s = Q_theta, solved for Q.
+Vector cartpole_inverse_dynamics(const Vector& x, const Vector& qdd, double u, double mc, double mp, double l, double k) {
+  const double g = 9.81, s = std::sin(x(2)), c = std::cos(x(2));
+  Vector Q(2);
+  Q(0) = (mc + mp) * qdd(0) + mp * l * c * qdd(1) - mp * l * s * x(3) * x(3) - k * u;
+  Q(1) = mp * l * c * qdd(0) + mp * l * l * qdd(1) + mp * g * l * s;
+  return Q;
+}
+
+TEST(InverseDynamicsResidual, CartPoleMatchesTheClosedFormWithTheModelsParametersGainAndDelay) {
+  // Random states, accelerations and controls in two episodes. The model: the simulator preset
+  // (cart 1 kg, pole 1 kg, length 1 m, CartPoleParameters::simulator()) with the pole recalibrated to
+  // 1.3 m, an actuator gain of 0.8 and an input delay of one control period, so the force at row t is
+  // 0.8 u_{t-1} (u_0 at an episode's first row).
+  const int T = 40;
+  std::vector<Matrix> states, controls;
+  for (unsigned e = 0; e < 2; ++e) {
+    Matrix x(T, 4), u(T, 1);
+    for (int i = 0; i < T; ++i) {
+      x.row(i) = test::random_vector(4, -3.0, 3.0, 100 * e + i).transpose();
+      u(i, 0) = test::random_vector(1, -10.0, 10.0, 7000 + 100 * e + i)(0);
+    }
+    states.push_back(x);
+    controls.push_back(u);
+  }
+  const Transitions data = transitions_of(states, controls, 0.02);
+  Matrix qdd(data.size(), 2);
+  for (int r = 0; r < data.size(); ++r) qdd.row(r) = test::random_vector(2, -20.0, 20.0, 9000 + r).transpose();
+
+  ModelSpec model;
+  model.system = "cartpole";
+  model.parameters["pole_length"] = 1.3;
+  model.actuator_gain = 0.8;
+  model.input_delay = 1.0;
+  const DynamicsPtr built = model.build();
+  const ForceComponents components = force_components(*built);
+  ASSERT_EQ(components.forces.size(), 2u);
+  EXPECT_EQ(components.forces[0].name, "Q_x");
+  EXPECT_EQ(components.forces[0].unit, "N");
+  EXPECT_EQ(components.forces[1].name, "Q_theta");
+  EXPECT_EQ(components.forces[1].unit, "N m");
+  EXPECT_EQ(components.velocity_states(), (std::vector<int>{1, 3}));
+
+  std::vector<int> rows(static_cast<std::size_t>(data.size()));
+  for (int r = 0; r < data.size(); ++r) rows[static_cast<std::size_t>(r)] = data.size() - 1 - r;  // any order
+  const Matrix r = generalised_force_residual(model, data, qdd, rows);
+  ASSERT_EQ(r.rows(), data.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const int t = rows[i];
+    const bool first = t == 0 || data.episode[static_cast<std::size_t>(t)] != data.episode[static_cast<std::size_t>(t - 1)];
+    const double u = data.u(first ? t : t - 1, 0);
+    const Vector expected = cartpole_inverse_dynamics(data.x.row(t).transpose(), qdd.row(t).transpose(), u, 1.0, 1.0, 1.3, 0.8);
+    EXPECT_MATRIX_NEAR(r.row(static_cast<Eigen::Index>(i)).transpose(), expected, 1e-9 * (1.0 + expected.norm()));
+  }
+}
+
+// --- The residual of a MuJoCo model, against mj_inverse ------------------------------------------
+
+std::string arm_path() { return (test::source_dir() / "data" / "two_link_arm.xml").string(); }
+
+/// MuJoCo's inverse dynamics as a second implementation: qfrc_inverse (M qacc + bias - passive) minus
+/// the actuator forces of ctrl = u, from the file itself.
+Vector mujoco_force_residual(const Vector& x, const Vector& qdd, const Vector& u) {
+  char error[512] = "";
+  mjModel* m = mj_loadXML(arm_path().c_str(), nullptr, error, sizeof error);
+  EXPECT_NE(m, nullptr) << error;
+  mjData* d = mj_makeData(m);
+  for (int i = 0; i < m->nv; ++i) {
+    d->qpos[i] = x(i);
+    d->qvel[i] = x(m->nv + i);
+  }
+  for (int a = 0; a < m->nu; ++a) d->ctrl[a] = u(a);
+  mj_forward(m, d);  // the actuator forces of ctrl
+  Vector actuator(m->nv);
+  for (int i = 0; i < m->nv; ++i) actuator(i) = d->qfrc_actuator[i];
+  for (int i = 0; i < m->nv; ++i) d->qacc[i] = qdd(i);
+  mj_inverse(m, d);
+  Vector r(m->nv);
+  for (int i = 0; i < m->nv; ++i) r(i) = d->qfrc_inverse[i] - actuator(i);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  return r;
+}
+
+TEST(InverseDynamicsResidual, MujocoArmMatchesMjInverseAndAnEffectInTheModelIsSubtracted) {
+  const int T = 30;
+  Matrix x(T, 4), u(T, 2);
+  for (int i = 0; i < T; ++i) {
+    x.row(i) = test::random_vector(4, -2.0, 2.0, 300 + i).transpose();
+    u.row(i) = test::random_vector(2, -3.0, 3.0, 600 + i).transpose();
+  }
+  const Transitions data = transitions_of({x}, {u}, 0.01);
+  Matrix qdd(data.size(), 2);
+  for (int r = 0; r < data.size(); ++r) qdd.row(r) = test::random_vector(2, -30.0, 30.0, 900 + r).transpose();
+
+  ModelSpec bare;
+  bare.system = arm_path();
+  ModelSpec damped = bare;  // the model already has 0.3 N m s/rad of damping on the shoulder
+  damped.forces.push_back({"joint_viscous_damping:shoulder", Vector::Constant(1, 0.3)});
+  const std::vector<int> rows = [&] {
+    std::vector<int> all;
+    for (int r = 0; r < data.size(); ++r) all.push_back(r);
+    return all;
+  }();
+  const Matrix r_bare = generalised_force_residual(bare, data, qdd, rows);
+  const Matrix r_damped = generalised_force_residual(damped, data, qdd, rows);
+  EXPECT_EQ(names_of(force_components(*bare.build()).forces), (std::vector<std::string>{"Q_shoulder", "Q_elbow"}));
+  for (int t = 0; t < data.size(); ++t) {
+    const Vector expected = mujoco_force_residual(data.x.row(t).transpose(), qdd.row(t).transpose(), data.u.row(t).transpose());
+    EXPECT_MATRIX_NEAR(r_bare.row(t).transpose(), expected, 1e-8 * (1.0 + expected.norm()));
+    // The model's own damping force -0.3 shoulder_dot is no longer missing.
+    Vector damping = Vector::Zero(2);
+    damping(0) = -0.3 * data.x(t, 2);
+    EXPECT_MATRIX_NEAR(r_damped.row(t).transpose(), (expected - damping).eval(), 1e-8 * (1.0 + expected.norm()));
+  }
+}
+
+/// A system without a generalised-force map: xdot = u.
+class Integrator1D final : public Dynamics {
+ public:
+  const std::string& name() const override { return name_; }
+  const std::vector<Quantity>& states() const override { return states_; }
+  const std::vector<Quantity>& controls() const override { return controls_; }
+  std::vector<Parameter> parameters() const override { return {}; }
+  void evaluate(const VectorCRef&, const VectorCRef& u, VectorRef xdot, DynamicsJacobians*) const override {
+    xdot(0) = u(0);
+  }
+
+ private:
+  std::string name_ = "integrator";
+  std::vector<Quantity> states_{{"p", "m"}};
+  std::vector<Quantity> controls_{{"v", "m/s"}};
+};
+
+TEST(InverseDynamicsResidual, BadInputIsAClearError) {
+  const Integrator1D plain;
+  try {
+    force_components(plain);
+    ADD_FAILURE() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("system 'integrator' has no generalised-force map"), std::string::npos)
+        << e.what();
+  }
+  const Transitions data = transitions_of({Matrix::Zero(5, 4)}, {Matrix::Zero(5, 1)}, 0.02);
+  ModelSpec cartpole;
+  EXPECT_THROW(generalised_force_residual(cartpole, data, Matrix::Zero(4, 1), {0}), std::invalid_argument);  // 1 column
+  EXPECT_THROW(generalised_force_residual(cartpole, data, Matrix::Zero(4, 2), {4}), std::invalid_argument);  // no row 4
+}
+
+// --- A world with hidden friction: the residual is the friction ----------------------------------
+
+constexpr double kShoulderDamping = 0.4;  // N m s/rad, hidden from the model
+constexpr double kElbowFriction = 0.3;    // N m, hidden from the model
+constexpr double kElbowSmoothing = 0.1;   // rad/s, v0 of the elbow's tanh
+
+/// The hidden forces written out: -b shoulder_dot on the shoulder, -tau tanh(elbow_dot / v0) on the elbow.
+Vector hidden_force(const Vector& x) {
+  return (Vector(2) << -kShoulderDamping * x(2), -kElbowFriction * std::tanh(x(3) / kElbowSmoothing)).finished();
+}
+
+/// Smooth joint torques [N m]: sums of sinusoids, so the true acceleration has no jumps.
+Vector torque(double t, int episode) {
+  const double p = 0.7 * episode;
+  return (Vector(2) << 1.5 * std::sin(2 * M_PI * 0.6 * t + p) + 0.6 * std::sin(2 * M_PI * 1.7 * t),
+          0.6 * std::sin(2 * M_PI * 0.9 * t + 1.0 + p) + 0.3 * std::sin(2 * M_PI * 2.3 * t))
+      .finished();
+}
+
+/// The world (the arm with the hidden forces) integrated by RK4 at dt / 10 with the torques at the stage
+/// times, sampled at dt: noise-free states and the torques at the samples.
+void simulate_world(const Dynamics& world, double dt, int T, int episode, Matrix& x, Matrix& u) {
+  const int substeps = 10;
+  const double h = dt / substeps;
+  x.resize(T, 4);
+  u.resize(T, 2);
+  Vector s = (Vector(4) << 0.3 * episode - 0.4, 0.2, 0.5, -0.3).finished();
+  const auto workspace = world.make_workspace();
+  Vector k1(4), k2(4), k3(4), k4(4);
+  const auto f = [&](const Vector& state, double t, Vector& xdot) {
+    world.evaluate(state, torque(t, episode), xdot, nullptr, *workspace);
+  };
+  for (int i = 0; i < T; ++i) {
+    x.row(i) = s.transpose();
+    u.row(i) = torque(i * dt, episode).transpose();
+    for (int j = 0; j < substeps; ++j) {
+      const double t = i * dt + j * h;
+      f(s, t, k1);
+      f(s + 0.5 * h * k1, t + 0.5 * h, k2);
+      f(s + 0.5 * h * k2, t + 0.5 * h, k3);
+      f(s + h * k3, t + h, k4);
+      s += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    }
+  }
+}
+
+/// The arm as the model and the world with the hidden forces.
+struct HiddenFrictionWorld {
+  ModelSpec model;
+  DynamicsPtr world;
+  std::vector<Matrix> states, controls;  ///< three episodes of 3 s at 500 Hz
+  double dt = 0.002;  ///< the elbow's friction turns within v0 = 0.1 rad/s, a few milliseconds at these speeds
+};
+
+const HiddenFrictionWorld& hidden_friction_world() {
+  static const HiddenFrictionWorld w = [] {
+    HiddenFrictionWorld w;
+    w.model.system = arm_path();
+    ModelSpec world = w.model;
+    world.forces.push_back({"joint_viscous_damping:shoulder", Vector::Constant(1, kShoulderDamping)});
+    world.forces.push_back({"joint_coulomb_friction:elbow", Vector::Constant(1, kElbowFriction)});
+    world.smoothing["joint_coulomb_friction:elbow"] = kElbowSmoothing;
+    w.world = world.build();
+    for (int e = 0; e < 3; ++e) {
+      Matrix x, u;
+      simulate_world(*w.world, w.dt, 1501, e, x, u);
+      w.states.push_back(x);
+      w.controls.push_back(u);
+    }
+    return w;
+  }();
+  return w;
+}
+
+/// IDIM-LS on the residual: b and tau by linear least squares, each on its own joint's column.
+Vector friction_by_least_squares(const Transitions& data, const Matrix& r) {
+  const Vector shoulder_basis = -data.x.col(2);
+  const Vector elbow_basis = -(data.x.col(3) / kElbowSmoothing).array().tanh().matrix();
+  return (Vector(2) << shoulder_basis.dot(r.col(0)) / shoulder_basis.squaredNorm(),
+          elbow_basis.dot(r.col(1)) / elbow_basis.squaredNorm())
+      .finished();
+}
+
+TEST(InverseDynamicsResidual, NoiseFreeWorldWithHiddenFrictionGivesTheFrictionAsResidual) {
+  const HiddenFrictionWorld& w = hidden_friction_world();
+  const ModelSpec& model = w.model;
+  const Transitions data = transitions_of(w.states, w.controls, w.dt);
+  const std::vector<int> rows = data.rows(false);
+
+  // With the world's true accelerations the residual is the hidden force, exactly.
+  Matrix true_qdd(data.size(), 2);
+  for (int t = 0; t < data.size(); ++t) {
+    const Vector xdot = w.world->f(data.x.row(t).transpose(), data.u.row(t).transpose());
+    true_qdd.row(t) = xdot.tail(2).transpose();
+  }
+  const Matrix exact = generalised_force_residual(model, data, true_qdd, rows);
+  Matrix hidden(data.size(), 2);
+  for (int t = 0; t < data.size(); ++t) hidden.row(t) = hidden_force(data.x.row(t).transpose()).transpose();
+  EXPECT_MATRIX_NEAR(exact, hidden, 1e-9);
+
+  // With the estimated accelerations: the hidden force within the estimate's error.
+  const AccelerationEstimate estimate =
+      estimate_accelerations(data, force_components(*model.build()).velocity_states(), w.dt);
+  const Matrix r = generalised_force_residual(model, data, estimate.qdd, rows);
+  const Vector error_rms = ((r - hidden).colwise().squaredNorm() / data.size()).cwiseSqrt().transpose();
+  const Vector hidden_rms = (hidden.colwise().squaredNorm() / data.size()).cwiseSqrt().transpose();
+  const Vector qdd_error_rms = ((estimate.qdd - true_qdd).colwise().squaredNorm() / data.size()).cwiseSqrt().transpose();
+  std::printf("windows %d, %d; acceleration error rms %.3g, %.3g rad/s^2; force error rms %.3g, %.3g of %.3g, %.3g N m\n",
+              estimate.windows[0].window, estimate.windows[1].window, qdd_error_rms(0), qdd_error_rms(1), error_rms(0),
+              error_rms(1), hidden_rms(0), hidden_rms(1));
+  EXPECT_LT(error_rms(0), 0.02 * hidden_rms(0));
+  EXPECT_LT(error_rms(1), 0.02 * hidden_rms(1));
+
+  // IDIM-LS on the residual: the friction parameters by linear least squares, each on its own joint.
+  const Vector theta = friction_by_least_squares(data, r);
+  const double b = theta(0), tau = theta(1);
+  std::printf("least squares on the residual: b = %.4f (true %.4f), tau = %.4f (true %.4f)\n", b, kShoulderDamping, tau,
+              kElbowFriction);
+  EXPECT_NEAR(b, kShoulderDamping, 0.01 * kShoulderDamping);
+  EXPECT_NEAR(tau, kElbowFriction, 0.01 * kElbowFriction);
+}
+
+TEST(InverseDynamicsResidual, NoisyVelocitiesGiveTheFrictionByLeastSquaresOnTheResidual) {
+  // The same record with white noise of 0.02 rad/s on the measured velocities (and 1e-4 rad on the
+  // angles): the window rule smooths, and least squares on the residual finds the hidden friction.
+  const HiddenFrictionWorld& w = hidden_friction_world();
+  std::mt19937 rng(5);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<Matrix> noisy = w.states;
+  for (Matrix& x : noisy)
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      for (Eigen::Index j = 0; j < 4; ++j) x(i, j) += (j < 2 ? 1e-4 : 0.02) * gauss(rng);
+  const Transitions data = transitions_of(noisy, w.controls, w.dt);
+  const AccelerationEstimate estimate =
+      estimate_accelerations(data, force_components(*w.model.build()).velocity_states(), w.dt);
+  const Matrix r = generalised_force_residual(w.model, data, estimate.qdd, data.rows(false));
+  const Vector theta = friction_by_least_squares(data, r);
+  std::printf("windows %d, %d (sigma_hat %.4f, %.4f rad/s); b = %.4f (true %.4f), tau = %.4f (true %.4f)\n",
+              estimate.windows[0].window, estimate.windows[1].window, estimate.windows[0].noise_std,
+              estimate.windows[1].noise_std, theta(0), kShoulderDamping, theta(1), kElbowFriction);
+  EXPECT_NEAR(estimate.windows[0].noise_std, 0.02, 0.002);
+  EXPECT_NEAR(estimate.windows[1].noise_std, 0.02, 0.002);
+  EXPECT_GT(estimate.windows[0].window, 3);
+  EXPECT_NEAR(theta(0), kShoulderDamping, 0.05 * kShoulderDamping);
+  EXPECT_NEAR(theta(1), kElbowFriction, 0.05 * kElbowFriction);
+}
+
+}  // namespace
+}  // namespace gpilqg
