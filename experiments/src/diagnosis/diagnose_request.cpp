@@ -82,7 +82,8 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
     throw InputError(std::string("--backend: ") + e.what());
   }
   const auto criterion = parse_fit_criterion(o.criterion);
-  if (!criterion) throw InputError("--criterion '" + o.criterion + "': expected 'one-step' or 'simulation'");
+  if (!criterion || *criterion == FitCriterion::InverseDynamics)
+    throw InputError("--criterion '" + o.criterion + "': expected 'one-step' or 'simulation'");
   if (*criterion == FitCriterion::Simulation && !o.window)
     throw InputError("--criterion simulation: expected --window N, the samples per simulation window (e.g. a few "
                      "periods of the slowest motion)");

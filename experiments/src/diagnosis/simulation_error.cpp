@@ -8,11 +8,17 @@ namespace gpilqg::diagnosis {
 std::optional<FitCriterion> parse_fit_criterion(std::string_view name) {
   if (name == "one-step") return FitCriterion::OneStep;
   if (name == "simulation") return FitCriterion::Simulation;
+  if (name == "inverse-dynamics") return FitCriterion::InverseDynamics;
   return std::nullopt;
 }
 
 std::string fit_criterion_name(FitCriterion criterion) {
-  return criterion == FitCriterion::Simulation ? "simulation" : "one-step";
+  switch (criterion) {
+    case FitCriterion::Simulation: return "simulation";
+    case FitCriterion::InverseDynamics: return "inverse-dynamics";
+    case FitCriterion::OneStep: break;
+  }
+  return "one-step";
 }
 
 std::vector<int> all_rows(const Transitions& data) {

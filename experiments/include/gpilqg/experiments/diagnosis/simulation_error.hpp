@@ -53,17 +53,9 @@
 #include <vector>
 
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
+#include "gpilqg/experiments/diagnosis/fit_criterion.hpp"
 
 namespace gpilqg::diagnosis {
-
-enum class FitCriterion {
-  OneStep,     ///< "one-step": e_r after one step from the measured x_r
-  Simulation,  ///< "simulation": e_r after simulating from the measured start of r's window
-};
-
-/// "one-step" or "simulation"; nullopt for any other name.
-std::optional<FitCriterion> parse_fit_criterion(std::string_view name);
-std::string fit_criterion_name(FitCriterion criterion);
 
 /// Predictions of `rows` of `data` (rows.size() x n), windows of `window` rows (see the file comment;
 /// window = 1 gives one_step_predictions), the model driven by `u` (N x m, applied_controls). A
