@@ -255,8 +255,12 @@ def selection_path(f, out, states):
     """--auto: what each step of the forward selection bought, in units of the noise floor."""
     g = f["selection"]
     effects = names(g.attrs["effect"])
-    rmse = g["heldout_rmse"][()]  # (steps + 1) x n
+    rmse = g["heldout_rmse"][()]  # (steps + 1) x channels: the states, or the force components
     floor = np.maximum(f["compare/states"]["noise_floor"][()], 1e-300)
+    if "channels" in g.attrs and rmse.shape[1] != len(states):
+        # Inverse dynamics: the force components' RMSE, relative to the model as given.
+        states = names(g.attrs["channels"])
+        floor = np.maximum(rmse[0], 1e-300)
     ratio = rmse / floor
     moved = [i for i in range(len(states)) if ratio[0, i] > 1.05 or ratio[-1, i] > 1.05] or list(range(len(states)))
     fig, ax = plt.subplots(figsize=(max(6, 1.9 * len(effects) + 3), 4.2))

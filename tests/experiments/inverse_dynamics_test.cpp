@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <functional>
+#include <map>
 #include <random>
 
 #include <Eigen/QR>
@@ -18,6 +19,7 @@
 #include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/savitzky_golay.hpp"
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
+#include "gpilqg/experiments/diagnosis/diagnosis.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "test_support.hpp"
 
@@ -503,6 +505,67 @@ TEST(InverseDynamicsResidual, NoisyVelocitiesGiveTheFrictionByLeastSquaresOnTheR
   EXPECT_GT(estimate.windows[0].window, 3);
   EXPECT_NEAR(theta(0), kShoulderDamping, 0.05 * kShoulderDamping);
   EXPECT_NEAR(theta(1), kElbowFriction, 0.05 * kElbowFriction);
+}
+
+// --- The whole diagnosis on the inverse-dynamics criterion ------------------------------------------
+
+// The noisy record as a measurement file would hold it, diagnosed with --auto on the inverse-dynamics
+// criterion: both hidden frictions are found within 15%, and nothing else is added (no delay, gain,
+// armature or mass stands in for them).
+TEST(InverseDynamicsDiagnosis, AutoFindsTheHiddenFrictionAndNothingElse) {
+  const HiddenFrictionWorld& w = hidden_friction_world();
+  std::mt19937 rng(7);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  MeasurementSet set;
+  set.system = system_signature(w.model.system);
+  for (std::size_t e = 0; e < w.states.size(); ++e) {
+    Episode episode;
+    episode.id = static_cast<long>(e);
+    episode.x = w.states[e];
+    for (Eigen::Index i = 0; i < episode.x.rows(); ++i)
+      for (Eigen::Index j = 0; j < 4; ++j) episode.x(i, j) += (j < 2 ? 1e-4 : 0.02) * gauss(rng);
+    episode.u = w.controls[e];
+    episode.t = Vector::LinSpaced(episode.x.rows(), 0.0, w.dt * static_cast<double>(episode.x.rows() - 1));
+    set.episodes.push_back(std::move(episode));
+  }
+  // The diagnosis also simulates the model (one-step and k-step predictions, free runs) at the data's
+  // step: the same arm with a timestep of 2 ms, whose physics the world was simulated with.
+  const std::filesystem::path dir = test::temporary_dir("inverse_dynamics_diagnosis");
+  std::string text = test::read_text(arm_path());
+  const auto at = text.find("timestep=\"0.01\"");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, std::string("timestep=\"0.01\"").size(), "timestep=\"0.002\"");
+  const std::string arm_2ms = test::write_text(dir / "two_link_arm_2ms.xml", text).string();
+  set.system = system_signature(arm_2ms);
+  write_measurements(dir / "record.csv", set);  // to compare the criteria from the command line
+  diagnosis::DiagnosisOptions o;
+  o.model.system = arm_2ms;
+  o.criterion = diagnosis::FitCriterion::InverseDynamics;
+  o.auto_select = true;
+  o.gp.points = 100;
+  o.gp.restarts = 0;
+  o.gp.threads = 1;
+  o.horizons = {1, 10};
+  const diagnosis::DiagnosisReport r = diagnosis::diagnose(set, o);
+  EXPECT_EQ(r.channel_names, (std::vector<std::string>{"Q_shoulder", "Q_elbow"}));
+  ASSERT_TRUE(r.selection.has_value());
+  ASSERT_FALSE(r.selection->steps.empty()) << r.verdict.reason;
+  std::map<std::string, double> found;
+  const diagnosis::EffectFit& last = r.selection->steps.back().fit;
+  found[last.effect] = last.estimate(0);
+  for (const diagnosis::EffectValues& v : last.refitted) found[v.effect] = v.estimate(0);
+  std::string names;
+  for (const auto& [name, value] : found) names += name + " = " + std::to_string(value) + "; ";
+  std::printf("found: %s\nverdict: %s (%s)\n", names.c_str(), r.verdict.status.c_str(), r.verdict.reason.c_str());
+  SCOPED_TRACE(names + r.selection->stop_reason);
+  EXPECT_EQ(found.size(), 2u);
+  const double shoulder = found.count("joint_viscous_damping:shoulder") ? found["joint_viscous_damping:shoulder"]
+                                                                        : found["param:shoulder.damping"];
+  EXPECT_NEAR(shoulder, kShoulderDamping, 0.15 * kShoulderDamping);
+  const double elbow = found.count("joint_coulomb_friction:elbow") ? found["joint_coulomb_friction:elbow"]
+                                                                   : found["param:elbow.frictionloss"];
+  EXPECT_NEAR(elbow, kElbowFriction, 0.15 * kElbowFriction);
+  EXPECT_NE(r.verdict.status, "unexplained") << r.verdict.reason;
 }
 
 }  // namespace

@@ -192,8 +192,14 @@ TEST(SimulationError, TheRequestChecksCriterionAndWindow) {
   r.criterion = "one-step";
   r.window = 50;
   EXPECT_NE(message().find("--window 50: windows belong to --criterion simulation"), std::string::npos) << message();
+  r.criterion = "inverse-dynamics";
+  EXPECT_NE(message().find("--window 50: windows belong to --criterion simulation; the criterion is inverse-dynamics"),
+            std::string::npos) << message();
+  r.window.reset();
+  EXPECT_EQ(diagnosis_options(r).criterion, FitCriterion::InverseDynamics);
   r.criterion = "output";
-  EXPECT_NE(message().find("--criterion 'output': expected 'one-step' or 'simulation'"), std::string::npos) << message();
+  EXPECT_NE(message().find("--criterion 'output': expected 'one-step', 'simulation' or 'inverse-dynamics'"),
+            std::string::npos) << message();
   DiagnosisOptions o;
   o.model.system = "cartpole";
   o.window = 5;
@@ -212,7 +218,8 @@ TEST(SimulationErrorCli, TheCommandLineTakesTheOptionsAndNamesThemInItsErrors) {
   EXPECT_NE(one_step.err.find("--window 10: windows belong to --criterion simulation"), std::string::npos) << one_step.err;
   const auto unknown = test::run_cli(call + " --criterion pem --window 10");
   EXPECT_EQ(unknown.status, 2);
-  EXPECT_NE(unknown.err.find("--criterion 'pem': expected 'one-step' or 'simulation'"), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("--criterion 'pem': expected 'one-step', 'simulation' or 'inverse-dynamics'"),
+            std::string::npos) << unknown.err;
 }
 
 }  // namespace

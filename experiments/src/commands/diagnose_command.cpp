@@ -69,10 +69,11 @@ std::string plugin_option(const std::string& system) {
   return origin == "built-in" ? "" : " --plugin " + origin;
 }
 
-/// " --criterion simulation --window N" and " --exclude P" when the request has them, so that the next
-/// call uses the same criterion and candidates.
+/// " --criterion C [--window N]" and " --exclude P" when the request has them, so that the next call
+/// uses the same criterion and candidates.
 std::string criterion_options(const diagnosis::DiagnoseRequest& r) {
-  std::string out = r.window ? fmt::format(" --criterion {} --window {}", r.criterion, *r.window) : "";
+  std::string out = r.window ? fmt::format(" --criterion {} --window {}", r.criterion, *r.window)
+                  : r.criterion != diagnosis::DiagnoseRequest{}.criterion ? " --criterion " + r.criterion : "";
   for (const std::string& pattern : r.exclude) out += " --exclude '" + pattern + "'";
   return out;
 }
@@ -181,8 +182,9 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
       ->capture_default_str()
       ->check(integer_in(0, static_cast<long long>(limits::kMaxSeed)));
   cmd->add_option("--criterion", r.criterion,
-                  "Error the effects are fitted to and scored on: one-step, or simulation over --window samples from "
-                  "measured states (finds effects too small to see in one step, e.g. light damping)")
+                  "Error the effects are fitted to and scored on: one-step; simulation over --window samples from "
+                  "measured states (finds effects too small to see in one step, e.g. light damping); or "
+                  "inverse-dynamics, the generalised-force residual (torque-sensing robots, measured velocities)")
       ->capture_default_str();
   auto* window = cmd->add_option("--window", o->window,
                                  "Samples per simulation window, with --criterion simulation (e.g. a few periods of the "

@@ -7,9 +7,21 @@ namespace gpilqg::diagnosis {
 int input_delay_start(const FitContext& c, int max_lag) {
   const Transitions& data = *c.data;
   const int N = data.size();
-  const auto n = static_cast<Eigen::Index>(c.weights.size());
+  const auto n = static_cast<Eigen::Index>(data.x.cols());
   if (N == 0) return 0;
   const std::vector<int> training = data.rows(false);
+  // The states' weights: the context's under a state criterion; under inverse dynamics (whose weights
+  // are the force components') the inverse variance of each state's measured one-step change.
+  Vector weights = c.weights;
+  if (weights.size() != n) {
+    weights = Vector::Ones(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double sum = 0.0;
+      for (int r : training) sum += std::pow(data.x_next(r, i) - data.x(r, i), 2);
+      const double variance = sum / std::max<double>(1.0, static_cast<double>(training.size()));
+      if (variance > 0.0) weights(i) = 1.0 / variance;
+    }
+  }
   Vector u_ref = Vector::Zero(data.u.cols());
   for (int r : training) u_ref += data.u.row(r).transpose();
   u_ref /= static_cast<double>(std::max<std::size_t>(1, training.size()));
@@ -17,7 +29,7 @@ int input_delay_start(const FitContext& c, int max_lag) {
   // Weighted responses at every row (rows of held-out episodes are not used below).
   const auto model = make_step_model(c.model, c.integrator, c.dt, c.substeps);
   const auto workspace = model->make_workspace();
-  const Vector sqrt_w = c.weights.cwiseSqrt();
+  const Vector sqrt_w = weights.cwiseSqrt();
   Matrix measured(N, n), predicted(N, n);
   Vector with_u(n), with_ref(n);
   for (int r = 0; r < N; ++r) {

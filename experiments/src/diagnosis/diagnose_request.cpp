@@ -9,6 +9,7 @@
 
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/limits.hpp"
+#include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
@@ -82,13 +83,17 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
     throw InputError(std::string("--backend: ") + e.what());
   }
   const auto criterion = parse_fit_criterion(o.criterion);
-  if (!criterion || *criterion == FitCriterion::InverseDynamics)
-    throw InputError("--criterion '" + o.criterion + "': expected 'one-step' or 'simulation'");
+  if (!criterion)
+    throw InputError("--criterion '" + o.criterion + "': expected 'one-step', 'simulation' or 'inverse-dynamics'");
   if (*criterion == FitCriterion::Simulation && !o.window)
     throw InputError("--criterion simulation: expected --window N, the samples per simulation window (e.g. a few "
                      "periods of the slowest motion)");
-  if (*criterion == FitCriterion::OneStep && o.window)
-    throw InputError(fmt::format("--window {}: windows belong to --criterion simulation; the criterion is one-step", *o.window));
+  if (*criterion != FitCriterion::Simulation && o.window)
+    throw InputError(fmt::format("--window {}: windows belong to --criterion simulation; the criterion is {}", *o.window,
+                                 fit_criterion_name(*criterion)));
+  if (*criterion == FitCriterion::InverseDynamics && !find_system(o.system)->generalised_forces)
+    throw InputError(fmt::format("--criterion inverse-dynamics: system '{}' has no generalised-force map, so it has no "
+                                 "generalised-force residual; expected 'one-step' or 'simulation'", o.system));
   if (o.window && (*o.window < 1 || *o.window > limits::kMaxHorizon))
     throw InputError(fmt::format("--window {}: expected a whole number of samples from 1 to {}", *o.window, limits::kMaxHorizon));
   d.criterion = *criterion;

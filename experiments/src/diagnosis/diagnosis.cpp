@@ -11,6 +11,7 @@
 #include "gpilqg/core/input_delay.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
+#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
 namespace gpilqg::diagnosis {
@@ -113,16 +114,19 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   v.reason = fmt::format("the best candidate '{}' removes {:.1f}% of the held-out residual (z = {:.1f}); the GP removes {:.1f}%",
                          f.effect, 100.0 * f.explained, f.z_score, 100.0 * r.gp_explained_total);
   // The GP's share is of the one-step residual: comparable with the effects' under the one-step criterion only.
-  const bool simulation = o.criterion == FitCriterion::Simulation;
-  if (simulation)
+  const bool one_step = o.criterion == FitCriterion::OneStep;
+  if (o.criterion == FitCriterion::Simulation)
     v.reason += fmt::format(" of the one-step residual; the effects are scored on the simulation error over windows of {} "
                             "samples, so the GP's share is not required", o.window);
+  if (o.criterion == FitCriterion::InverseDynamics)
+    v.reason += " of the one-step residual; the effects are scored on the generalised-force (inverse-dynamics) residual, "
+                "so the GP's share is not required";
   if (!finding.accepted) {
     v.status = "unexplained";
     v.reason += "; not a finding: " + finding.reason;
     return v;
   }
-  if (!simulation && f.explained < o.relative_to_gp * r.gp_explained_total) {
+  if (one_step && f.explained < o.relative_to_gp * r.gp_explained_total) {
     v.status = "unexplained";
     v.reason += ", so the residual's structure is mostly something else";
     return v;
@@ -182,8 +186,8 @@ void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0
   v.aliases.clear();
   v.reason = fmt::format("the {} effect(s) chosen by --auto ({}) remove {:.1f}% of the held-out residual; the GP removes {:.1f}%",
                          v.effects.size(), fmt::join(v.effects, ", "), 100.0 * (1.0 - left), 100.0 * (1.0 - v.gp_left));
-  if (o.criterion == FitCriterion::Simulation)
-    v.reason += " of the one-step residual (the effects are scored on the simulation error)";
+  if (o.criterion != FitCriterion::OneStep)
+    v.reason += fmt::format(" of the one-step residual (the effects are scored on the {} error)", fit_criterion_name(o.criterion));
 }
 
 /// The one-step residual of `model` on settings.data, integrated as `settings` says and driven by
@@ -370,6 +374,17 @@ void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidat
                                          o.criterion, o.window, &R.window_restarts);
   context.excluded = o.exclude;
   R.excluded = o.exclude;
+  R.criterion_weights = context.weights;
+  R.accelerations = context.accelerations;
+  if (o.criterion == FitCriterion::InverseDynamics) {
+    for (const Quantity& q : force_components(*R.model.build()).forces) {
+      R.channel_names.push_back(q.name);
+      R.channel_units.push_back(q.unit);
+    }
+  } else {
+    R.channel_names = R.state_names;
+    for (const Quantity& q : system_signature(R.system).states) R.channel_units.push_back(q.unit);
+  }
   const std::vector<RefitEffect> present = o.auto_select ? model_effects(R.model, candidates) : std::vector<RefitEffect>{};
   if (o.rank && !R.model_diverges) R.ranking = rank_effects(context, o.alias_gain, o.progress, present, o.gp.threads);
   // The GP sees (x_t, u_t) only: the residual of an effect of the input history (input_delay) looks
@@ -456,6 +471,14 @@ bool add(const DiagnosisOptions& o, const ModelAsGiven& given, const std::vector
 double flexible_share(const ModelSpec& model, const Matrix& residual, const ResidualGp& gp, const DiagnosisOptions& o,
                       const DiagnosisReport& R) {
   if (o.criterion == FitCriterion::OneStep) return weighted_heldout_explained(R.data, residual, gp.mean, R.weights);
+  if (o.criterion == FitCriterion::InverseDynamics) {
+    // A GP of each component of the model's generalised-force residual, on (x, u).
+    FitContext c{&R.data, model, o.integrator, R.dt, o.substeps, R.criterion_weights, Matrix()};
+    c.criterion = FitCriterion::InverseDynamics;
+    c.accelerations = R.accelerations;
+    const Matrix force = criterion_residual(model, c);
+    return weighted_heldout_explained(R.data, force, gp_column_means(R.data, force, o.gp), R.criterion_weights);
+  }
   const std::vector<int> rows = R.data.rows(true);
   const Matrix u = applied_controls(R.data, model.input_delay);
   const Matrix plain = simulated_predictions(*make_step_model(model, o.integrator, R.dt, o.substeps), R.data, u, rows, o.window);
@@ -475,11 +498,17 @@ double flexible_share(const ModelSpec& model, const Matrix& residual, const Resi
 void judge_proposal(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidates, const FitContext& settings,
                     bool compared, const ResidualGp& gp_after, DiagnosisReport& R) {
   if (!R.verdict.effect || R.verdict.status != "explained") return;
-  if (o.add.empty() && compared) {
+  if (o.add.empty() && compared && o.criterion != FitCriterion::InverseDynamics) {
     judge_remainder(R.verdict, flexible_share(R.model_next, R.residual_after, gp_after, o, R), o);
     return;
   }
-  const ModelSpec proposed = R.model.with(named(candidates, R.verdict.effect->effect), R.verdict.effect->estimate);
+  const ModelSpec proposed = o.add.empty() && compared
+                                ? R.model_next
+                                : R.model.with(named(candidates, R.verdict.effect->effect), R.verdict.effect->estimate);
+  if (o.criterion == FitCriterion::InverseDynamics) {  // its flexible model is a GP of the force residual
+    judge_remainder(R.verdict, flexible_share(proposed, Matrix(), ResidualGp(), o, R), o);
+    return;
+  }
   const Matrix residual = residual_of_model(proposed, settings);
   const ResidualGp gp = fit_residual_gp(make_step_model(proposed, o.integrator, R.dt, o.substeps), R.data, residual, o.gp);
   judge_remainder(R.verdict, flexible_share(proposed, residual, gp, o, R), o);

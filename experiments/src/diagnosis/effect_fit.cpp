@@ -18,6 +18,7 @@
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
+#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 
@@ -36,7 +37,27 @@ Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int
                               diverged, model.input_delay);
 }
 
+Matrix criterion_residual(const ModelSpec& model, const FitContext& settings, int* diverged) {
+  if (settings.criterion == FitCriterion::InverseDynamics) {
+    if (diverged != nullptr) *diverged = 0;
+    return generalised_force_residual(model, *settings.data, *settings.accelerations, all_rows(*settings.data));
+  }
+  return settings.data->x_next - model_predictions(model, settings, diverged);
+}
+
 namespace {
+
+/// Inverse dynamics: sqrt(w_i) r_{t,i} of the generalised-force residual stacked over `rows` (index
+/// k c + i). A model that does not accept the data (a singular map, a force that is not finite) is an
+/// std::invalid_argument, which the objective turns into +inf.
+Vector weighted_force_residual(const ModelSpec& model, const FitContext& c, const std::vector<int>& rows) {
+  const Matrix r = generalised_force_residual(model, *c.data, *c.accelerations, rows);
+  const Vector sqrt_w = c.weights.cwiseSqrt();
+  const auto k = static_cast<Eigen::Index>(sqrt_w.size());
+  Vector out(static_cast<Eigen::Index>(rows.size()) * k);
+  for (Eigen::Index i = 0; i < r.rows(); ++i) out.segment(i * k, k) = sqrt_w.cwiseProduct(r.row(i).transpose());
+  return out;
+}
 
 /// sqrt(w_i) (x_{t+1,i} - phi_i(x_t, u_t)) stacked row by row over `rows` (index r * n + i); `finite`
 /// turns false when a prediction diverged (prediction_diverged: not finite or beyond 1e12). Such a
@@ -108,6 +129,7 @@ struct EffectSet {
 Vector weighted_residual_at(const EffectSet& set, const VectorCRef& theta, const FitContext& c,
                             const std::vector<int>& rows, bool* finite = nullptr) {
   const ModelSpec spec = set.model_at(c.model, theta);
+  if (c.criterion == FitCriterion::InverseDynamics) return weighted_force_residual(spec, c, rows);
   const auto model = make_step_model(spec, c.integrator, c.dt, c.substeps);
   return weighted_residual(*model, applied_controls(*c.data, spec.input_delay), c, rows, finite);
 }
@@ -276,6 +298,7 @@ EffectValues own_values(const EffectFit& fit) {
 }
 
 Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows) {
+  if (settings.criterion == FitCriterion::InverseDynamics) return weighted_force_residual(model, settings, rows);
   const auto step = make_step_model(model, settings.integrator, settings.dt, settings.substeps);
   return weighted_residual(*step, applied_controls(*settings.data, model.input_delay), settings, rows, nullptr);
 }
@@ -355,16 +378,23 @@ const std::vector<int>& velocity_states(const ModelSpec& model) {
 /// predicted change (x_hat = x_next - residual under the criterion). Infinite where J_j is zero on
 /// them (nothing to compare with).
 Vector data_scales(const Matrix& J, const FitContext& c, const std::vector<int>& rows, const Vector& null) {
-  const std::vector<int>& velocities = velocity_states(c.model);
+  const bool forces = c.criterion == FitCriterion::InverseDynamics && c.own_force;
   const auto n = static_cast<Eigen::Index>(c.weights.size());
+  std::vector<int> channels;
+  if (forces) {
+    for (int i = 0; i < n; ++i) channels.push_back(i);
+  } else {
+    channels = velocity_states(c.model);
+  }
   double motion = 0.0;
   Vector column = Vector::Zero(J.cols());
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const int r = rows[k];
-    for (int i : velocities) {
+    for (int i : channels) {
       if (i >= n) continue;
       const double w = c.weights(i);
-      const double change = c.data->x_next(r, i) - c.residual(r, i) - c.data->x(r, i);
+      // The model's own change under the criterion: its predicted state change, or its generalised force.
+      const double change = forces ? (*c.own_force)(r, i) : c.data->x_next(r, i) - c.residual(r, i) - c.data->x(r, i);
       motion += w * change * change;
       column += J.row(static_cast<Eigen::Index>(k) * n + i).transpose().cwiseAbs2();
     }

@@ -121,7 +121,7 @@ Selection select_effects(const FitContext& context, const SelectionOptions& o, s
         if (v.effect == r.effect->name) next.push_back({r.effect, v.estimate});
     next.push_back({&named(candidates, added.effect), added.estimate});
     chosen = std::move(next);
-    step_context.residual = context.data->x_next - model_predictions(step.model, context);
+    step_context.residual = criterion_residual(step.model, context);
     S.model = step.model;
     S.steps.push_back(std::move(step));
   }

@@ -184,8 +184,8 @@ void write_where(Hdf5Writer& h5, const DiagnosisReport& r) {
 }
 
 void write_ranking(Hdf5Writer& h5, const DiagnosisReport& r) {
-  const int state = worst_state(r);
-  h5.attribute("/ranking", "heldout_state", r.state_names[static_cast<std::size_t>(state)]);
+  const int state = worst_channel(r);
+  h5.attribute("/ranking", "heldout_state", r.channel_names.empty() ? std::string() : r.channel_names[static_cast<std::size_t>(state)]);
   h5.attribute("/ranking", "criterion", fit_criterion_name(r.criterion));
   h5.attribute("/ranking", "window", static_cast<std::int64_t>(r.window));
   h5.attribute("/ranking", "window_restarts", static_cast<std::int64_t>(r.window_restarts));
@@ -248,15 +248,20 @@ void write_add(Hdf5Writer& h5, const DiagnosisReport& r) {
   h5.attribute("/add", "model", names);
 }
 
-/// /selection (--auto): heldout_rmse ((steps + 1) x n: row 0 before the first step, row k after step k),
+/// /selection (--auto): heldout_rmse ((steps + 1) x c: row 0 before the first step, row k after step k,
+/// per channel of the criterion: the states, or the force components under inverse dynamics),
 /// explained and z_score per step, and per step /selection/step_<k> with the joint values of every
 /// effect of the model after that step (parameter names "<effect>.<parameter>", the added effect first).
 void write_selection(Hdf5Writer& h5, const DiagnosisReport& r) {
   if (!r.selection) return;
   const auto& steps = r.selection->steps;
-  const auto n = static_cast<Eigen::Index>(r.states.size());
+  const auto n = steps.empty() ? static_cast<Eigen::Index>(r.states.size()) : steps.front().fit.heldout_rmse_before.size();
   Matrix rmse(static_cast<Eigen::Index>(steps.size()) + 1, n);
-  for (Eigen::Index i = 0; i < n; ++i) rmse(0, i) = r.states[static_cast<std::size_t>(i)].heldout_rmse;
+  if (steps.empty()) {
+    for (Eigen::Index i = 0; i < n; ++i) rmse(0, i) = r.states[static_cast<std::size_t>(i)].heldout_rmse;
+  } else {
+    rmse.row(0) = steps.front().fit.heldout_rmse_before.transpose();
+  }
   std::vector<double> explained, z;
   std::vector<std::string> effects;
   for (std::size_t k = 0; k < steps.size(); ++k) {
@@ -289,6 +294,7 @@ void write_selection(Hdf5Writer& h5, const DiagnosisReport& r) {
   h5.write_vector("/selection/explained", explained);
   h5.write_vector("/selection/z_score", z);
   h5.attribute("/selection", "effect", effects);
+  if (!r.channel_names.empty()) h5.attribute("/selection", "channels", r.channel_names);
   h5.attribute("/selection", "stop_reason", r.selection->stop_reason);
   h5.attribute("/selection", "method", std::string(to_string(r.selection->method)));
 }

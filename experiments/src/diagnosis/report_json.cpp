@@ -21,6 +21,14 @@ int worst_state(const DiagnosisReport& r) {
   return worst;
 }
 
+int worst_channel(const DiagnosisReport& r) {
+  if (r.criterion != FitCriterion::InverseDynamics) return worst_state(r);
+  if (r.ranking.empty() || r.criterion_weights.size() != r.ranking.front().fit.heldout_rmse_before.size()) return 0;
+  Eigen::Index worst = 0;
+  (r.ranking.front().fit.heldout_rmse_before.array() * r.criterion_weights.array().sqrt()).maxCoeff(&worst);
+  return static_cast<int>(worst);
+}
+
 namespace {
 
 using nlohmann::json;
@@ -87,11 +95,11 @@ json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
           {"interval_holds_null", interval_contains_null(own_values(f))},
           {"scale", scale},
           {"evaluations", f.evaluations},
-          {"heldout_state", r.state_names[static_cast<std::size_t>(state)]},
+          {"heldout_state", r.channel_names[static_cast<std::size_t>(state)]},
           {"heldout_rmse_before", f.heldout_rmse_before(state)},
           {"heldout_rmse_after", f.heldout_rmse_after(state)},
           {"heldout_rmse_by_state",
-           {{"before", by_name(r.state_names, f.heldout_rmse_before)}, {"after", by_name(r.state_names, f.heldout_rmse_after)}}}};
+           {{"before", by_name(r.channel_names, f.heldout_rmse_before)}, {"after", by_name(r.channel_names, f.heldout_rmse_after)}}}};
 }
 
 json where_json(const DiagnosisReport& r) {
@@ -151,7 +159,7 @@ json free_run_json(const DiagnosisReport& r) {
 }  // namespace
 
 nlohmann::json report_json(const DiagnosisReport& r) {
-  const int state = worst_state(r);
+  const int state = worst_channel(r);
   json states = json::array();
   for (const StateScore& s : r.states)
     states.push_back({{"name", s.name}, {"rmse", s.rmse}, {"noise_floor", s.noise_floor}, {"fit_percent", s.fit_percent},
@@ -222,7 +230,7 @@ nlohmann::json report_json(const DiagnosisReport& r) {
       for (const EffectValues& v : step.fit.refitted) joint.push_back(values_json(v));
       entry["refitted"] = joint;
       entry["removed"] = step.removed;
-      entry["heldout_rmse_after_by_state"] = by_name(r.state_names, step.fit.heldout_rmse_after);
+      entry["heldout_rmse_after_by_state"] = by_name(r.channel_names, step.fit.heldout_rmse_after);
       entry["model"] = model_file_text(step.model);
       steps.push_back(entry);
     }

@@ -206,11 +206,14 @@ void which_section(const DiagnosisReport& r, std::string& out) {
   if (r.model_diverges && r.ranking.empty())
     out += "\n3. Which effect is missing: not ranked, the model diverges on the data\n";
   if (r.ranking.empty()) return;
-  const int worst = worst_state(r);
+  const int worst = worst_channel(r);
   out += fmt::format("\n3. Which effect is missing (fitted on training {0}s, scored on held-out {0}s {1})\n", unit_name(r),
                      fmt::join(r.heldout_episode_ids, ", "));
   if (!r.excluded.empty())
     out += fmt::format("   excluded by --exclude (never ranked, searched or proposed): {}\n", fmt::join(r.excluded, ", "));
+  if (r.criterion == FitCriterion::InverseDynamics)
+    out += "   criterion: inverse dynamics, the generalised-force residual M(q) qdd - h(q, qdot, u) with qdd a zero-phase "
+           "derivative of the measured velocities\n";
   if (r.criterion == FitCriterion::Simulation)
     out += fmt::format("   criterion: simulation error over windows of {} samples ({:g} s) from measured states{}\n",
                        r.window, r.window * r.dt,
@@ -226,7 +229,7 @@ void which_section(const DiagnosisReport& r, std::string& out) {
     }
   }
   out += fmt::format("   {:<3} {:<{}} {:<{}} {:>17} {:>24}\n", "#", "effect", name_width, "parameter [95% interval]",
-                     parameter_width, "explained", "held-out rmse " + r.state_names[static_cast<std::size_t>(worst)]);
+                     parameter_width, "explained", "held-out rmse " + r.channel_names[static_cast<std::size_t>(worst)]);
   int rank = 1;
   std::string not_identifiable;
   for (const RankedEffect& g : r.ranking) {
@@ -270,10 +273,10 @@ void selection_section(const DiagnosisReport& r, std::string& out) {
       out += fmt::format("           removed {}\n", name);
     out += fmt::format("           {}; held-out rmse:",
                        share_text(f.explained, f.explained_ci, f.z_score, "the held-out residual left"));
-    for (std::size_t i = 0; i < r.state_names.size(); ++i) {
+    for (std::size_t i = 0; i < r.channel_names.size() && i < static_cast<std::size_t>(f.heldout_rmse_before.size()); ++i) {
       const auto ii = static_cast<Eigen::Index>(i);
       if (f.heldout_rmse_before(ii) > 1.05 * f.heldout_rmse_after(ii))
-        out += fmt::format(" {} {:.3e} -> {:.3e}", r.state_names[i], f.heldout_rmse_before(ii), f.heldout_rmse_after(ii));
+        out += fmt::format(" {} {:.3e} -> {:.3e}", r.channel_names[i], f.heldout_rmse_before(ii), f.heldout_rmse_after(ii));
     }
     out += "\n";
   }

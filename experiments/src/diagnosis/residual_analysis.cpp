@@ -68,6 +68,28 @@ ResidualGp fit_residual_gp(std::shared_ptr<const StepModel> simulator, const Tra
   return out;
 }
 
+Matrix gp_column_means(const Transitions& data, const Matrix& targets, const GpSettings& settings) {
+  gp::BackendSettings backend_settings;
+  backend_settings.exact_points = settings.points;
+  backend_settings.inducing = settings.points;
+  backend_settings.frequencies = settings.points;
+  const auto backend = gp::make_backend(settings.backend, backend_settings);
+  const Matrix z = inputs_of(data);
+  const std::vector<int> training = data.rows(false);
+  gp::FitOptions options;
+  options.restarts = settings.restarts;
+  Matrix out(data.size(), targets.cols());
+  Vector mean, variance;
+  for (Eigen::Index i = 0; i < targets.cols(); ++i) {
+    gp::TrainingSet all{z, targets.col(i)};
+    options.seed = settings.seed + 7919u * static_cast<std::uint64_t>(i);
+    const gp::FitResult fit = backend->fit(backend->select_training_points(all.subset(training), settings.seed), options);
+    fit.model->predict(z, mean, variance);
+    out.col(i) = mean;
+  }
+  return out;
+}
+
 Vector gp_explained(const ResidualGp& gp, const Transitions& data, const Matrix& residual) {
   const std::vector<int> rows = data.rows(true);
   Vector out = Vector::Zero(residual.cols());

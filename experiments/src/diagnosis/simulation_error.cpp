@@ -1,7 +1,12 @@
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <stdexcept>
+
+#include "gpilqg/experiments/diagnosis/accelerations.hpp"
+#include "gpilqg/experiments/diagnosis/derivative_window.hpp"
+#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -67,13 +72,52 @@ Matrix simulated_predictions(const StepModel& model, const Transitions& data, co
   return out;
 }
 
+namespace {
+
+/// Inverse dynamics: the accelerations, the generalised-force residual, its weights and the model's
+/// own force (inverse_dynamics_context in simulation_error.hpp).
+FitContext inverse_dynamics_context(FitContext context) {
+  context.window = 1;
+  context.criterion = FitCriterion::InverseDynamics;
+  if (context.data == nullptr) return context;
+  const Transitions& data = *context.data;
+  const DynamicsPtr system = context.model.build();
+  const ForceComponents components = force_components(*system);
+  const auto k = static_cast<Eigen::Index>(components.forces.size());
+  context.accelerations =
+      std::make_shared<const Matrix>(estimate_accelerations(data, components.velocity_states(), context.dt).qdd);
+  const std::vector<int> rows = all_rows(data);
+  context.residual = generalised_force_residual(context.model, data, *context.accelerations, rows);
+  // The model's own force: the residual at zero acceleration is -W_v^-1 f_v.
+  context.own_force =
+      std::make_shared<const Matrix>(-generalised_force_residual(context.model, data, Matrix::Zero(data.size(), k), rows));
+  // w_i = 1 / sigma_i^2 with sigma_i the white noise of component i's residual, from its repeated
+  // differences within each record (difference_noise_std): the noise of the torque and of the
+  // acceleration estimate, which a smooth missing force does not raise.
+  const std::vector<RowSegment> segments = row_segments(data);
+  context.weights.resize(k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    std::vector<Vector> pieces;
+    for (const RowSegment& s : segments) pieces.push_back(context.residual.col(i).segment(s.first, s.end - s.first));
+    const double rms = std::sqrt(context.residual.col(i).squaredNorm() / std::max<double>(1.0, data.size()));
+    const double sigma = std::max(difference_noise_std(pieces), 1e-12 * (1.0 + rms));
+    context.weights(i) = 1.0 / (sigma * sigma);
+  }
+  return context;
+}
+
+}  // namespace
+
 FitContext criterion_context(FitContext context, FitCriterion criterion, int window, int* restarts) {
   if (window < 1) throw std::invalid_argument("criterion_context: the window must be >= 1 row");
   if (restarts != nullptr) *restarts = 0;
+  if (criterion == FitCriterion::InverseDynamics) return inverse_dynamics_context(std::move(context));
   if (criterion == FitCriterion::OneStep) {
     context.window = 1;
+    context.criterion = FitCriterion::OneStep;
     return context;
   }
+  context.criterion = FitCriterion::Simulation;
   context.window = window;
   // Held-out batches are whole windows (heldout_batch_length in effect_fit.cpp): the errors within a
   // window are strongly correlated.

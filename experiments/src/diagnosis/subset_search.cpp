@@ -184,7 +184,7 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     accepted.clear();
     for (const std::string& name : now)
       if (std::find(removed.begin(), removed.end(), name) == removed.end()) accepted.push_back(name);
-    accepted_context.residual = context.data->x_next - model_predictions(step.model, context);
+    accepted_context.residual = criterion_residual(step.model, context);
     S.model = step.model;
     S.steps.push_back(std::move(step));
   }

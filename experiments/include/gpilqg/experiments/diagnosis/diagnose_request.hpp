@@ -26,8 +26,8 @@ struct DiagnoseRequest {
   int gp_restarts = 1;
   std::string backend = "exact";
   std::uint64_t seed = 1;
-  /// --criterion: the error effects are fitted to and scored on, "one-step" or "simulation"
-  /// (simulation_error.hpp).
+  /// --criterion: the error effects are fitted to and scored on, "one-step", "simulation" or
+  /// "inverse-dynamics" (fit_criterion.hpp).
   std::string criterion = "one-step";
   /// --window: samples per simulation window; required with "simulation", not accepted with "one-step".
   std::optional<long> window;

@@ -90,7 +90,7 @@ struct DiagnosisOptions {
   /// The error effects are fitted to and scored on (simulation_error.hpp): one-step, or simulation
   /// over windows of `window` samples from measured states (--criterion, --window).
   FitCriterion criterion = FitCriterion::OneStep;
-  int window = 1;                         ///< samples per window; 1 with the one-step criterion
+  int window = 1;                         ///< samples per window; 1 unless the criterion is simulation
   bool rank = true;                       ///< false: skip the ranking (faster; verdict from the GP only)
   /// Candidates never ranked, searched or proposed (`--exclude`, resolved to names: excluded_effects).
   std::vector<std::string> exclude;
@@ -204,6 +204,13 @@ struct DiagnosisReport {
   /// over windows of `window` samples (simulation_error.hpp).
   FitCriterion criterion = FitCriterion::OneStep;
   int window = 1;
+  /// The channels of the criterion, in which the fits' held-out RMSE are given: the states (one-step,
+  /// simulation) or the generalised-force components (inverse dynamics, e.g. Q_shoulder [N m]), with
+  /// the weights 1 / sigma_i^2 the fits use in them.
+  std::vector<std::string> channel_names, channel_units;
+  Vector criterion_weights;
+  /// Inverse dynamics: the measured accelerations (N x k) the residuals are computed with.
+  std::shared_ptr<const Matrix> accelerations;
   /// Simulation criterion: simulated states of the diagnosed model that diverged, each followed by a
   /// restart from the measurement (0 for the one-step criterion, whose divergences are counted in
   /// non_finite_predictions).

@@ -43,19 +43,21 @@
 
 #include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/integrator.hpp"
+#include "gpilqg/experiments/diagnosis/fit_criterion.hpp"
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
 
 namespace gpilqg::diagnosis {
 
-/// The data and model a fit works on.
+/// The data and model a fit works on. The criterion's channels are the states (one-step, simulation)
+/// or the generalised-force components (inverse dynamics): c of them below.
 struct FitContext {
   const Transitions* data = nullptr;
   ModelSpec model;                      ///< the model the effect is added to
   Integrator integrator = Integrator::RK4;
   double dt = 0.02;
   int substeps = 1;
-  Vector weights;                       ///< n, w_i = 1 / sigma_i^2
-  Matrix residual;                      ///< N x n, the model's residual at every row (under the criterion)
+  Vector weights;                       ///< c, w_i = 1 / sigma_i^2
+  Matrix residual;                      ///< N x c, the model's residual at every row (under the criterion)
   /// Batch length of the held-out significance test; 0: ceil(sqrt(N)) of the N held-out rows, at
   /// least 10 (24 on 600 held-out rows, 87 on 7,500). criterion_context makes it at least a window.
   int batch = 0;
@@ -63,6 +65,13 @@ struct FitContext {
   /// over windows of W rows started from measured states. criterion_context sets it with the
   /// residual and the batch.
   int window = 1;
+  /// The criterion (fit_criterion.hpp); Simulation exactly when window > 1. criterion_context sets it.
+  FitCriterion criterion = FitCriterion::OneStep;
+  /// Inverse dynamics: the measured accelerations of the force components' velocity states at every
+  /// row (N x k, accelerations.hpp), and the model's own generalised force W_v^-1 f_v at every row
+  /// (N x k, the scale of EffectFit::scale). Null for the other criteria.
+  std::shared_ptr<const Matrix> accelerations = {};
+  std::shared_ptr<const Matrix> own_force = {};
   /// Candidates left out of every ranking and search (`--exclude`): effects the user declares
   /// physically meaningless for these data (an armature when torques are measured after the gearbox).
   std::vector<std::string> excluded = {};
@@ -80,7 +89,13 @@ Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int
 
 /// sqrt(w_i) (x_{t+1,i} - phi_i(x_t, u_t)) of `model` stacked over `rows` (index k n + i), integrated
 /// and weighted as `settings` says; a diverged prediction counts as x_t (see one_step_predictions).
+/// Under the inverse-dynamics criterion the weighted generalised-force residual (index k c + i).
 Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows);
+
+/// The residual of `model` at every row of settings.data under settings' criterion (N x c): x_next
+/// minus model_predictions for one-step and simulation, the generalised-force residual
+/// (generalised_force_residual.hpp) for inverse dynamics.
+Matrix criterion_residual(const ModelSpec& model, const FitContext& settings, int* diverged = nullptr);
 
 /// The values of one effect inside a joint fit: where it started, where it ended, its 95% interval.
 struct EffectValues {

@@ -19,6 +19,12 @@ namespace gpilqg::diagnosis {
 /// Index of the state whose held-out RMSE / noise floor is largest.
 int worst_state(const DiagnosisReport& report);
 
+/// The channel of the criterion (DiagnosisReport::channel_names) the reports single out for the
+/// effects' held-out RMSE: worst_state for the state criteria; under inverse dynamics the force
+/// component whose weighted held-out residual is largest before the best-ranked effect (0 when nothing
+/// is ranked).
+int worst_channel(const DiagnosisReport& report);
+
 /// The whole report as JSON. Every number is finite.
 nlohmann::json report_json(const DiagnosisReport& report);
 
