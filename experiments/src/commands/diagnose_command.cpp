@@ -87,7 +87,10 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   check_output_file_option("--write-model", o.write_model, {"diagnose writes a TOML model file", kTomlExtensions},
                            inputs);
   const SystemSignature signature = system_signature(r.system);
-  const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(r);
+  diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(r);
+  // Progress on stderr, with --json too (stdout then holds the document alone): a long search on a
+  // robot's log is not silent.
+  options.progress = [](const std::string& line) { std::cerr << "diagnose: " << line << std::endl; };
   if (!o.plots.empty()) check_plotting();
   const MeasurementSet data = read_measurements(o.data, signature);
   diagnosis::DiagnosisReport report;

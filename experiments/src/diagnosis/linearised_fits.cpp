@@ -173,12 +173,18 @@ double LinearisedFits::left(const std::vector<int>& subset, const Matrix& gram, 
 }
 
 double LinearisedFits::screening_left(const std::vector<int>& subset) const {
-  if (fold_gram_.empty()) return training_left(subset);
-  const std::vector<Eigen::Index> cols = columns_of(subset);
   double total = 0.0;
-  for (std::size_t f = 0; f < fold_gram_.size(); ++f)
-    total += left_of(cols, rest_gram_[f], rest_cross_[f], fold_gram_[f], fold_cross_[f], fold_base_[f]);
+  for (double term : screening_folds(subset)) total += term;
   return total;
+}
+
+std::vector<double> LinearisedFits::screening_folds(const std::vector<int>& subset) const {
+  if (fold_gram_.empty()) return {training_left(subset)};
+  const std::vector<Eigen::Index> cols = columns_of(subset);
+  std::vector<double> out;
+  for (std::size_t f = 0; f < fold_gram_.size(); ++f)
+    out.push_back(left_of(cols, rest_gram_[f], rest_cross_[f], fold_gram_[f], fold_cross_[f], fold_base_[f]));
+  return out;
 }
 
 double LinearisedFits::gain(const std::vector<int>& subset, const std::vector<int>& reference) const {

@@ -63,11 +63,11 @@ const char* to_string(SearchMethod method);
 
 struct SelectionOptions {
   SearchMethod method = SearchMethod::Subsets;
-  int max_subset = 4;           ///< subsets: the largest set searched
+  int max_subset = 4;           ///< subsets: the largest size searched exhaustively (subset_search.hpp)
   double alias_gain = 0.05;     ///< rank_effects' alias rule
   double min_explained = 0.05;  ///< step 3: explained >= this ...
   double min_z = 3.0;           ///< ... and z >= this
-  int max_steps = 10;           ///< at most this many effects
+  int max_steps = 32;           ///< at most this many effects (a 7-joint arm's friction alone takes 14)
   int threads = 1;              ///< candidates fitted at once
   std::function<void(const std::string&)> progress;
 };

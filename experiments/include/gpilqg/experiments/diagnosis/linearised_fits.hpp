@@ -64,6 +64,8 @@ class LinearisedFits {
   /// The cross-validated screening score on the training rows (see the file comment); the training
   /// residual left (training_left) when the training rows hold fewer than two episodes.
   double screening_left(const std::vector<int>& subset) const;
+  /// Its terms, one per fold (a single entry, training_left, without folds).
+  std::vector<double> screening_folds(const std::vector<int>& subset) const;
   /// The folds of screening_left (0 when it falls back to training_left).
   int folds() const { return static_cast<int>(fold_gram_.size()); }
 
