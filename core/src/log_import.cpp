@@ -359,6 +359,9 @@ ImportResult import_log(const RawLog& log, const LogMap& written_map, const Syst
                                 rows, report.dropped.size(), report.max_gap),
                     fmt::format("an episode of at least {} samples at dt = {} s", min_samples, report.dt));
   result.set.system = system;
+  for (const Quantity& state : system.states)  // the provenance, in the system's order
+    for (const auto& [velocity, position] : report.estimated)
+      if (velocity == state.name) result.set.estimated_states.push_back(velocity);
   return result;
 }
 

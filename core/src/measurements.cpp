@@ -15,6 +15,7 @@
 
 #include "gpilqg/core/atomic_file.hpp"
 #include "measurements_internal.hpp"
+#include "name_list.hpp"
 
 namespace gpilqg {
 
@@ -178,6 +179,21 @@ void check_writable(const MeasurementSet& set) {
       throw std::invalid_argument(fmt::format("measurement set: episode {}, sample {}: {}; expected {}", e.id,
                                               issue->index, issue->problem, issue->expected));
   }
+  if (const auto problem = estimated_states_problem(set.estimated_states, set.system))
+    throw std::invalid_argument("measurement set: estimated_states: " + *problem);
+}
+
+std::optional<std::string> estimated_states_problem(const std::vector<std::string>& names,
+                                                    const SystemSignature& system) {
+  std::set<std::string> seen;
+  for (const std::string& name : names) {
+    if (index_of(system.states, name) < 0)
+      return fmt::format("{} is not a state of system '{}'; expected some of its states: {}", name_list::quoted(name),
+                         system.name, join(names_of(system.states)));
+    if (!seen.insert(name).second)
+      return fmt::format("{} is listed twice; expected each state at most once", name_list::quoted(name));
+  }
+  return std::nullopt;
 }
 
 }  // namespace measurements_detail
@@ -222,6 +238,7 @@ ColumnSummary summarize_column(const Quantity& quantity, const std::vector<Episo
 MeasurementSummary summarize(const MeasurementSet& set) {
   MeasurementSummary summary;
   summary.system = set.system.name;
+  summary.estimated_states = set.estimated_states;
   summary.episodes = static_cast<int>(set.episodes.size());
   summary.samples = set.sample_count();
   bool first = true;

@@ -8,6 +8,10 @@
 /// A system without controls (m = 0, a passive system): control_names may be absent or empty and each
 /// u absent or of shape (T x 0); the writer writes an empty control_names and u of shape (T x 0).
 ///
+/// Optional root attribute estimated_states (1-D string array): the states that were estimated from
+/// others rather than measured (MeasurementSet::estimated_states), each a name of state_names, once.
+/// Absent means every state was measured; the writer writes it only when some state was estimated.
+///
 /// The reader accepts variable-length and fixed-length strings (null- or space-padded) and any
 /// floating-point storage type; episodes come back ordered by k. Other objects (extra attributes,
 /// groups or datasets) are ignored. Every failure, including one inside the HDF5 library, is a
@@ -83,6 +87,7 @@ class MeasurementsHdf5Reader {
       check_attributes(root);
       MeasurementSet set;
       set.system = system_;
+      set.estimated_states = estimated_states(root);
       const auto names = guarded(file_, "/episodes", "listing the episodes", "a readable group /episodes",
                                  [&] { return episode_names(); });
       for (const auto& [id, name] : names) set.episodes.push_back(read_episode(id, name));
@@ -170,6 +175,29 @@ class MeasurementsHdf5Reader {
     // A system without controls (a passive system): control_names may be absent, or an empty array.
     if (!system_.controls.empty() || root.attrExists("control_names"))
       check_names(root, "control_names", names_of(system_.controls), "control");
+  }
+
+  /// The optional attribute estimated_states: empty when absent, else distinct state names.
+  std::vector<std::string> estimated_states(const H5::Group& root) const {
+    const std::string name = "estimated_states";
+    if (!root.attrExists(name)) return {};
+    const std::string expected = fmt::format(
+        "a 1-D array of the states estimated from others (e.g. by gpilqg data import), each one of the states of "
+        "system '{}' once: {}",
+        system_.name, quoted_list(names_of(system_.states)));
+    const std::vector<std::string> found = read_strings(root, name, false, expected);
+    std::vector<std::string> seen;
+    for (const std::string& state : found) {
+      if (index_of(system_.states, state) < 0)
+        throw DataError(file_, attribute_location(name),
+                        fmt::format("names {}, which is not a state of system '{}'", name_list::quoted(state),
+                                    system_.name),
+                        expected);
+      if (std::find(seen.begin(), seen.end(), state) != seen.end())
+        throw DataError(file_, attribute_location(name), fmt::format("lists {} twice", name_list::quoted(state)), expected);
+      seen.push_back(state);
+    }
+    return found;
   }
 
   void check_names(const H5::Group& root, const std::string& attribute,
@@ -345,6 +373,7 @@ void write_measurements_hdf5(const std::filesystem::path& file, const Measuremen
       write_string(root, "system", set.system.name);
       write_strings(root, "state_names", names_of(set.system.states));
       write_strings(root, "control_names", names_of(set.system.controls));
+      if (!set.estimated_states.empty()) write_strings(root, "estimated_states", set.estimated_states);
       H5::Group episodes = h5.createGroup("episodes");
       for (const Episode& e : set.episodes) {
         H5::Group group = episodes.createGroup(std::to_string(e.id));

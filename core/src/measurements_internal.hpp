@@ -53,4 +53,9 @@ std::string format_number(double value);
 /// file that the readers would reject.
 void check_writable(const MeasurementSet& set);
 
+/// Why `names` cannot be the estimated states of a set of `system` (a name that is not one of its
+/// states, or one listed twice), as "<problem>; expected <...>"; nullopt when they can.
+std::optional<std::string> estimated_states_problem(const std::vector<std::string>& names,
+                                                    const SystemSignature& system);
+
 }  // namespace gpilqg::measurements_detail

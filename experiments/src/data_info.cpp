@@ -65,6 +65,11 @@ std::string format_data_info(const std::filesystem::path& file, const Measuremen
     line("dt", fmt::format("{} to {} (differs between episodes)", statistic_text(summary.dt_min, " s"),
                            statistic_text(summary.dt_max, " s")));
   line("duration", statistic_text(summary.duration, " s"));
+  // The provenance of the states (HDF5 attribute estimated_states; a CSV file cannot hold it).
+  line("estimated", summary.estimated_states.empty()
+                        ? std::string("none (every state measured)")
+                        : fmt::format("{} (from other states, e.g. by gpilqg data import)",
+                                      fmt::join(summary.estimated_states, ", ")));
 
   std::size_t name_width = 4, unit_width = 4;
   for (const auto* columns : {&summary.states, &summary.controls})
@@ -94,6 +99,7 @@ nlohmann::json data_info_json(const std::filesystem::path& file, const Measureme
           {"dt_min", statistic(summary.dt_min)},
           {"dt_max", statistic(summary.dt_max)},
           {"duration_s", statistic(summary.duration)},
+          {"estimated_states", summary.estimated_states},  // [] when every state was measured
           {"states", columns_json(summary.states)},
           {"controls", columns_json(summary.controls)}};
 }

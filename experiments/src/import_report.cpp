@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -92,6 +93,17 @@ std::string format_import_report(const ImportReport& r, const std::filesystem::p
                         "({:.4g} /s at the first and last samples)\n",
                         r.estimator->window, r.estimator->order, r.estimator_lag, r.estimator_noise_gain,
                         r.estimator_end_noise_gain);
+  if (!r.estimated.empty()) {
+    std::string extension = out.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::vector<std::string> names;
+    for (const auto& estimated : r.estimated) names.push_back(estimated.first);
+    text += extension == ".csv"
+                ? fmt::format("note: a CSV file cannot record that {} {} estimated, so they read back as measured; write "
+                              ".h5 to keep it (the diagnosis chooses its criterion by it)\n",
+                              fmt::join(names, ", "), names.size() == 1 ? "was" : "were")
+                : fmt::format("provenance: {} recorded as estimated (attribute estimated_states)\n", fmt::join(names, ", "));
+  }
   std::string ignored;
   for (const std::string& name : r.ignored_columns) ignored += (ignored.empty() ? "" : ", ") + name;
   text += fmt::format("ignored columns: {}\n", ignored.empty() ? "none" : ignored);

@@ -85,6 +85,20 @@ shapes, non-finite values, or times that do not increase at a constant step.)")
           out.append(py::cast(&e, py::return_value_policy::reference_internal, self));
         return out;
       }, "the episodes, in order (views into the set)")
+      .def_property(
+          "estimated_states", [](const MeasurementSet& s) { return s.estimated_states; },
+          [](MeasurementSet& s, const std::vector<std::string>& names) {
+            std::vector<std::string> previous = std::move(s.estimated_states);
+            s.estimated_states = names;
+            try {
+              check_measurement_set(s);
+            } catch (const std::invalid_argument& e) {
+              s.estimated_states = std::move(previous);
+              throw InputError(e.what());
+            }
+          },
+          "the states estimated from others rather than measured (e.g. velocities differentiated from positions); "
+          "[] when all were measured. Kept by HDF5 files (attribute estimated_states), not by CSV.")
       .def_property_readonly("sample_count", &MeasurementSet::sample_count)
       .def("write", [](const MeasurementSet& s, const std::filesystem::path& file) { write_measurements(file, s); },
            py::arg("file"), "Writes CSV or HDF5 by the file's extension, atomically.");

@@ -82,6 +82,7 @@ MeasurementSet block_episodes(const MeasurementSet& set, const HeldoutBlocks& bl
   const Episode& record = set.episodes.front();
   MeasurementSet out;
   out.system = set.system;
+  out.estimated_states = set.estimated_states;
   for (std::size_t b = 0; b < blocks.blocks.size(); ++b) {
     const HeldoutBlock& block = blocks.blocks[b];
     const int length = block.used_samples();

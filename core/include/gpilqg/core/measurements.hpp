@@ -9,7 +9,9 @@
 /// A file of one episode may leave the `episode` column out (header `t,<states>,<controls>`): its
 /// rows are episode 0.
 /// HDF5: /episodes/<k>/t (T), /episodes/<k>/x (T x n), /episodes/<k>/u (T x m), root attributes
-/// `system`, `state_names`, `control_names`.
+/// `system`, `state_names`, `control_names`, and optionally `estimated_states` (the provenance of the
+/// states: MeasurementSet::estimated_states). CSV cannot carry the provenance: its states count as
+/// measured.
 
 #include <filesystem>
 #include <optional>
@@ -38,6 +40,13 @@ struct Episode {
 struct MeasurementSet {
   SystemSignature system;
   std::vector<Episode> episodes;
+  /// The states that were not measured but estimated from other states, e.g. the velocities that
+  /// `gpilqg data import` differentiated from positions ({"x_dot", "theta_dot"}), in the system's
+  /// order; empty when every state was measured. The diagnosis chooses its criterion by it
+  /// (criterion_choice.hpp): a fit that regresses on estimated states is biased (errors in
+  /// variables). Stored in HDF5 as the root attribute `estimated_states`; a CSV file cannot hold it,
+  /// so its states read back as measured. Every name must be a state of `system`, once.
+  std::vector<std::string> estimated_states;
   /// Total number of rows over all episodes.
   long sample_count() const;
 };
@@ -87,6 +96,7 @@ MeasurementSet parse_measurements_csv(std::string_view text, const std::filesyst
 
 /// Reads and validates an HDF5 measurement file: same checks, naming the dataset or attribute
 /// (e.g. "/episodes/3/x", "attribute 'state_names'"), plus missing groups, datasets or attributes,
+/// an optional `estimated_states` that is not a 1-D string array of distinct state names,
 /// wrong shapes or types, a `system` attribute that differs from `system`, no episodes, and group
 /// names under /episodes that are not non-negative integers. String attributes may be variable- or
 /// fixed-length; datasets any floating-point type. Episodes come back ordered by k; other objects
@@ -103,17 +113,21 @@ MeasurementSet read_measurements(const std::filesystem::path& file, const System
 /// Writes CSV with every number in its shortest round-trip form, so reading it back gives the same
 /// doubles bit for bit. Written atomically (atomic_file.hpp): a temporary file beside `file`, flushed
 /// and renamed into place, so a failed write leaves any previous `file` untouched. Both writers first
-/// check the set (shapes, finite values, distinct non-negative ids, valid times) and throw
-/// std::invalid_argument rather than write a file the readers would reject.
+/// check the set (shapes, finite values, distinct non-negative ids, valid times, estimated states
+/// that are states) and throw std::invalid_argument rather than write a file the readers would
+/// reject. The CSV header is fixed, so estimated_states is not written: the file's states read back
+/// as measured (write HDF5 to keep the provenance).
 void write_measurements_csv(const std::filesystem::path& file, const MeasurementSet& set);
-/// Writes HDF5 in the layout above (float64, variable-length UTF-8 strings), group names /episodes/<id>.
-/// Written atomically like the CSV.
+/// Writes HDF5 in the layout above (float64, variable-length UTF-8 strings), group names /episodes/<id>,
+/// and the root attribute `estimated_states` when the set has estimated states (a file without it
+/// reads back as "all measured"). Written atomically like the CSV.
 void write_measurements_hdf5(const std::filesystem::path& file, const MeasurementSet& set);
 /// Chooses the writer by extension like read_measurements.
 void write_measurements(const std::filesystem::path& file, const MeasurementSet& set);
 
 /// Checks a set built in memory as the writers do before writing: shapes against its system, finite
-/// values, distinct non-negative episode ids, times increasing at a constant step. Throws
+/// values, distinct non-negative episode ids, times increasing at a constant step, estimated states
+/// that are states of the system, each once. Throws
 /// std::invalid_argument naming the episode and the sample.
 void check_measurement_set(const MeasurementSet& set);
 
@@ -136,6 +150,7 @@ struct MeasurementSummary {
   double duration = 0.0;  ///< total measured time, sum over episodes of (T - 1) dt [s]
   std::vector<ColumnSummary> states;
   std::vector<ColumnSummary> controls;
+  std::vector<std::string> estimated_states;  ///< MeasurementSet::estimated_states (empty: all measured)
 };
 
 /// Per-column min, max, mean and population std over all samples of all episodes, in the system's

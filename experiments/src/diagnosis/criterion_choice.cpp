@@ -1,0 +1,389 @@
+#include "gpilqg/experiments/diagnosis/criterion_choice.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <Eigen/LU>
+#include <fmt/format.h>
+
+#include "gpilqg/core/effects.hpp"
+#include "gpilqg/core/generalised_forces.hpp"
+#include "gpilqg/core/savitzky_golay.hpp"
+#include "gpilqg/experiments/diagnosis/derivative_window.hpp"
+#include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
+#include "gpilqg/experiments/diagnosis/motion_period.hpp"
+
+namespace gpilqg::diagnosis {
+
+namespace {
+
+/// Relative tolerance on the gains of the controls (G) and on their reach outside the velocities.
+constexpr double kGainTolerance = 1e-4;
+/// States at which the gains are compared.
+constexpr int kGainSamples = 8;
+/// Rows at which the control's error in the acceleration estimate is averaged (evenly strided).
+constexpr long kControlErrorRows = 2000;
+
+/// The system whose generalised-force map `model` uses: itself, or the base of an EffectDynamics.
+const GeneralisedForceInput* force_input(const Dynamics& model) {
+  const Dynamics* system = &model;
+  while (true) {
+    if (const auto* input = dynamic_cast<const GeneralisedForceInput*>(system)) return input;
+    const auto* decorated = dynamic_cast<const EffectDynamics*>(system);
+    if (decorated == nullptr) return nullptr;
+    system = &decorated->base();
+  }
+}
+
+/// The coordinates of the model's force components, when every component has one (else empty).
+std::vector<GeneralisedCoordinate> force_coordinates(const Dynamics& model) {
+  const GeneralisedForceInput* input = force_input(model);
+  if (input == nullptr) return {};
+  std::vector<GeneralisedCoordinate> coordinates(input->generalised_forces().size());
+  std::vector<bool> found(coordinates.size(), false);
+  const Dynamics* owner = &model;
+  while (dynamic_cast<const GeneralisedForceInput*>(owner) == nullptr)
+    owner = &dynamic_cast<const EffectDynamics*>(owner)->base();
+  for (const GeneralisedCoordinate& c : generalised_coordinates(*owner)) {
+    coordinates[static_cast<std::size_t>(c.component)] = c;
+    found[static_cast<std::size_t>(c.component)] = true;
+  }
+  if (std::find(found.begin(), found.end(), false) != found.end()) return {};
+  return coordinates;
+}
+
+/// The velocity states (file comment of the header): the coordinates', else `<q>_dot`, else all.
+std::vector<int> velocity_states(const std::vector<GeneralisedCoordinate>& coordinates, const SystemSignature& system) {
+  std::vector<int> out;
+  for (const GeneralisedCoordinate& c : coordinates) out.push_back(c.velocity);
+  if (!out.empty()) return out;
+  for (int i = 0; i < static_cast<int>(system.states.size()); ++i) {
+    const std::string& name = system.states[static_cast<std::size_t>(i)].name;
+    if (name.size() > 4 && name.ends_with("_dot") && index_of(system.states, name.substr(0, name.size() - 4)) >= 0)
+      out.push_back(i);
+  }
+  if (!out.empty()) return out;
+  for (int i = 0; i < static_cast<int>(system.states.size()); ++i) out.push_back(i);
+  return out;
+}
+
+/// The sample `index` of all samples of `data` counted episode after episode: (episode, row).
+std::pair<const Episode*, Eigen::Index> sample_at(const MeasurementSet& data, long index) {
+  for (const Episode& e : data.episodes) {
+    if (index < e.length()) return {&e, index};
+    index -= e.length();
+  }
+  return {&data.episodes.back(), data.episodes.back().length() - 1};
+}
+
+/// Why the controls of `model` are not generalised forces with a constant gain (header, rule 2), or
+/// "" when they are.
+std::string why_not_forces(const Dynamics& model, const std::vector<GeneralisedCoordinate>& coordinates,
+                           const MeasurementSet& data) {
+  const GeneralisedForceInput* input = force_input(model);
+  if (input == nullptr) return fmt::format("system '{}' has no generalised-force map", model.name());
+  if (coordinates.empty())
+    return fmt::format("a generalised force of system '{}' acts on no coordinate with a velocity state", model.name());
+  const auto k = static_cast<Eigen::Index>(coordinates.size());
+  const int n = model.state_dim(), m = model.control_dim();
+  std::vector<bool> velocity_row(static_cast<std::size_t>(n), false);
+  for (const GeneralisedCoordinate& c : coordinates) velocity_row[static_cast<std::size_t>(c.velocity)] = true;
+
+  const long total = data.sample_count();
+  DynamicsJacobians jac;
+  Vector xdot(n);
+  Matrix W;
+  Matrix reference;  // G at the first state
+  for (int s = 0; s < 2 * kGainSamples; ++s) {
+    // Samples spread over the data; the second half pairs each state with another sample's control.
+    const long i = (static_cast<long>(s % kGainSamples) * total) / kGainSamples;
+    const auto [episode, row] = sample_at(data, i);
+    const Vector x = episode->x.row(row).transpose();
+    const auto [other, other_row] = sample_at(data, (i + total / 2) % total);
+    const Vector u = (s < kGainSamples ? episode->u.row(row) : other->u.row(other_row)).transpose();
+    model.evaluate(x, u, xdot, &jac);
+    for (int j = 0; j < m; ++j) {
+      const double scale = jac.fu.col(j).cwiseAbs().maxCoeff();
+      for (int r = 0; r < n; ++r)
+        if (!velocity_row[static_cast<std::size_t>(r)] && std::abs(jac.fu(r, j)) > kGainTolerance * scale)
+          return fmt::format("control '{}' drives state '{}', not the velocity of a coordinate",
+                             data.system.controls[static_cast<std::size_t>(j)].name,
+                             data.system.states[static_cast<std::size_t>(r)].name);
+    }
+    input->generalised_force_map(x, W, nullptr);
+    Matrix Wv(k, k), bv(k, m);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      Wv.row(c) = W.row(coordinates[static_cast<std::size_t>(c)].velocity);
+      bv.row(c) = jac.fu.row(coordinates[static_cast<std::size_t>(c)].velocity);
+    }
+    const Eigen::FullPivLU<Matrix> lu(Wv);
+    if (!lu.isInvertible()) return "the generalised-force map is singular at a measured state";
+    const Matrix G = lu.solve(bv);
+    if (s == 0) {
+      reference = G;
+      if (reference.cwiseAbs().maxCoeff() == 0.0) return "the controls do not act on the model";
+      continue;
+    }
+    const double scale = reference.cwiseAbs().maxCoeff();
+    Eigen::Index r = 0, c = 0;
+    const double change = (G - reference).cwiseAbs().maxCoeff(&r, &c);
+    if (change > kGainTolerance * scale)
+      return fmt::format("the generalised force of control '{}' on coordinate '{}' changes with the {} by {:.2g}% of "
+                         "the largest gain",
+                         data.system.controls[static_cast<std::size_t>(c)].name,
+                         coordinates[static_cast<std::size_t>(r)].name, s < kGainSamples ? "state" : "control",
+                         100.0 * change / scale);
+  }
+  return "";
+}
+
+/// rho of one velocity state (header, rule 2), with its window and the controls' share of E_ID.
+struct StateRatio {
+  double ratio = 0.0;
+  int window = 0;
+  double control_error = 0.0;
+};
+
+/// The symmetric smoothing kernel kk_{-h..h} (2h + 1 weights summing to 1) that the centred
+/// Savitzky-Golay derivative of window w applies to the acceleration: with c_j its weights (per unit
+/// step), the derivative is sum_{s=-h..h-1} k_s a_s over the velocity increments of the steps
+/// [t+s, t+s+1], k_s = sum_{j >= max(s+1, -s)} c_j; each increment holds the mean of the acceleration
+/// at its two ends (a continuous signal), so kk_r = (k_r + k_{r-1}) / 2.
+Vector acceleration_kernel(int window) {
+  const int h = window / 2;
+  const SavitzkyGolayDerivative filter(window, 2);
+  const Vector c = filter.weights(h);
+  Vector k = Vector::Zero(2 * h);  // k_s at index s + h, s = -h .. h-1
+  for (int s = -h; s < h; ++s)
+    for (int j = std::max(s + 1, -s); j <= h; ++j) k(s + h) += c(h + j);
+  Vector kernel = Vector::Zero(2 * h + 1);  // kk_r at index r + h
+  for (int r = -h; r <= h; ++r) {
+    const double right = r < h ? k(r + h) : 0.0, left = r > -h ? k(r - 1 + h) : 0.0;
+    kernel(r + h) = 0.5 * (right + left);
+  }
+  return kernel;
+}
+
+/// The white-noise level of a sampled signal robust to isolated corners and steps: for each order
+/// k = k_min..k_max the median of |Delta^k y| pooled over the segments, over its value for white noise
+/// of unit variance (0.6745 sqrt(C(2k, k)), Delta^k e being normal with variance C(2k, k)), the
+/// smallest over k. A median ignores the differences a held control's steps (in the control) or
+/// corners (in the velocity) spoil as long as they are fewer than half, where the mean of squares of
+/// difference_noise_std takes them for noise; that matters for E_1, which is the noise alone. The
+/// smallest k that a smooth trend does not dominate wins, as in difference_noise_std.
+double robust_noise_std(const std::vector<Vector>& segments, int k_min, int k_max) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = k_min; k <= k_max; ++k) {
+    std::vector<double> magnitudes;
+    for (const Vector& y : segments) {
+      if (y.size() <= k) continue;
+      Vector d = y;
+      for (int order = 0; order < k; ++order) d = (d.tail(d.size() - 1) - d.head(d.size() - 1)).eval();
+      for (Eigen::Index i = 0; i < d.size(); ++i) magnitudes.push_back(std::abs(d(i)));
+    }
+    if (magnitudes.empty()) continue;
+    const auto mid = magnitudes.begin() + static_cast<std::ptrdiff_t>(magnitudes.size() / 2);
+    std::nth_element(magnitudes.begin(), mid, magnitudes.end());
+    double binomial = 1.0;  // C(2k, k)
+    for (int i = 1; i <= k; ++i) binomial = binomial * (k + i) / i;
+    best = std::min(best, *mid / (0.674489750196 * std::sqrt(binomial)));
+  }
+  return std::isfinite(best) ? best : 0.0;
+}
+
+StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, int state, double dt) {
+  std::vector<Vector> segments;
+  for (const Episode& e : data.episodes)
+    if (e.length() >= shortest_differentiable_segment(2)) segments.push_back(e.x.col(state));
+  StateRatio out;
+  if (segments.empty()) return out;
+  // The noise of the controls, which both residuals carry alike (b_v n_u in acceleration units).
+  const int m = model.control_dim();
+  Vector control_noise(m);
+  for (int j = 0; j < m; ++j) {
+    std::vector<Vector> columns;
+    for (const Episode& e : data.episodes) columns.push_back(e.u.col(j));
+    control_noise(j) = robust_noise_std(columns, 1, 2);
+  }
+  const DerivativeWindow dw = choose_derivative_window(segments, dt, 2);
+  out.window = dw.window;
+  const int h = dw.window / 2;
+  const Vector kernel = acceleration_kernel(dw.window);
+
+  long interior = 0;
+  for (const Episode& e : data.episodes)
+    if (e.length() >= dw.window) interior += e.length() - 2 * h;
+  const long stride = std::max(1L, interior / kControlErrorRows);
+  DynamicsJacobians jac;
+  Vector xdot(model.state_dim());
+  const auto workspace = model.make_workspace();
+  double sum = 0.0, shared = 0.0;
+  long count = 0, position = 0;
+  for (const Episode& e : data.episodes) {
+    if (e.length() < dw.window) continue;
+    for (Eigen::Index t = h; t + h < e.length(); ++t, ++position) {
+      if (position % stride != 0) continue;
+      const Vector smoothed = e.u.middleRows(t - h, dw.window).transpose() * kernel;
+      const Vector du = smoothed - e.u.row(t).transpose();
+      model.evaluate(e.x.row(t).transpose(), e.u.row(t).transpose(), xdot, &jac, *workspace);
+      sum += std::pow(jac.fu.row(state).dot(du), 2);
+      shared += jac.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
+      ++count;
+    }
+  }
+  const double control_mse = count > 0 ? sum / static_cast<double>(count) : 0.0;
+  const double sigma = robust_noise_std(segments, 2, 4);
+  const double e1_squared =
+      2.0 * sigma * sigma / (dt * dt) + (count > 0 ? shared / static_cast<double>(count) : 0.0);
+  const double eid_squared = dw.risk + control_mse;
+  out.ratio = eid_squared > 0.0 ? std::sqrt(e1_squared / eid_squared)
+                                : (e1_squared > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
+  out.control_error = eid_squared > 0.0 ? std::sqrt(control_mse / eid_squared) : 0.0;
+  return out;
+}
+
+std::string seconds(double value) { return fmt::format("{:.3g} s", value); }
+
+std::string names(const std::vector<std::string>& list) { return fmt::format("{}", fmt::join(list, ", ")); }
+
+/// W and the phrase that says how it was chosen (header: the window).
+std::pair<int, std::string> simulation_window(const MeasurementSet& data, const std::vector<int>& states,
+                                              CriterionFacts& facts) {
+  const double dt = facts.dt;
+  facts.window_cap = simulation_window_cap(data);
+  const std::string cap_text =
+      data.episodes.size() == 1
+          ? fmt::format("capped at {} samples so that a training block of the record (cut into {} blocks) keeps two "
+                        "windows beside the gaps",
+                        facts.window_cap, kHeldoutBlockCount)
+          : fmt::format("capped at {} samples, half the shortest episode", facts.window_cap);
+  bool moving = false;
+  for (int s : states) {
+    const MotionPeriod p = motion_period(data, s);
+    if (p.still) continue;
+    if (!moving || p.period > facts.slowest_period) {
+      facts.slowest_period = p.period;
+      facts.slowest_state = data.system.states[static_cast<std::size_t>(s)].name;
+    }
+    moving = true;
+  }
+  if (!moving)
+    return {facts.window_cap, "no velocity state moves beyond its noise, so the longest window: " + cap_text};
+  if (!std::isfinite(facts.slowest_period))
+    return {facts.window_cap, fmt::format("the slowest motion, {}, is slower than the episodes: {}", facts.slowest_state,
+                                          cap_text)};
+  const double periods = 2.0 * facts.slowest_period / dt;
+  const std::string two_periods =
+      fmt::format("two periods of the slowest motion, {}'s {}", facts.slowest_state, seconds(facts.slowest_period));
+  if (periods > facts.window_cap) return {facts.window_cap, fmt::format("{}: {}", two_periods, cap_text)};
+  if (periods < kMinWindow)
+    return {std::min(kMinWindow, facts.window_cap),
+            fmt::format("the shortest window; {} last {:.3g} samples", two_periods, periods)};
+  return {static_cast<int>(std::lround(periods)), two_periods};
+}
+
+}  // namespace
+
+int simulation_window_cap(const MeasurementSet& data) {
+  if (data.episodes.empty()) return 0;
+  if (data.episodes.size() == 1) {
+    const int block = data.episodes.front().length() / kHeldoutBlockCount;
+    return std::max(0, (block - 2) / 4);
+  }
+  int shortest = std::numeric_limits<int>::max();
+  for (const Episode& e : data.episodes) shortest = std::min(shortest, e.length());
+  return shortest / 2;
+}
+
+CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& model) {
+  if (data.episodes.empty()) throw std::invalid_argument("criterion choice: the measurement set has no episodes");
+  const DynamicsPtr dynamics = model.build();
+  if (dynamics->state_dim() != static_cast<int>(data.system.states.size()) ||
+      dynamics->control_dim() != static_cast<int>(data.system.controls.size()))
+    throw std::invalid_argument(fmt::format(
+        "criterion choice: the model '{}' has {} states and {} controls; the data of '{}' have {} and {}",
+        dynamics->name(), dynamics->state_dim(), dynamics->control_dim(), data.system.name,
+        data.system.states.size(), data.system.controls.size()));
+
+  CriterionChoice choice;
+  CriterionFacts& facts = choice.facts;
+  facts.dt = data.episodes.front().dt();
+  facts.passive = data.system.controls.empty();
+  facts.estimated_states = data.estimated_states;
+  const std::vector<GeneralisedCoordinate> coordinates = force_coordinates(*dynamics);
+  const std::vector<int> states = velocity_states(coordinates, data.system);
+  for (int s : states) facts.velocity_states.push_back(data.system.states[static_cast<std::size_t>(s)].name);
+
+  // 1. Passive, or estimated states: simulation.
+  if (facts.passive || !facts.estimated_states.empty()) {
+    std::string why;
+    if (!facts.estimated_states.empty())
+      why = fmt::format("{} {} estimated from other states (e.g. by the import), and a one-step fit regresses on them: "
+                        "biased, as errors in the variables are",
+                        names(facts.estimated_states), facts.estimated_states.size() == 1 ? "was" : "were");
+    if (facts.passive)
+      why += std::string(why.empty() ? "" : "; and ") +
+             "the system has no controls, so the data are a free response whose decay accumulates over periods "
+             "but is below the noise of one step when it is light";
+    const auto [window, how] = simulation_window(data, states, facts);
+    if (window < 2) {
+      choice.reason = fmt::format(
+          "one-step: the simulation criterion is called for ({}), but no window of 2 samples or more fits the "
+          "episodes ({})",
+          why, how);
+      return choice;
+    }
+    choice.criterion = FitCriterion::Simulation;
+    choice.window = window;
+    choice.reason = fmt::format("simulation over windows of {} samples ({}, {}): {}", window,
+                                seconds(window * facts.dt), how, why);
+    return choice;
+  }
+
+  // 2. Generalised forces, and the inverse-dynamics residual clearly less noisy per sample.
+  facts.forces_checked = true;
+  facts.not_forces = why_not_forces(*dynamics, coordinates, data);
+  if (!facts.not_forces.empty()) {
+    choice.reason = fmt::format("one-step: the velocities are measured and the system is driven, but {}, so the "
+                                "inverse-dynamics residual is not the generalised force the model misses",
+                                facts.not_forces);
+    return choice;
+  }
+  facts.ratio = std::numeric_limits<double>::infinity();
+  for (const GeneralisedCoordinate& c : coordinates) {
+    const StateRatio r = state_ratio(*dynamics, data, c.velocity, facts.dt);
+    if (r.ratio < facts.ratio || facts.ratio_state.empty()) {
+      facts.ratio = r.ratio;
+      facts.ratio_state = data.system.states[static_cast<std::size_t>(c.velocity)].name;
+      facts.acceleration_window = r.window;
+      facts.control_error = r.control_error;
+    }
+  }
+  if (facts.acceleration_window == 0) {
+    facts.ratio = 0.0;
+    choice.reason = fmt::format("one-step: every episode is shorter than the {} samples an acceleration estimate needs",
+                                shortest_differentiable_segment(2));
+    return choice;
+  }
+  const std::string measured = fmt::format(
+      "{}: acceleration window of {} samples at {:.4g} Hz, {:.0f}% of its mean squared error from the controls changing within it",
+      facts.ratio_state, facts.acceleration_window, 1.0 / facts.dt, 100.0 * facts.control_error * facts.control_error);
+  if (facts.ratio >= kInverseDynamicsRatio) {
+    choice.criterion = FitCriterion::InverseDynamics;
+    choice.reason = fmt::format(
+        "inverse-dynamics: the controls are generalised forces, the velocities are measured, and the "
+        "inverse-dynamics residual's error per sample is {:.3g} times below the one-step residual's ({}; {:.0f} "
+        "needed)",
+        facts.ratio, measured, kInverseDynamicsRatio);
+    return choice;
+  }
+  choice.reason = fmt::format(
+      "one-step: the controls are generalised forces and the velocities are measured, but the inverse-dynamics "
+      "residual's error per sample would be only {:.3g} times below the one-step residual's ({}; {:.0f} needed)",
+      facts.ratio, measured, kInverseDynamicsRatio);
+  return choice;
+}
+
+}  // namespace gpilqg::diagnosis

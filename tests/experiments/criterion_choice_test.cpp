@@ -1,0 +1,392 @@
+// `--criterion auto` (criterion_choice.hpp) and the provenance it reads (MeasurementSet::estimated_states,
+// the HDF5 attribute estimated_states). Each choice is checked against something independent of the
+// rule: how the data were made (held controls, a passive pendulum, velocities the import estimated),
+// the pendulum's period in closed form, and, for the inverse-dynamics case, the actual errors of the
+// one-step and inverse-dynamics residuals of the true model on the same data, which the rule's ratio
+// estimates without knowing the model is true.
+
+#include <gtest/gtest.h>
+#include <H5Cpp.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <random>
+
+#include "diagnosis_support.hpp"
+#include "free_decay_pendulum.hpp"
+#include "gpilqg/core/log_import.hpp"
+#include "gpilqg/core/raw_log.hpp"
+#include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/data_info.hpp"
+#include "gpilqg/experiments/diagnosis/accelerations.hpp"
+#include "gpilqg/experiments/diagnosis/criterion_choice.hpp"
+#include "gpilqg/experiments/diagnosis/motion_period.hpp"
+#include "gpilqg/experiments/diagnosis/transitions.hpp"
+#include "gpilqg/experiments/import_map.hpp"
+#include "test_support.hpp"
+
+namespace gpilqg {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace diagnosis;
+
+ModelSpec preset(const std::string& system) {
+  ModelSpec m;
+  m.system = system;
+  return m;
+}
+
+// --- The rule on the data of the diagnosis tests ------------------------------------------------
+
+TEST(CriterionChoice, CartPoleTestDataWithHeldControlsChooseOneStep) {
+  // 50 Hz, a new force every 5 samples (ExcitationSettings::hold_steps), every state measured: the
+  // acceleration jumps at every switch, so one step is the criterion.
+  const MeasurementSet set = test::hidden_effect_data(preset("cartpole").build(), 3);
+  const CriterionChoice c = choose_criterion(set, preset("cartpole"));
+  EXPECT_EQ(c.criterion, FitCriterion::OneStep) << c.reason;
+  EXPECT_EQ(c.window, 1);
+  EXPECT_TRUE(c.facts.forces_checked);
+  EXPECT_EQ(c.facts.not_forces, "") << "the cart-pole's force is a generalised force";
+  EXPECT_LT(c.facts.ratio, kInverseDynamicsRatio);
+  EXPECT_GT(c.facts.control_error, 0.5) << "the held controls dominate the acceleration estimate's error";
+  EXPECT_NE(c.reason.find("one-step"), std::string::npos);
+  std::printf("cart-pole: %s\n", c.reason.c_str());
+}
+
+struct PendulumFiles {
+  fs::path model;
+  MeasurementSet data;
+};
+
+const PendulumFiles& pendulum() {
+  static const PendulumFiles p = [] {
+    const fs::path dir = test::temporary_dir("criterion_choice_pendulum");
+    test::write_pendulum(dir / "damped.xml", test::kPendulumDamping);
+    test::write_pendulum(dir / "pendulum.xml", 0.0);
+    return PendulumFiles{dir / "pendulum.xml", test::free_decay(dir / "damped.xml", 10, 7)};
+  }();
+  return p;
+}
+
+TEST(CriterionChoice, FreeDecayPendulumChoosesSimulationOverTwoPeriods) {
+  const CriterionChoice c = choose_criterion(pendulum().data, preset(pendulum().model.string()));
+  ASSERT_EQ(c.criterion, FitCriterion::Simulation) << c.reason;
+  EXPECT_TRUE(c.facts.passive);
+  // The small-angle period 2 pi sqrt(I / (m g l)) = 1.004 s, lengthened by at most 1 + theta_0^2 / 16
+  // (5%) at the amplitudes of up to 0.9 rad the episodes start from.
+  const double period = 2.0 * M_PI * std::sqrt(test::kPendulumInertia / test::kPendulumGravityTorque);
+  EXPECT_EQ(c.facts.slowest_state, "hinge_dot");
+  EXPECT_GT(c.facts.slowest_period, 0.98 * period);
+  EXPECT_LT(c.facts.slowest_period, 1.08 * period);
+  const double two_periods = 2.0 * period / 0.01;
+  EXPECT_NEAR(c.window, two_periods, 0.1 * two_periods);
+  EXPECT_EQ(c.facts.window_cap, 200);  // half the 400 samples of an episode
+  EXPECT_LE(c.window, c.facts.window_cap);
+  EXPECT_NE(c.reason.find("no controls"), std::string::npos) << c.reason;
+  std::printf("pendulum: period %.4f s (closed form %.4f s): %s\n", c.facts.slowest_period, period, c.reason.c_str());
+}
+
+TEST(MotionPeriod, ASinusoidWithNoiseAndADriftingPositionAreMeasuredByTheirVelocity) {
+  // v = 0.8 sin(2 pi t / 0.37) + noise 0.05 over 3 episodes of 2 s at 200 Hz: P = 0.37 s.
+  MeasurementSet set;
+  set.system = system_signature("cartpole");
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  for (int k = 0; k < 3; ++k) {
+    Episode e;
+    e.id = k;
+    e.t = Vector::LinSpaced(401, 0.0, 2.0);
+    e.x = Matrix::Zero(401, 4);
+    e.u = Matrix::Zero(401, 1);
+    for (int i = 0; i < 401; ++i) {
+      e.x(i, 1) = 0.8 * std::sin(2.0 * M_PI * e.t(i) / 0.37 + k) + noise(rng);
+      e.x(i, 3) = 1e-4 * noise(rng);  // still: noise only
+    }
+    set.episodes.push_back(e);
+  }
+  const MotionPeriod p = motion_period(set, 1);
+  EXPECT_FALSE(p.still);
+  EXPECT_NEAR(p.period, 0.37, 0.01 * 0.37);
+  EXPECT_TRUE(motion_period(set, 3).still);
+}
+
+TEST(CriterionChoice, WindowCapsFollowTheEpisodesAndTheHeldOutBlocks) {
+  MeasurementSet set;
+  set.system = system_signature("cartpole");
+  for (int k = 0; k < 2; ++k) {
+    Episode e;
+    e.id = k;
+    e.t = Vector::LinSpaced(k == 0 ? 300 : 81, 0.0, (k == 0 ? 299 : 80) * 0.01);
+    e.x = Matrix::Zero(e.t.size(), 4);
+    e.u = Matrix::Zero(e.t.size(), 1);
+    set.episodes.push_back(e);
+  }
+  EXPECT_EQ(simulation_window_cap(set), 40);  // half of 81
+  set.episodes.resize(1);                      // one record of 300: blocks of 30, (30 - 2) / 4
+  EXPECT_EQ(simulation_window_cap(set), 7);
+}
+
+// --- Estimated velocities, through the import -------------------------------------------------------
+
+TEST(CriterionChoice, VelocitiesEstimatedByTheImportChooseSimulationAndTheFileRemembersThem) {
+  // The cart-pole test data logged as positions and force only, imported with a [velocities]
+  // estimator, written to HDF5 and read back.
+  const MeasurementSet truth = test::hidden_effect_data(preset("cartpole").build(), 3);
+  const fs::path dir = test::temporary_dir("criterion_choice_import");
+  {
+    std::ofstream log(dir / "log.csv");
+    log << "trial,time,pos,angle,force\n";
+    for (const Episode& e : truth.episodes)
+      for (int i = 0; i < e.length(); ++i)
+        log << e.id << ',' << e.t(i) << ',' << e.x(i, 0) << ',' << e.x(i, 2) << ',' << e.u(i, 0) << '\n';
+    std::ofstream(dir / "map.toml") << "[time]\ncolumn = \"time\"\n[episode]\ncolumn = \"trial\"\n"
+                                       "[states]\nx = \"pos\"\ntheta = \"angle\"\n[controls]\nforce = \"force\"\n"
+                                       "[velocities]\nmethod = \"savitzky_golay\"\nwindow = 9\norder = 4\n";
+  }
+  const SystemSignature cartpole = system_signature("cartpole");
+  const ImportResult imported = import_log(read_raw_log(dir / "log.csv"), read_import_map(dir / "map.toml"), cartpole);
+  EXPECT_EQ(imported.set.estimated_states, (std::vector<std::string>{"x_dot", "theta_dot"}));
+  write_measurements(dir / "imported.h5", imported.set);
+  const MeasurementSet set = read_measurements(dir / "imported.h5", cartpole);
+  EXPECT_EQ(set.estimated_states, (std::vector<std::string>{"x_dot", "theta_dot"}));
+
+  const CriterionChoice c = choose_criterion(set, preset("cartpole"));
+  ASSERT_EQ(c.criterion, FitCriterion::Simulation) << c.reason;
+  EXPECT_GE(c.window, kMinWindow);
+  EXPECT_LE(c.window, c.facts.window_cap);
+  EXPECT_EQ(c.facts.window_cap, 60);  // half the 120 samples of an episode
+  EXPECT_NE(c.reason.find("x_dot, theta_dot were estimated"), std::string::npos) << c.reason;
+  EXPECT_FALSE(c.facts.forces_checked);
+  std::printf("imported cart-pole: %s\n", c.reason.c_str());
+
+  // The same data with every state measured: one-step (the first test), and a CSV copy of the
+  // imported file forgets the provenance.
+  write_measurements(dir / "imported.csv", imported.set);
+  EXPECT_TRUE(read_measurements(dir / "imported.csv", cartpole).estimated_states.empty());
+}
+
+// --- Measured torques at 1 kHz on the two-link arm -------------------------------------------------
+
+/// data/two_link_arm.xml with MuJoCo's timestep 1 ms (a diagnosis at 1 kHz needs dt a multiple of it).
+ModelSpec arm_spec() {
+  static const fs::path file = [] {
+    std::ifstream in(test::source_dir() / "data" / "two_link_arm.xml");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string from = R"(timestep="0.01")";
+    text.replace(text.find(from), from.size(), R"(timestep="0.001")");
+    const fs::path out = test::temporary_dir("criterion_choice_arm") / "two_link_arm.xml";
+    std::ofstream(out) << text;
+    return out;
+  }();
+  return preset(file.string());
+}
+
+/// The two-link arm (data/two_link_arm.xml) at 1 kHz: 2 episodes of 4 s, integrated by RK4 at the
+/// sampling step with the torques `torque(t)` (smooth) or held over `hold` samples (hold > 0: random
+/// levels of +-2 N m), measured with noise 1e-4 rad on the angles, 1e-3 rad/s on the velocities
+/// (measured, not estimated) and 0.01 N m on the torques.
+MeasurementSet arm_data(int hold, double velocity_noise, double torque_noise) {
+  const DynamicsPtr arm = arm_spec().build();
+  const auto workspace = arm->make_workspace();
+  const auto f = [&](const Vector& x, const Vector& u) {
+    Vector xdot(4);
+    arm->evaluate(x, u, xdot, nullptr, *workspace);
+    return xdot;
+  };
+  const double dt = 1e-3;
+  const int T = 4001;
+  std::mt19937 rng(17);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> level(-2.0, 2.0);
+  MeasurementSet set;
+  set.system = arm->signature();
+  for (int k = 0; k < 2; ++k) {
+    Vector held = Vector::Zero(2);
+    const auto smooth = [k](double t) {
+      Vector u(2);
+      u << 1.5 * std::sin(2.0 * M_PI * 0.7 * t + k) + 0.8 * std::sin(2.0 * M_PI * 1.9 * t + 0.5),
+          0.6 * std::sin(2.0 * M_PI * 1.3 * t + 2.0 * k) + 0.3 * std::sin(2.0 * M_PI * 3.1 * t);
+      return u;
+    };
+    Episode e;
+    e.id = k;
+    e.t = Vector::LinSpaced(T, 0.0, (T - 1) * dt);
+    e.x.resize(T, 4);
+    e.u.resize(T, 2);
+    Vector x = Vector::Zero(4);
+    x(0) = 0.3 * k;
+    for (int i = 0; i < T; ++i) {
+      const double t = i * dt;
+      if (hold > 0 && i % hold == 0) held << level(rng), 0.5 * level(rng);
+      const auto u = [&](double s) { return hold > 0 ? held : smooth(s); };
+      for (int j = 0; j < 4; ++j) e.x(i, j) = x(j) + (j < 2 ? 1e-4 : velocity_noise) * gauss(rng);
+      for (int j = 0; j < 2; ++j) e.u(i, j) = u(t)(j) + torque_noise * gauss(rng);
+      const Vector k1 = f(x, u(t)), k2 = f(x + 0.5 * dt * k1, u(t + 0.5 * dt));
+      const Vector k3 = f(x + 0.5 * dt * k2, u(t + 0.5 * dt)), k4 = f(x + dt * k3, u(t + dt));
+      x += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    }
+    set.episodes.push_back(e);
+  }
+  return set;
+}
+
+/// What the rule's ratio estimates, measured with the true model: per velocity state, the rms of the
+/// one-step residual of the velocity over dt, and the rms of the inverse-dynamics residual in
+/// acceleration units (the zero-phase estimate of accelerations.hpp minus the model's f_v at the
+/// measured state and control); the smaller ratio of the two states.
+double actual_ratio(const MeasurementSet& set) {
+  const ModelSpec spec = arm_spec();
+  const double dt = set.episodes.front().dt();
+  const Transitions data = make_transitions(set, {}, dt);
+  const Matrix one_step = one_step_predictions(*make_step_model(spec, Integrator::RK4, dt, 1), data);
+  const AccelerationEstimate qdd = estimate_accelerations(data, {2, 3}, dt);
+  const DynamicsPtr arm = spec.build();
+  const auto workspace = arm->make_workspace();
+  Vector xdot(4);
+  double ratio = INFINITY;
+  for (int k = 0; k < 2; ++k) {
+    double e1 = 0.0, eid = 0.0;
+    for (int r = 0; r < data.size(); ++r) {
+      e1 += std::pow((data.x_next(r, 2 + k) - one_step(r, 2 + k)) / dt, 2);
+      arm->evaluate(data.x.row(r).transpose(), data.u.row(r).transpose(), xdot, nullptr, *workspace);
+      eid += std::pow(qdd.qdd(r, k) - xdot(2 + k), 2);
+    }
+    ratio = std::min(ratio, std::sqrt(e1 / eid));
+  }
+  return ratio;
+}
+
+TEST(CriterionChoice, SmoothMeasuredTorquesAtOneKilohertzChooseInverseDynamics) {
+  const MeasurementSet set = arm_data(0, 5e-3, 2e-3);
+  const CriterionChoice c = choose_criterion(set, arm_spec());
+  const double actual = actual_ratio(set);
+  std::printf("arm, smooth torques: rule's ratio %.3g, actual %.3g, window %d: %s\n", c.facts.ratio, actual,
+              c.facts.acceleration_window, c.reason.c_str());
+  ASSERT_EQ(c.criterion, FitCriterion::InverseDynamics) << c.reason;
+  EXPECT_EQ(c.facts.not_forces, "");
+  EXPECT_GE(actual, kInverseDynamicsRatio);
+  EXPECT_NEAR(std::log(c.facts.ratio / actual), 0.0, std::log(2.0)) << "within a factor of 2 of the actual ratio";
+}
+
+TEST(CriterionChoice, HeldTorquesOnTheSameArmChooseOneStep) {
+  // The same arm and noise, the torques held for 20 ms: the acceleration jumps 50 times a second.
+  const MeasurementSet set = arm_data(20, 5e-3, 2e-3);
+  const CriterionChoice c = choose_criterion(set, arm_spec());
+  const double actual = actual_ratio(set);
+  std::printf("arm, held torques: rule's ratio %.3g, actual %.3g, window %d: %s\n", c.facts.ratio, actual,
+              c.facts.acceleration_window, c.reason.c_str());
+  EXPECT_EQ(c.criterion, FitCriterion::OneStep) << c.reason;
+  EXPECT_LT(actual, kInverseDynamicsRatio);
+  EXPECT_NEAR(std::log(c.facts.ratio / actual), 0.0, std::log(2.0)) << "within a factor of 2 of the actual ratio";
+}
+
+TEST(CriterionChoice, ControlsThatAreNotGeneralisedForcesKeepOneStep) {
+  // The quadrotor's thrusts turn with its attitude: their generalised force depends on the state.
+  const DynamicsPtr quad = preset("quadrotor").build();
+  const MeasurementSet set = test::hidden_effect_data(quad, 4);
+  const CriterionChoice c = choose_criterion(set, preset("quadrotor"));
+  EXPECT_EQ(c.criterion, FitCriterion::OneStep) << c.reason;
+  EXPECT_NE(c.facts.not_forces, "") << c.reason;
+  std::printf("quadrotor: %s\n", c.reason.c_str());
+}
+
+// --- The provenance in HDF5 files --------------------------------------------------------------------
+
+MeasurementSet small_cartpole_set() {
+  MeasurementSet set;
+  set.system = system_signature("cartpole");
+  Episode e;
+  e.t = Vector::LinSpaced(4, 0.0, 0.06);
+  e.x = Matrix::Random(4, 4);
+  e.u = Matrix::Random(4, 1);
+  set.episodes.push_back(e);
+  return set;
+}
+
+/// Replaces the root attribute estimated_states of `file` by the strings `values`.
+void set_attribute(const fs::path& file, const std::vector<std::string>& values) {
+  H5::H5File h5(file.string(), H5F_ACC_RDWR);
+  H5::Group root = h5.openGroup("/");
+  if (root.attrExists("estimated_states")) root.removeAttr("estimated_states");
+  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+  std::vector<const char*> data;
+  for (const auto& v : values) data.push_back(v.c_str());
+  const hsize_t dims[1] = {values.size()};
+  root.createAttribute("estimated_states", type, H5::DataSpace(1, dims)).write(type, data.data());
+}
+
+std::string read_error(const fs::path& file) {
+  try {
+    read_measurements(file, system_signature("cartpole"));
+  } catch (const DataError& e) {
+    EXPECT_EQ(e.location(), "attribute 'estimated_states'") << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "no DataError";
+  return "";
+}
+
+TEST(MeasurementProvenance, RoundTripsThroughHdf5AndIsAbsentWhenAllMeasured) {
+  const fs::path dir = test::temporary_dir("criterion_choice_provenance");
+  MeasurementSet set = small_cartpole_set();
+  write_measurements(dir / "measured.h5", set);
+  EXPECT_FALSE(H5::H5File((dir / "measured.h5").string(), H5F_ACC_RDONLY).openGroup("/").attrExists("estimated_states"));
+  EXPECT_TRUE(read_measurements(dir / "measured.h5", set.system).estimated_states.empty());
+
+  set.estimated_states = {"x_dot", "theta_dot"};
+  write_measurements(dir / "estimated.h5", set);
+  const MeasurementSet back = read_measurements(dir / "estimated.h5", set.system);
+  EXPECT_EQ(back.estimated_states, set.estimated_states);
+  EXPECT_EQ(back.episodes.front().x, set.episodes.front().x);
+
+  // data info shows it, in the table and in JSON.
+  const MeasurementSummary summary = summarize(back);
+  EXPECT_NE(format_data_info("estimated.h5", summary).find("estimated x_dot, theta_dot"), std::string::npos)
+      << format_data_info("estimated.h5", summary);
+  EXPECT_EQ(data_info_json("estimated.h5", summary)["estimated_states"], nlohmann::json({"x_dot", "theta_dot"}));
+  EXPECT_EQ(data_info_json("measured.h5", summarize(set = small_cartpole_set()))["estimated_states"],
+            nlohmann::json::array());
+  EXPECT_NE(format_data_info("measured.h5", summarize(set)).find("estimated none (every state measured)"),
+            std::string::npos);
+}
+
+TEST(MeasurementProvenance, BadNamesAreErrorsNamingTheAttribute) {
+  const fs::path dir = test::temporary_dir("criterion_choice_provenance_errors");
+  const fs::path file = dir / "set.h5";
+  write_measurements(file, small_cartpole_set());
+
+  set_attribute(file, {"x_dot", "force"});  // a control, not a state
+  std::string message = read_error(file);
+  EXPECT_NE(message.find("set.h5"), std::string::npos) << message;
+  EXPECT_NE(message.find("'force', which is not a state of system 'cartpole'"), std::string::npos) << message;
+
+  set_attribute(file, {"x_dot", "x_dot"});
+  message = read_error(file);
+  EXPECT_NE(message.find("lists 'x_dot' twice"), std::string::npos) << message;
+
+  {  // not strings
+    H5::H5File h5(file.string(), H5F_ACC_RDWR);
+    H5::Group root = h5.openGroup("/");
+    root.removeAttr("estimated_states");
+    const double value = 1.0;
+    root.createAttribute("estimated_states", H5::PredType::NATIVE_DOUBLE, H5::DataSpace(H5S_SCALAR))
+        .write(H5::PredType::NATIVE_DOUBLE, &value);
+  }
+  message = read_error(file);
+  EXPECT_NE(message.find("is not a string attribute"), std::string::npos) << message;
+
+  // The writers refuse what the reader would.
+  MeasurementSet bad = small_cartpole_set();
+  bad.estimated_states = {"speed"};
+  EXPECT_THROW(write_measurements(dir / "bad.h5", bad), std::invalid_argument);
+  EXPECT_THROW(check_measurement_set(bad), std::invalid_argument);
+  bad.estimated_states = {"x_dot", "x_dot"};
+  EXPECT_THROW(write_measurements(dir / "bad.h5", bad), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace gpilqg

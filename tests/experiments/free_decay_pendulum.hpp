@@ -1,0 +1,74 @@
+#pragma once
+/// @file free_decay_pendulum.hpp
+/// A lightly damped MuJoCo pendulum in free decay, the passive test case of the simulation criterion
+/// (simulation_error_test.cpp) and of its automatic choice (criterion_choice_test.cpp).
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+
+#include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/measurements.hpp"
+#include "gpilqg/experiments/synthetic_data.hpp"
+
+namespace gpilqg::test {
+
+/// A point-like bob of 1 kg on a 0.25 m rod about a hinge: I = 0.0626 kg m^2, omega_0 = 6.26 rad/s
+/// (period 1.0 s); damping b gives zeta = b / (2 I omega_0), 0.005 for b = 0.0039 N m s/rad.
+inline void write_pendulum(const std::filesystem::path& file, double damping) {
+  std::ofstream(file) << R"(<mujoco model="pendulum">
+  <compiler angle="radian" inertiafromgeom="false"/>
+  <option timestep="0.01" gravity="0 0 -9.81" integrator="RK4"><flag contact="disable"/></option>
+  <worldbody>
+    <body name="bob">
+      <joint name="hinge" type="hinge" axis="0 1 0" damping=")" << damping << R"("/>
+      <inertial pos="0 0 -0.25" mass="1" diaginertia="0.0001 0.0001 0.0001"/>
+    </body>
+  </worldbody>
+</mujoco>
+)";
+}
+
+/// The pendulum's moment of inertia about the hinge [kg m^2] and its weight's lever: m g l [N m].
+inline constexpr double kPendulumInertia = 1.0 * 0.25 * 0.25 + 0.0001;
+inline constexpr double kPendulumGravityTorque = 1.0 * 9.81 * 0.25;
+
+inline constexpr double kPendulumDamping = 0.0039;
+inline constexpr double kPendulumAngleNoise = 1e-3;  // rad
+
+/// Free decay of the pendulum of `world_file`: `episodes` records of 4 s (about 4 periods) at 100 Hz
+/// from angles of 0.3 to 0.9 rad, no controls. The angle carries sensor noise of 1 mrad; the velocity
+/// is not measured but computed from the noisy angles by central differences (first and last sample
+/// dropped), as from an encoder.
+inline MeasurementSet free_decay(const std::filesystem::path& world_file, int episodes, std::uint64_t seed) {
+  ModelSpec world;
+  world.system = world_file.string();
+  ExcitationSettings s;
+  s.episodes = episodes;
+  s.steps = 402;
+  s.dt = 0.01;
+  s.nominal_state = Vector::Zero(2);
+  s.nominal_state(0) = 0.6;
+  s.initial_spread = Vector::Zero(2);
+  s.initial_spread << 0.3, 0.5;
+  s.observation_std = Vector::Zero(2);
+  s.observation_std(0) = kPendulumAngleNoise;
+  s.seed = seed;
+  MeasurementSet set = simulate_measurements(world.build(), s).set;
+  for (Episode& e : set.episodes) {
+    const int T = e.length();
+    Episode d;
+    d.id = e.id;
+    d.t = e.t.segment(1, T - 2);
+    d.u = e.u.middleRows(1, T - 2);
+    d.x.resize(T - 2, 2);
+    for (int k = 1; k + 1 < T; ++k) {
+      d.x(k - 1, 0) = e.x(k, 0);
+      d.x(k - 1, 1) = (e.x(k + 1, 0) - e.x(k - 1, 0)) / (2.0 * s.dt);
+    }
+    e = std::move(d);
+  }
+  return set;
+}
+
+}  // namespace gpilqg::test
