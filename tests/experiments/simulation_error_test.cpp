@@ -123,7 +123,7 @@ TEST(SimulationError, WindowsRestartFromMeasuredStatesAndWindowOneIsOneStep) {
 TEST(SimulationError, TheRequestChecksCriterionAndWindow) {
   DiagnoseRequest r;
   r.system = "cartpole";
-  EXPECT_EQ(diagnosis_options(r).criterion, FitCriterion::OneStep);
+  EXPECT_TRUE(diagnosis_options(r).choose_criterion);  // the default: --criterion auto
   EXPECT_EQ(diagnosis_options(r).window, 1);
   const auto message = [&r] {
     try {
@@ -133,6 +133,13 @@ TEST(SimulationError, TheRequestChecksCriterionAndWindow) {
     }
     return std::string("no error");
   };
+  r.window = 50;
+  EXPECT_NE(message().find("--window 50: windows belong to --criterion simulation; with --criterion auto the data choose"),
+            std::string::npos) << message();
+  r.window.reset();
+  r.criterion = "one-step";
+  EXPECT_FALSE(diagnosis_options(r).choose_criterion);
+  EXPECT_EQ(diagnosis_options(r).criterion, FitCriterion::OneStep);
   r.criterion = "simulation";
   EXPECT_NE(message().find("--criterion simulation: expected --window N"), std::string::npos) << message();
   r.window = 50;
@@ -149,7 +156,7 @@ TEST(SimulationError, TheRequestChecksCriterionAndWindow) {
   r.window.reset();
   EXPECT_EQ(diagnosis_options(r).criterion, FitCriterion::InverseDynamics);
   r.criterion = "output";
-  EXPECT_NE(message().find("--criterion 'output': expected 'one-step', 'simulation' or 'inverse-dynamics'"),
+  EXPECT_NE(message().find("--criterion 'output': expected 'auto', 'one-step', 'simulation' or 'inverse-dynamics'"),
             std::string::npos) << message();
   DiagnosisOptions o;
   o.model.system = "cartpole";
@@ -169,7 +176,7 @@ TEST(SimulationErrorCli, TheCommandLineTakesTheOptionsAndNamesThemInItsErrors) {
   EXPECT_NE(one_step.err.find("--window 10: windows belong to --criterion simulation"), std::string::npos) << one_step.err;
   const auto unknown = test::run_cli(call + " --criterion pem --window 10");
   EXPECT_EQ(unknown.status, 2);
-  EXPECT_NE(unknown.err.find("--criterion 'pem': expected 'one-step', 'simulation' or 'inverse-dynamics'"),
+  EXPECT_NE(unknown.err.find("--criterion 'pem': expected 'auto', 'one-step', 'simulation' or 'inverse-dynamics'"),
             std::string::npos) << unknown.err;
 }
 

@@ -82,9 +82,13 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("--backend: ") + e.what());
   }
-  const auto criterion = parse_fit_criterion(o.criterion);
+  const bool chosen_by_data = o.criterion == "auto";
+  const auto criterion = chosen_by_data ? std::optional<FitCriterion>(FitCriterion::OneStep) : parse_fit_criterion(o.criterion);
   if (!criterion)
-    throw InputError("--criterion '" + o.criterion + "': expected 'one-step', 'simulation' or 'inverse-dynamics'");
+    throw InputError("--criterion '" + o.criterion + "': expected 'auto', 'one-step', 'simulation' or 'inverse-dynamics'");
+  if (chosen_by_data && o.window)
+    throw InputError(fmt::format("--window {}: windows belong to --criterion simulation; with --criterion auto the data "
+                                 "choose the criterion and its window", *o.window));
   if (*criterion == FitCriterion::Simulation && !o.window)
     throw InputError("--criterion simulation: expected --window N, the samples per simulation window (e.g. a few "
                      "periods of the slowest motion)");
@@ -97,6 +101,7 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   if (o.window && (*o.window < 1 || *o.window > limits::kMaxHorizon))
     throw InputError(fmt::format("--window {}: expected a whole number of samples from 1 to {}", *o.window, limits::kMaxHorizon));
   d.criterion = *criterion;
+  d.choose_criterion = chosen_by_data;
   d.window = o.window ? static_cast<int>(*o.window) : 1;
   d.auto_select = o.auto_select;
   if (o.search == "subsets") d.search = SearchMethod::Subsets;

@@ -9,6 +9,7 @@
 
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/input_delay.hpp"
+#include "gpilqg/experiments/diagnosis/criterion_choice.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
@@ -534,21 +535,41 @@ void falls(const DiagnosisOptions& o, const MeasurementSet& set, const ModelAsGi
 
 }  // namespace
 
-DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& o) {
-  o.validate();
+DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& options) {
+  options.validate();
   if (input.episodes.empty()) throw std::invalid_argument("the data has no episodes");
   check_measurement_range(input);
+  // A model file's data carry the model's name (<mujoco model="...">), not the file's path.
+  if (const std::string model_name = system_signature(options.model.system).name; input.system.name != model_name)
+    throw std::invalid_argument("the data are of system '" + input.system.name + "'; the model is '" + model_name + "'");
+  // --criterion auto: the data choose the criterion and its window, before the record is cut into
+  // blocks (whose gaps depend on the window). Data too short for the rule's estimates keep the
+  // one-step criterion, and the reason says so.
+  DiagnosisOptions o = options;
+  std::string criterion_reason;
+  if (o.choose_criterion) {
+    o.choose_criterion = false;
+    try {
+      const CriterionChoice choice = choose_criterion(input, o.model);
+      o.criterion = choice.criterion;
+      o.window = choice.window;
+      criterion_reason = choice.reason;
+    } catch (const std::invalid_argument& e) {
+      o.criterion = FitCriterion::OneStep;
+      o.window = 1;
+      criterion_reason = std::string("one-step: the data are too short to choose by the rule (") + e.what() + ")";
+    }
+  }
   DiagnosisReport R;
   R.system = o.model.system;
-  // A model file's data carry the model's name (<mujoco model="...">), not the file's path.
-  if (const std::string model_name = system_signature(R.system).name; input.system.name != model_name)
-    throw std::invalid_argument("the data are of system '" + input.system.name + "'; the model is '" + model_name + "'");
+  R.criterion_reason = criterion_reason;
   MeasurementSet blocks_as_episodes;
   const MeasurementSet& set = episodes_of(input, o, blocks_as_episodes, R);
 
   // One-step predictions of a model (its input delay applied to the measured inputs).
   const FitContext settings{&R.data, o.model, o.integrator, R.dt, o.substeps, Vector(), Matrix()};
   const ModelAsGiven given = model_as_given(o, settings);
+  if (o.progress && !criterion_reason.empty()) o.progress("criterion: " + criterion_reason);
   R.model_before = given.model;
   // The library and the model's declared effects; the fits below point into it.
   const std::vector<LibraryEffect> candidates = candidate_effects(given.model);

@@ -211,6 +211,7 @@ void which_section(const DiagnosisReport& r, std::string& out) {
                      fmt::join(r.heldout_episode_ids, ", "));
   if (!r.excluded.empty())
     out += fmt::format("   excluded by --exclude (never ranked, searched or proposed): {}\n", fmt::join(r.excluded, ", "));
+  if (!r.criterion_reason.empty()) out += "   criterion chosen by the data (--criterion auto): " + r.criterion_reason + "\n";
   if (r.criterion == FitCriterion::InverseDynamics)
     out += "   criterion: inverse dynamics, the generalised-force residual M(q) qdd - h(q, qdot, u) with qdd a zero-phase "
            "derivative of the measured velocities\n";

@@ -27,8 +27,8 @@ struct DiagnoseRequest {
   std::string backend = "exact";
   std::uint64_t seed = 1;
   /// --criterion: the error effects are fitted to and scored on, "one-step", "simulation" or
-  /// "inverse-dynamics" (fit_criterion.hpp).
-  std::string criterion = "one-step";
+  /// "inverse-dynamics" (fit_criterion.hpp), or "auto": chosen from the data (criterion_choice.hpp).
+  std::string criterion = "auto";
   /// --window: samples per simulation window; required with "simulation", not accepted with "one-step".
   std::optional<long> window;
   /// --exclude: candidate effects never ranked, searched or proposed, each a name or a shell pattern

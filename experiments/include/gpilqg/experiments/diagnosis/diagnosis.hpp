@@ -91,6 +91,9 @@ struct DiagnosisOptions {
   /// over windows of `window` samples from measured states (--criterion, --window).
   FitCriterion criterion = FitCriterion::OneStep;
   int window = 1;                         ///< samples per window; 1 unless the criterion is simulation
+  /// `--criterion auto`: criterion and window are chosen from the data by choose_criterion
+  /// (criterion_choice.hpp) before anything else; `criterion` and `window` are then ignored.
+  bool choose_criterion = false;
   bool rank = true;                       ///< false: skip the ranking (faster; verdict from the GP only)
   /// Candidates never ranked, searched or proposed (`--exclude`, resolved to names: excluded_effects).
   std::vector<std::string> exclude;
@@ -204,6 +207,9 @@ struct DiagnosisReport {
   /// over windows of `window` samples (simulation_error.hpp).
   FitCriterion criterion = FitCriterion::OneStep;
   int window = 1;
+  /// `--criterion auto`: the sentence saying which criterion the data chose and why (empty when the
+  /// user chose it).
+  std::string criterion_reason;
   /// The channels of the criterion, in which the fits' held-out RMSE are given: the states (one-step,
   /// simulation) or the generalised-force components (inverse dynamics, e.g. Q_shoulder [N m]), with
   /// the weights 1 / sigma_i^2 the fits use in them.
