@@ -375,6 +375,20 @@ void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidat
                                          o.criterion, o.window, &R.window_restarts);
   context.excluded = o.exclude;
   R.excluded = o.exclude;
+  // On the force residual M qdd - h(q, qdot, k u) the inertias and the actuators' gains can all shrink
+  // together to zero, where the residual vanishes whatever the data: the equation is homogeneous in
+  // them (the scale ambiguity of inverse-dynamics identification, which a measured torque fixes by
+  // its own calibration). So the gains are not candidates there.
+  if (o.criterion == FitCriterion::InverseDynamics)
+    for (const LibraryEffect& effect : candidates) {
+      const bool gain = effect.kind == EffectKind::ActuatorGain ||
+                        (effect.kind == EffectKind::Recalibration &&
+                         (effect.recalibrated.ends_with(".gain") || effect.recalibrated.ends_with(".gear")));
+      if (gain && std::find(context.excluded.begin(), context.excluded.end(), effect.name) == context.excluded.end()) {
+        context.excluded.push_back(effect.name);
+        R.criterion_excluded.push_back(effect.name);
+      }
+    }
   R.criterion_weights = context.weights;
   R.accelerations = context.accelerations;
   if (o.criterion == FitCriterion::InverseDynamics) {

@@ -282,6 +282,7 @@ nlohmann::json report_json(const DiagnosisReport& r) {
             {"window", r.window},
             {"restarts", r.window_restarts},
             {"chosen_by", r.criterion_reason.empty() ? "user" : "data"},
+            {"excluded", r.criterion_excluded},
             {"reason", r.criterion_reason.empty() ? json(nullptr) : json(r.criterion_reason)}}},
           {"ranking", ranking},
           {"verdict", verdict},

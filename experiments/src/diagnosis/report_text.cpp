@@ -215,6 +215,9 @@ void which_section(const DiagnosisReport& r, std::string& out) {
   if (r.criterion == FitCriterion::InverseDynamics)
     out += "   criterion: inverse dynamics, the generalised-force residual M(q) qdd - h(q, qdot, u) with qdd a zero-phase "
            "derivative of the measured velocities\n";
+  if (!r.criterion_excluded.empty())
+    out += fmt::format("   not candidates on this criterion (the force residual and the inertias scale with them): {}\n",
+                       fmt::join(r.criterion_excluded, ", "));
   if (r.criterion == FitCriterion::Simulation)
     out += fmt::format("   criterion: simulation error over windows of {} samples ({:g} s) from measured states{}\n",
                        r.window, r.window * r.dt,

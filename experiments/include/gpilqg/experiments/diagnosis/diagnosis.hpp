@@ -223,6 +223,9 @@ struct DiagnosisReport {
   int window_restarts = 0;
   std::vector<RankedEffect> ranking;
   std::vector<std::string> excluded;     ///< candidates left out by the user (DiagnosisOptions::exclude)
+  /// Candidates the criterion cannot identify and leaves out: under inverse dynamics the actuators'
+  /// gains and gears (the force residual is homogeneous in them and the inertias).
+  std::vector<std::string> criterion_excluded;
   Verdict verdict;
   /// The "add" step (present when effects were added, or when a proposal exists): the four models.
   std::vector<ModelScore> comparison;
