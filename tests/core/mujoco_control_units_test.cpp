@@ -34,7 +34,9 @@ std::string chain_model(const std::string& actuators) {
 std::vector<std::string> control_units(const std::string& actuators) {
   const auto file = test::write_text(test::temporary_dir("control_units") / "model.xml", chain_model(actuators));
   std::vector<std::string> units;
-  for (const Quantity& q : MujocoSystem::load(file.string())->controls()) units.push_back(q.unit);
+  // The system held for the loop: the controls are a member of it.
+  const auto system = MujocoSystem::load(file.string());
+  for (const Quantity& q : system->controls()) units.push_back(q.unit);
   return units;
 }
 
