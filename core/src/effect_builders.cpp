@@ -31,6 +31,15 @@ LinearForceEffect::Basis coulomb(int component, int velocity, double width) {
   };
 }
 
+LinearForceEffect::Basis cubic_spring(int component, int position, double reference) {
+  // g = -e^3, dg/dq = -3 e^2, e = q - reference.
+  return [=](const VectorCRef& x, double theta, VectorRef Q, Matrix* dQ_dx) {
+    const double e = x(position) - reference;
+    Q(component) -= theta * e * e * e;
+    if (dQ_dx != nullptr) (*dQ_dx)(component, position) -= 3.0 * theta * e * e;
+  };
+}
+
 LinearForceEffect::Basis constant(int component) {
   return [=](const VectorCRef&, double theta, VectorRef Q, Matrix*) { Q(component) += theta; };
 }

@@ -87,6 +87,14 @@ double typical_scale(const std::string& field, double value) {
   return std::max(std::abs(value), floor);
 }
 
+/// Whether a cubic spring is a candidate on `joint`: one to which the model gives a spring
+/// (stiffness > 0), whose force may stiffen or soften with the displacement (a Duffing oscillator).
+/// A joint without a spring has no rest position to be displaced from: a slide's origin is a
+/// convention, and a hinge may turn freely (a potential of a free angle is periodic; a cubic is not).
+bool has_spring(const mjModel* m, const std::string& joint) {
+  return m->jnt_stiffness[mj_name2id(m, mjOBJ_JOINT, joint.c_str())] > 0.0;
+}
+
 }  // namespace
 
 std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
@@ -102,6 +110,18 @@ std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
                                      fmt::format("Q_{0} = -b {0}_dot", joint), nv, viscous(dof, nv + dof)));
     out.push_back(coulomb_friction_entry("joint_coulomb_friction:" + joint, {"tau", slide ? "N" : "N m", 0.1, 0.0}, joint,
                                          joint + "_dot", nv, dof, nv + dof));
+    if (has_spring(m, joint)) {
+      const int id = mj_name2id(m, mjOBJ_JOINT, joint.c_str());
+      const int position = m->jnt_qposadr[id];
+      const double reference = m->qpos_spring[position];
+      const double stiffness = m->jnt_stiffness[id];
+      out.push_back(linear_force_entry(
+          "joint_cubic_spring:" + joint,
+          {"k3", slide ? "N/m^3" : "N m/rad^3", stiffness},
+          reference == 0.0 ? fmt::format("Q_{0} = -k3 {0}^3", joint)
+                           : fmt::format("Q_{0} = -k3 ({0} - {1:.6g})^3", joint, reference),
+          nv, cubic_spring(dof, position, reference)));
+    }
   }
   for (const std::string& actuator : system.actuator_names()) {
     LibraryEffect gain = recalibration_entry("actuator_gain:" + actuator, {actuator + ".gain", "-", 1.0}, true, true);

@@ -207,6 +207,13 @@ TEST(MujocoSystem, SeveralThreadsStepOneModel) {
   for (int i = 0; i < 16; ++i) EXPECT_MATRIX_NEAR(parallel[i], serial[i], 0.0);
 }
 
+/// Writes `text` to a file in a fresh folder and returns its path.
+std::string write_model(const std::string& label, const std::string& text) {
+  const auto path = test::temporary_dir(label) / "model.xml";
+  std::ofstream(path) << text;
+  return path.string();
+}
+
 TEST(MujocoSystem, TheLibraryHasTheGenericEffectsWithAliases) {
   const auto& library = effect_library(arm_path());
   std::vector<std::string> names;
@@ -223,11 +230,40 @@ TEST(MujocoSystem, TheLibraryHasTheGenericEffectsWithAliases) {
   EXPECT_TRUE(damping_alias);
 }
 
-/// Writes `text` to a file in a fresh folder and returns its path.
-std::string write_model(const std::string& label, const std::string& text) {
-  const auto path = test::temporary_dir(label) / "model.xml";
-  std::ofstream(path) << text;
-  return path.string();
+TEST(MujocoSystem, SprungJointsHaveACubicSpringCandidateAboutTheirRestPosition) {
+  // A slide with a spring (stiffness 2, rest at 0.1) on a hinge without one: only the slide may
+  // stiffen. Q_y = -k3 (y - 0.1)^3, checked against that closed form and its derivative against
+  // central differences.
+  const std::string path = write_model("cubic_spring", R"(<mujoco>
+  <option gravity="0 0 0"/>
+  <worldbody><body name="b"><joint name="y" type="slide" axis="1 0 0" stiffness="2" springref="0.1"/>
+    <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
+    <body name="c"><joint name="h" type="hinge" axis="0 1 0"/>
+      <inertial pos="0 0 0.1" mass="1" diaginertia="1 1 1"/></body></body></worldbody>
+</mujoco>)");
+  const auto& library = effect_library(path);
+  const auto named = [&](const std::string& name) {
+    return std::find_if(library.begin(), library.end(), [&](const LibraryEffect& e) { return e.name == name; });
+  };
+  EXPECT_EQ(named("joint_cubic_spring:h"), library.end()) << "a hinge without a spring has no rest position";
+  const auto cubic = named("joint_cubic_spring:y");
+  ASSERT_NE(cubic, library.end());
+  ASSERT_TRUE(cubic->force);
+  EXPECT_EQ(cubic->parameters.at(0).unit, "N/m^3");
+  const Vector theta = Vector::Constant(1, 3.0);
+  const Vector u = Vector::Zero(0);
+  const auto force = [&](const Vector& x) {
+    Vector Q = Vector::Zero(2);
+    cubic->force->add_force(x, u, theta, Q, nullptr, nullptr);
+    return Q;
+  };
+  const Vector x = (Vector(4) << 0.4, 0.2, -0.3, 0.5).finished();
+  EXPECT_NEAR(force(x)(0), -3.0 * std::pow(0.4 - 0.1, 3), 1e-14);
+  EXPECT_EQ(force(x)(1), 0.0);
+  Matrix dQ = Matrix::Zero(2, 4);
+  Vector Q = Vector::Zero(2);
+  cubic->force->add_force(x, u, theta, Q, &dQ, nullptr);
+  EXPECT_TRUE(test::matrices_near(dQ, test::numeric_jacobian(force, x, 1e-6), 1e-7, 1e-7));
 }
 
 std::string load_error(const std::string& path) {

@@ -21,8 +21,10 @@
 namespace gpilqg {
 namespace {
 
+using diagnosis::compare_heldout;
 using diagnosis::EffectFit;
 using diagnosis::EffectTestThresholds;
+using diagnosis::HeldoutComparison;
 using diagnosis::EffectValues;
 using diagnosis::test_effect;
 
@@ -236,6 +238,28 @@ TEST(EffectTest, OneOfTwoHiddenEffectsIsPartlyExplained) {
   const diagnosis::DiagnosisReport r = diagnosis::diagnose(data, test::fast_options("cartpole"));
   EXPECT_EQ(r.verdict.status, "partly_explained") << r.verdict.reason;
   EXPECT_GT(r.verdict.remainder, 1.0 / 3.0) << r.verdict.reason;
+}
+
+TEST(EffectTest, TwoFitsAreComparedBatchByBatchOnTheSameHeldOutRows) {
+  // Closed form: batches b = 1 each; the first fit removes 0.5 of every batch, the second 0.3 or 0.5
+  // in turn. Difference 0.1 (= 0.4 / 4), residuals of the batch differences +-0.1, so the variance
+  // of the ratio is K / (K - 1) * 0.04 / B^2 = 4/3 * 0.04 / 16 and the half-width 1.96 times its root.
+  EffectFit a, b;
+  a.heldout_batch_before = b.heldout_batch_before = Vector::Ones(4);
+  a.heldout_batch_reduction = Vector::Constant(4, 0.5);
+  b.heldout_batch_reduction = (Vector(4) << 0.3, 0.5, 0.3, 0.5).finished();
+  const HeldoutComparison c = compare_heldout(a, b);
+  ASSERT_TRUE(c.comparable);
+  EXPECT_NEAR(c.difference, 0.1, 1e-15);
+  EXPECT_NEAR(c.difference_ci, 1.96 * std::sqrt(4.0 / 3.0 * 0.04) / 4.0, 1e-15);
+  // The same reductions in every batch: the difference is certain, however much each share varies.
+  b.heldout_batch_reduction = a.heldout_batch_reduction.array() - 0.1;
+  a.heldout_batch_reduction = (Vector(4) << 0.9, 0.1, 0.8, 0.2).finished();
+  b.heldout_batch_reduction = a.heldout_batch_reduction.array() - 0.05;
+  EXPECT_NEAR(compare_heldout(a, b).difference_ci, 0.0, 1e-15);
+  // Fits of other rows (other batches) are not compared.
+  b.heldout_batch_before(0) = 2.0;
+  EXPECT_FALSE(compare_heldout(a, b).comparable);
 }
 
 }  // namespace

@@ -134,6 +134,8 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   }
   v.effect = f;
   for (const auto& a : best.aliases) v.aliases.push_back(a.effect);
+  for (const RankedEffect& other : r.ranking)
+    if (other.rival) v.rivals.push_back(other.fit.effect);
   // "explained" until the remainder test (judge_remainder) has seen what the effect leaves.
   v.status = "explained";
   return v;
@@ -185,6 +187,8 @@ void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0
   // single effect's aliases are not the set's.
   v.effect = last;
   v.aliases.clear();
+  // A set of one is the ranking's first: its rivals stand (judge); a larger set has none computed.
+  if (!(v.effects.size() == 1 && last.refitted.empty() && v.effects.front() == last.effect)) v.rivals.clear();
   v.reason = fmt::format("the {} effect(s) chosen by --auto ({}) remove {:.1f}% of the held-out residual; the GP removes {:.1f}%",
                          v.effects.size(), fmt::join(v.effects, ", "), 100.0 * (1.0 - left), 100.0 * (1.0 - v.gp_left));
   if (o.criterion != FitCriterion::OneStep)

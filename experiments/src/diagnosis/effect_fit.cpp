@@ -216,6 +216,8 @@ void score_heldout(const EffectSet& set, const Vector& theta, const FitContext& 
     spread += e * e;
   }
   const double se = std::sqrt(K / (K - 1.0) * spread) / b_total;
+  fit.heldout_batch_before = Eigen::Map<const Vector>(b_batches.data(), static_cast<Eigen::Index>(b_batches.size()));
+  fit.heldout_batch_reduction = Eigen::Map<const Vector>(d_batches.data(), static_cast<Eigen::Index>(d_batches.size()));
   fit.explained_ci = 1.96 * se;
   fit.z_score = se > 0.0 ? fit.explained / se : (fit.explained > 0.0 ? 1e6 : 0.0);
 }
@@ -612,6 +614,15 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_g
       entry.aliases.push_back(fits[j]);
     }
     out.push_back(std::move(entry));
+  }
+  // Rivals: ranked entries that the held-out rows do not tell from the first, batch by batch.
+  for (std::size_t k = 1; k < out.size() && standing(out.front().fit) == 0; ++k) {
+    if (standing(out[k].fit) != 0) break;
+    const HeldoutComparison c = compare_heldout(out[k].fit, out.front().fit);
+    if (!c.comparable) continue;
+    out[k].behind_first = c.difference;
+    out[k].behind_first_ci = c.difference_ci;
+    out[k].rival = c.difference + c.difference_ci >= 0.0;
   }
   return out;
 }

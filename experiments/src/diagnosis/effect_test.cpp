@@ -63,4 +63,21 @@ std::string share_text(double explained, double explained_ci, double z, const st
   return fmt::format("removes {:.1f}% +- {:.1f}% of {} (z = {:.1f})", 100.0 * explained, 100.0 * explained_ci, what, z);
 }
 
+HeldoutComparison compare_heldout(const EffectFit& a, const EffectFit& b) {
+  HeldoutComparison c;
+  const Eigen::Index K = a.heldout_batch_before.size();
+  if (K < 2 || b.heldout_batch_before.size() != K || a.heldout_batch_reduction.size() != K ||
+      b.heldout_batch_reduction.size() != K || a.heldout_batch_before != b.heldout_batch_before)
+    return c;
+  const double before = a.heldout_batch_before.sum();
+  if (!(before > 0.0)) return c;
+  const Vector d = a.heldout_batch_reduction - b.heldout_batch_reduction;
+  c.comparable = true;
+  c.difference = d.sum() / before;
+  const double spread = (d - c.difference * a.heldout_batch_before).squaredNorm();
+  const auto k = static_cast<double>(K);
+  c.difference_ci = 1.96 * std::sqrt(k / (k - 1.0) * spread) / before;
+  return c;
+}
+
 }  // namespace gpilqg::diagnosis

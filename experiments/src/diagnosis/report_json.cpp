@@ -188,10 +188,13 @@ nlohmann::json report_json(const DiagnosisReport& r) {
     }
     entry["aliases"] = aliases;
     entry["alias_fits"] = alias_fits;
+    entry["behind_first"] = g.behind_first;
+    entry["behind_first_ci"] = g.behind_first_ci;
+    entry["rival"] = g.rival;
     ranking.push_back(entry);
   }
   json verdict = {{"status", r.verdict.status}, {"reason", r.verdict.reason},   {"aliases", r.verdict.aliases},
-                  {"effects", r.verdict.effects}, {"left", r.verdict.left},       {"gp_left", r.verdict.gp_left},
+                  {"rivals", r.verdict.rivals},  {"effects", r.verdict.effects}, {"left", r.verdict.left},       {"gp_left", r.verdict.gp_left},
                   {"remainder", r.verdict.remainder}};
   if (r.verdict.effect) {
     // The judged effect or set: the lead's values, every member's in "members" (one joint fit).

@@ -245,7 +245,10 @@ void which_section(const DiagnosisReport& r, std::string& out) {
     out += fmt::format("   {:<3} {:<{}} {:<{}} {:>8} +-{:>6} {:>11.3e} -> {:.3e}{}\n", rank++, f.effect, name_width,
                        parameter_text(f, true), parameter_width, percent(f.explained), percent(f.explained_ci),
                        f.heldout_rmse_before(worst), f.heldout_rmse_after(worst),
-                       interval_contains_null(own_values(f)) ? "  (interval holds its value without it)" : "");
+                       interval_contains_null(own_values(f)) ? "  (interval holds its value without it)"
+                       : g.rival ? fmt::format("  (as good as #1 on the held-out rows: {} +- {})", percent(g.behind_first),
+                                               percent(g.behind_first_ci))
+                                 : "");
     for (const EffectFit& a : g.aliases)
       out += fmt::format("       alias {:<{}} {:<{}} {:>8}   (cannot be told apart on these data)\n", a.effect,
                          name_width - 6, parameter_text(a, true), parameter_width, percent(a.explained));
@@ -336,6 +339,8 @@ std::string report_text(const DiagnosisReport& r) {
     out += fmt::format(": {} ({})", r.verdict.effect->effect, parameter_text(*r.verdict.effect, true));
     if (!r.verdict.aliases.empty()) out += fmt::format(", or its aliases {}", fmt::join(r.verdict.aliases, ", "));
   }
+  if (!r.verdict.rivals.empty())
+    out += fmt::format("; or as well {} (the held-out rows do not tell them apart)", fmt::join(r.verdict.rivals, ", "));
   out += "\n  " + r.verdict.reason + "\n";
   return out;
 }

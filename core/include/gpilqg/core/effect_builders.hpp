@@ -23,6 +23,9 @@ inline constexpr double kDefaultCoulombWidth = 0.05;
 LinearForceEffect::Basis viscous(int component, int velocity);
 /// g = -tanh(x(velocity) / width) on `component`: Coulomb friction, smoothed over `width` (> 0).
 LinearForceEffect::Basis coulomb(int component, int velocity, double width = kDefaultCoulombWidth);
+/// g = -(x(position) - reference)^3 on `component`: a cubic (stiffening, or softening when theta < 0)
+/// spring about the rest position `reference`, the Duffing term of m q'' + d q' + a q + b q^3 = u.
+LinearForceEffect::Basis cubic_spring(int component, int position, double reference);
 /// g = e_component: a constant generalised force.
 LinearForceEffect::Basis constant(int component);
 /// g_i = -|v_i| v_i for `components` velocities starting at x(first_velocity): quadratic drag.

@@ -153,6 +153,11 @@ struct Verdict {
   /// set's last joint fit: its lead here, the other members in effect->refitted.
   std::optional<EffectFit> effect;
   std::vector<std::string> aliases;
+  /// Rival explanations of a single proposed effect: ranked effects that are not its aliases but
+  /// that the held-out rows do not tell from it (RankedEffect::rival). The data support the
+  /// proposed effect no better than any of these; more data, or data that excite them differently,
+  /// decide.
+  std::vector<std::string> rivals;
   /// --auto: every effect of the chosen model beyond M_0's (empty without --auto).
   std::vector<std::string> effects;
   /// Shares of the diagnosed model's weighted held-out squared residual left by the proposed

@@ -135,6 +135,11 @@ struct EffectFit {
   double explained = 0.0;      ///< 1 - S_after / S_before on the held-out rows
   double explained_ci = 0.0;   ///< half-width of its 95% interval
   double z_score = 0.0;        ///< mean reduction / its batch-means standard error
+  /// The held-out batches of the significance test (step 4), in order: each batch's weighted
+  /// squared residual of the model (before) and its reduction by the fit (before - after). Every fit
+  /// of one context has the same batches, so two fits can be compared batch by batch
+  /// (effect_test.hpp, compare_heldout).
+  Vector heldout_batch_before, heldout_batch_reduction;
   Vector regressor;            ///< weighted J at theta_0 over the training rows (first parameter), for aliasing
   /// False when the data do not determine the fit: the effect does not change the predictions, its
   /// covariance is not finite, or a parameter of the set ran away (effect_test.hpp, test 1).
@@ -189,6 +194,12 @@ EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, co
 struct RankedEffect {
   EffectFit fit;
   std::vector<EffectFit> aliases;
+  /// This entry against the ranking's first (compare_heldout, effect_test.hpp): its held-out share
+  /// minus the first's, with the 95% half-width of that paired difference; both 0 for the first.
+  double behind_first = 0.0, behind_first_ci = 0.0;
+  /// True when the held-out rows do not prefer the first entry to this one (the paired difference is
+  /// within its 95% interval) although the two are not aliases: a rival explanation.
+  bool rival = false;
 };
 
 /// Fits every candidate effect and ranks the alias groups in the order of their standing

@@ -57,6 +57,22 @@ bool interval_contains_null(const EffectValues& v);
 EffectTestResult test_effect(const EffectFit& fit, const EffectTestThresholds& thresholds,
                              const std::vector<std::string>& already_in_model = {});
 
+/// Two fits of one context compared on the same held-out batches: the difference of their explained
+/// shares, D_a / B - D_b / B = (D_a - D_b) / B, with the ratio estimator's batch-means variance
+/// applied to the batch differences,
+///
+///   Var ~ K / (K - 1) sum_k (d_a,k - d_b,k - difference b_k)^2 / B^2,
+///
+/// which is far smaller than either share's own variance when the two fits track the same structure
+/// (their batch reductions move together). `comparable` is false when the fits have different
+/// batches (not of one context) or fewer than two.
+struct HeldoutComparison {
+  bool comparable = false;
+  double difference = 0.0;     ///< a.explained - b.explained
+  double difference_ci = 0.0;  ///< 95% half-width
+};
+HeldoutComparison compare_heldout(const EffectFit& a, const EffectFit& b);
+
 /// "removes 12.3% +- 4.1% of <what> (z = 5.2)", or, when the share is not positive, "removes nothing
 /// of <what> (it adds 0.04%, z = -1.2)": never a "-0.0%".
 std::string share_text(double explained, double explained_ci, double z, const std::string& what);
