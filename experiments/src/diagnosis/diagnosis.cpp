@@ -155,8 +155,12 @@ void judge_remainder(Verdict& v, double remainder, const DiagnosisOptions& o) {
   if (!v.effect || v.status != "explained") return;
   v.remainder = remainder;
   const double allowed = 1.0 - 1.0 / o.explained_left_ratio;
-  v.reason += fmt::format("; the GP of what {} leave{} removes {:.1f}% of it", v.effects.size() > 1 ? "the effects" : "the effect",
-                          v.effects.size() > 1 ? "" : "s", 100.0 * remainder);
+  // A flexible model that predicts worse than the effects (its GP-corrected simulation drifts off)
+  // finds no structure in what they leave: nothing to remove, whatever it adds.
+  v.reason += fmt::format("; the GP of what {} leave{} {}", v.effects.size() > 1 ? "the effects" : "the effect",
+                          v.effects.size() > 1 ? "" : "s",
+                          remainder >= 0.0 ? fmt::format("removes {:.1f}% of it", 100.0 * remainder)
+                                           : std::string("removes nothing of it (its predictions are worse)"));
   if (remainder <= allowed) return;
   v.status = "partly_explained";
   v.reason += fmt::format(" (at most {:.1f}% for \"explained\": what is left is at most {:g} times what a flexible model "
