@@ -127,7 +127,9 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
     v.reason += "; not a finding: " + finding.reason;
     return v;
   }
-  if (one_step && f.explained < o.relative_to_gp * r.gp_explained_total) {
+  // With --auto the rule is the chosen set's (judge_selection): several effects may together remove
+  // what the GP removes when none does alone.
+  if (one_step && !o.auto_select && f.explained < o.relative_to_gp * r.gp_explained_total) {
     v.status = "unexplained";
     v.reason += ", so the residual's structure is mostly something else";
     return v;
@@ -172,7 +174,18 @@ void judge_remainder(Verdict& v, double remainder, const DiagnosisOptions& o) {
 /// The verdict once --auto has chosen its set: what the whole set leaves (each step's share is of
 /// what the step before left, so the shares multiply).
 void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0, const DiagnosisOptions& o) {
-  if (selection.steps.empty() || !v.effect) return;
+  if (!v.effect) return;
+  if (selection.steps.empty()) {
+    // Nothing chosen: the single best effect meets the rule decide() left to the set.
+    if (o.criterion == FitCriterion::OneStep && v.effect->explained < o.relative_to_gp * (1.0 - v.gp_left)) {
+      v.status = "unexplained";
+      v.reason += ", so the residual's structure is mostly something else";
+      v.effect.reset();
+      v.aliases.clear();
+      v.rivals.clear();
+    }
+    return;
+  }
   double left = 1.0;
   for (const SelectionStep& step : selection.steps) left *= 1.0 - step.fit.explained;
   v.left = left;
@@ -197,6 +210,11 @@ void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0
                          v.effects.size(), fmt::join(v.effects, ", "), 100.0 * (1.0 - left), 100.0 * (1.0 - v.gp_left));
   if (o.criterion != FitCriterion::OneStep)
     v.reason += fmt::format(" of the one-step residual (the effects are scored on the {} error)", fit_criterion_name(o.criterion));
+  if (o.criterion == FitCriterion::OneStep && 1.0 - left < o.relative_to_gp * (1.0 - v.gp_left)) {
+    v.status = "partly_explained";
+    v.reason += fmt::format(", less than {:g} of what the GP removes, so the residual's structure is mostly something else",
+                            o.relative_to_gp);
+  }
 }
 
 /// The one-step residual of `model` on settings.data, integrated as `settings` says and driven by

@@ -585,13 +585,9 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_g
     }
   });
   // The order of standing (effect_test.hpp): identifiable fits whose interval excludes their value
-  // without them, then those whose interval holds it, each by held-out share; the fits that are not
-  // identifiable last, unranked.
+  // without them, then those whose interval holds it, each by screening score (below); the fits that
+  // are not identifiable last, unranked.
   const auto standing = [](const EffectFit& f) { return !f.identifiable ? 2 : interval_contains_null(own_values(f)) ? 1 : 0; };
-  std::stable_sort(fits.begin(), fits.end(), [&](const EffectFit& a, const EffectFit& b) {
-    const int sa = standing(a), sb = standing(b);
-    return sa != sb ? sa < sb : a.explained > b.explained;
-  });
   // Aliases: the joint fit of the pair does no better than either alone, or the same physics by
   // declaration. An effect that explains nothing alone is nobody's alias.
   const LinearisedFits joint(context, fits, refit, threads);
@@ -601,13 +597,26 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_g
     if (joint.gain({j}, {}) < alias_gain) return false;
     return joint.gain({i, j}, {i}) < alias_gain && joint.gain({i, j}, {j}) < alias_gain;
   };
+  // Within a standing, the order is the cross-validated screening score on the training rows
+  // (linearised_fits.hpp): the held-out rows score the first entry and its rivals, so they must not
+  // also choose it among all candidates (the best of many held-out scores is biased upwards).
+  std::vector<double> screening(fits.size());
+  for (std::size_t i = 0; i < fits.size(); ++i) screening[i] = joint.screening_left({static_cast<int>(i)});
+  std::vector<std::size_t> order(fits.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const int sa = standing(fits[a]), sb = standing(fits[b]);
+    return sa != sb ? sa < sb : (sa < 2 && screening[a] < screening[b]);
+  });
   std::vector<bool> used(fits.size(), false);
   std::vector<RankedEffect> out;
-  for (std::size_t i = 0; i < fits.size(); ++i) {
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const std::size_t i = order[k];
     if (used[i]) continue;
     used[i] = true;
     RankedEffect entry{fits[i], {}};
-    for (std::size_t j = i + 1; j < fits.size() && fits[i].identifiable; ++j) {
+    for (std::size_t l = k + 1; l < order.size() && fits[i].identifiable; ++l) {
+      const std::size_t j = order[l];
       if (used[j] || !fits[j].identifiable) continue;
       if (!aliases(static_cast<int>(i), static_cast<int>(j))) continue;
       used[j] = true;

@@ -29,7 +29,9 @@
 ///  - otherwise, when the best alias group is a finding (effect_test.hpp: identifiable, its 95%
 ///    interval excludes its value without it, it removes at least min_explained of the held-out
 ///    residual with z >= min_z) and, under the one-step criterion, removes at least relative_to_gp
-///    (half) of what the GP removes on the same rows: "explained" or "partly_explained" by the
+///    (half) of what the GP removes on the same rows (with --auto the chosen set must, else it is
+///    "partly_explained"; several effects may remove together what none does alone): "explained" or
+///    "partly_explained" by the
 ///    remainder test, the same for every criterion: the model with the effect(s) plus a GP of its
 ///    residual (a flexible model) is scored under the criterion on the held-out rows; "explained"
 ///    when the effects leave at most explained_left_ratio (1.5) times what it leaves. A wrong effect

@@ -203,8 +203,10 @@ struct RankedEffect {
 };
 
 /// Fits every candidate effect and ranks the alias groups in the order of their standing
-/// (effect_test.hpp): the identifiable fits whose 95% interval excludes their value without them by
-/// held-out explained fraction, then the identifiable ones whose interval holds it, then, unranked and
+/// (effect_test.hpp): the identifiable fits whose 95% interval excludes their value without them, then
+/// the identifiable ones whose interval holds it, each in the order of their cross-validated screening
+/// score on the training rows (LinearisedFits::screening_left; the held-out rows score the entries,
+/// they do not choose among them), then, unranked and
 /// in no alias group, the fits that are not identifiable (EffectFit::identifiable). Two effects
 /// are aliases when their joint fit cannot separate them: the pair, fitted together on the training
 /// rows, removes less than `alias_gain` of the held-out residual that either leaves alone (each alone
