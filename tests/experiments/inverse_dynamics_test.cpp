@@ -485,17 +485,22 @@ TEST(InverseDynamicsResidual, NoiseFreeWorldWithHiddenFrictionGivesTheFrictionAs
   EXPECT_NEAR(tau, kElbowFriction, 0.01 * kElbowFriction);
 }
 
-TEST(InverseDynamicsResidual, NoisyVelocitiesGiveTheFrictionByLeastSquaresOnTheResidual) {
-  // The same record with white noise of 0.02 rad/s on the measured velocities (and 1e-4 rad on the
-  // angles): the window rule smooths, and least squares on the residual finds the hidden friction.
-  const HiddenFrictionWorld& w = hidden_friction_world();
-  std::mt19937 rng(5);
+/// The world's states with white noise of 0.02 rad/s on the velocities and 1e-4 rad on the angles.
+std::vector<Matrix> noisy_states(const HiddenFrictionWorld& w, unsigned seed) {
+  std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::vector<Matrix> noisy = w.states;
   for (Matrix& x : noisy)
     for (Eigen::Index i = 0; i < x.rows(); ++i)
       for (Eigen::Index j = 0; j < 4; ++j) x(i, j) += (j < 2 ? 1e-4 : 0.02) * gauss(rng);
-  const Transitions data = transitions_of(noisy, w.controls, w.dt);
+  return noisy;
+}
+
+TEST(InverseDynamicsResidual, NoisyVelocitiesGiveTheFrictionByLeastSquaresOnTheResidual) {
+  // The same record with white noise of 0.02 rad/s on the measured velocities (and 1e-4 rad on the
+  // angles): the window rule smooths, and least squares on the residual finds the hidden friction.
+  const HiddenFrictionWorld& w = hidden_friction_world();
+  const Transitions data = transitions_of(noisy_states(w, 5), w.controls, w.dt);
   const AccelerationEstimate estimate =
       estimate_accelerations(data, force_components(*w.model.build()).velocity_states(), w.dt);
   const Matrix r = generalised_force_residual(w.model, data, estimate.qdd, data.rows(false));
@@ -512,18 +517,11 @@ TEST(InverseDynamicsResidual, NoisyVelocitiesGiveTheFrictionByLeastSquaresOnTheR
 
 // --- Fits of forces linear in their parameters: least squares on the residual --------------------------
 
-/// The hidden-friction world's record with noise on the measured states (as in the test above, another
-/// seed), its third episode held out.
+/// The hidden-friction world's record with noise on the measured states, its third episode held out.
 const Transitions& friction_fit_data() {
   static const Transitions data = [] {
     const HiddenFrictionWorld& w = hidden_friction_world();
-    std::mt19937 rng(11);
-    std::normal_distribution<double> gauss(0.0, 1.0);
-    std::vector<Matrix> noisy = w.states;
-    for (Matrix& x : noisy)
-      for (Eigen::Index i = 0; i < x.rows(); ++i)
-        for (Eigen::Index j = 0; j < 4; ++j) x(i, j) += (j < 2 ? 1e-4 : 0.02) * gauss(rng);
-    Transitions out = transitions_of(noisy, w.controls, w.dt);
+    Transitions out = transitions_of(noisy_states(w, 11), w.controls, w.dt);
     for (std::size_t t = 0; t < out.episode.size(); ++t) out.heldout[t] = out.episode[t] == 2;
     return out;
   }();
