@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <atomic>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -140,19 +141,34 @@ class SetResidual {
       affine_.emplace(set.model_at(c.model, theta0), set.effects, theta0, c);
   }
 
-  /// sqrt(w) r at theta stacked over `rows`; `finite` as in weighted_residual.
+  /// sqrt(w) r at theta stacked over `rows`; `finite` as in weighted_residual. The fit asks for the
+  /// same point several times (the start, the accepted Gauss-Newton step, the interval's point): the
+  /// last few evaluations of the rebuilt model are kept.
   Vector at(const VectorCRef& theta, const std::vector<int>& rows, bool* finite = nullptr) const {
     if (affine_) return affine_->weighted(theta, rows);
+    for (const Evaluation& e : residuals_)
+      if (e.theta == theta && e.rows == rows) {
+        if (finite != nullptr && !e.finite) *finite = false;
+        return e.value;
+      }
     const ModelSpec spec = set_.model_at(c_.model, theta);
-    if (c_.criterion == FitCriterion::InverseDynamics) return weighted_force_residual(spec, c_, rows);
-    const auto model = make_step_model(spec, c_.integrator, c_.dt, c_.substeps);
-    return weighted_residual(*model, applied_controls(*c_.data, spec.input_delay), c_, rows, finite);
+    Evaluation e{theta, rows, {}, true};
+    if (c_.criterion == FitCriterion::InverseDynamics) {
+      e.value = weighted_force_residual(spec, c_, rows);
+    } else {
+      const auto model = make_step_model(spec, c_.integrator, c_.dt, c_.substeps);
+      e.value = weighted_residual(*model, applied_controls(*c_.data, spec.input_delay), c_, rows, &e.finite);
+    }
+    if (finite != nullptr && !e.finite) *finite = false;
+    return remember(residuals_, std::move(e)).value;
   }
 
   /// Weighted regressor d phi / d theta at theta (rows.size() n x p): by central differences (one-sided
   /// when the lower step would leave the physical range), or the closed form's.
   Matrix regressor(const VectorCRef& theta, const std::vector<int>& rows) const {
     if (affine_) return affine_->weighted_regressor(rows);
+    for (const Evaluation& e : regressors_)
+      if (e.theta == theta && e.rows == rows) return e.value;
     const auto p = theta.size();
     Matrix J(static_cast<Eigen::Index>(rows.size()) * c_.weights.size(), p);
     for (Eigen::Index j = 0; j < p; ++j) {
@@ -160,13 +176,29 @@ class SetResidual {
       // The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
       J.col(j) = (at(d.minus, rows) - at(d.plus, rows)) / d.width;
     }
-    return J;
+    return remember(regressors_, Evaluation{theta, rows, std::move(J), true}).value;
   }
 
  private:
+  /// One evaluation of the rebuilt model's residual (or regressor) at theta on `rows`.
+  struct Evaluation {
+    Vector theta;
+    std::vector<int> rows;
+    Matrix value;
+    bool finite = true;
+  };
+  /// Keeps `e` among the last kKept evaluations of its kind; returns it.
+  static const Evaluation& remember(std::deque<Evaluation>& kept, Evaluation e) {
+    constexpr std::size_t kKept = 4;
+    if (kept.size() == kKept) kept.pop_back();
+    kept.push_front(std::move(e));
+    return kept.front();
+  }
+
   const EffectSet& set_;
   const FitContext& c_;
   std::optional<AffineForceResidual> affine_;
+  mutable std::deque<Evaluation> residuals_, regressors_;
 };
 
 Vector weighted_model_residual(const FitContext& c, const std::vector<int>& rows) {
