@@ -164,18 +164,30 @@ class SetResidual {
   }
 
   /// Weighted regressor d phi / d theta at theta (rows.size() n x p): by central differences (one-sided
-  /// when the lower step would leave the physical range), or the closed form's.
+  /// when the lower step would leave the physical range), or the closed form's. Under inverse dynamics
+  /// the columns of forces linear in their parameters are their weighted bases in the model at theta,
+  /// exactly (affine_force_residual.hpp), beside the differences of the other effects.
   Matrix regressor(const VectorCRef& theta, const std::vector<int>& rows) const {
     if (affine_) return affine_->weighted_regressor(rows);
     for (const Evaluation& e : regressors_)
       if (e.theta == theta && e.rows == rows) return e.value;
-    const auto p = theta.size();
-    Matrix J(static_cast<Eigen::Index>(rows.size()) * c_.weights.size(), p);
-    for (Eigen::Index j = 0; j < p; ++j) {
-      const DifferenceStep d = difference_step(set_.parameter(j), theta, j);
-      // The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
-      J.col(j) = (at(d.minus, rows) - at(d.plus, rows)) / d.width;
+    Matrix J(static_cast<Eigen::Index>(rows.size()) * c_.weights.size(), theta.size());
+    std::vector<const LibraryEffect*> forces;
+    std::vector<Eigen::Index> force_columns;
+    for (std::size_t e = 0; e < set_.effects.size(); ++e) {
+      if (c_.criterion == FitCriterion::InverseDynamics && linear_forces({set_.effects[e]})) {
+        forces.push_back(set_.effects[e]);
+        for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) force_columns.push_back(j);
+        continue;
+      }
+      for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) {
+        const DifferenceStep d = difference_step(set_.parameter(j), theta, j);
+        // The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
+        J.col(j) = (at(d.minus, rows) - at(d.plus, rows)) / d.width;
+      }
     }
+    if (!forces.empty())
+      J(Eigen::all, force_columns) = weighted_force_regressor(set_.model_at(c_.model, theta), forces, c_, rows);
     return remember(regressors_, Evaluation{theta, rows, std::move(J), true}).value;
   }
 
