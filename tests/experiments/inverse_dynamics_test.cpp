@@ -640,6 +640,33 @@ TEST(InverseDynamicsFit, LinearForcesFitAsLeastSquaresOfTheResidualOnTheirRegres
   EXPECT_TRUE(blind.estimate.allFinite());
 }
 
+// A recalibration fitted jointly with a force linear in its parameter: the force's column of the
+// regressor is its basis, the recalibration's a central difference. The estimate is the minimum of the
+// rebuilt model's training objective: moving either parameter by 1% of itself raises it.
+TEST(InverseDynamicsFit, RecalibrationWithALinearForceEndsAtTheRebuiltModelsMinimum) {
+  const FitContext& c = friction_fit_context();
+  const std::vector<int> training = friction_fit_data().rows(false);
+  const LibraryEffect mass = find_candidate(c.model, "param:forearm.mass");
+  const LibraryEffect coulomb = find_candidate(c.model, "joint_coulomb_friction:elbow");
+  const EffectFit fit = fit_jointly(mass, {{&coulomb, Vector::Zero(1)}}, c);
+  ASSERT_TRUE(fit.identifiable) << fit.not_identifiable;
+  ASSERT_EQ(fit.refitted.size(), 1u);
+  const auto objective = [&](double m, double tau) {
+    return weighted_residual_of(c.model.with(mass, Vector::Constant(1, m)).with(coulomb, Vector::Constant(1, tau)), c,
+                                training)
+        .squaredNorm();
+  };
+  const double m = fit.estimate(0), tau = fit.refitted[0].estimate(0);
+  const double at = objective(m, tau);
+  std::printf("forearm mass %.5f kg, elbow Coulomb friction %.5f N m; objective %.6g\n", m, tau, at);
+  EXPECT_NEAR(fit.training_objective_after, at, 1e-9 * at);
+  EXPECT_NEAR(tau, kElbowFriction, 0.1 * kElbowFriction);
+  for (const double step : {-0.01, 0.01}) {
+    EXPECT_GT(objective(m * (1.0 + step), tau), at) << step;
+    EXPECT_GT(objective(m, tau * (1.0 + step)), at) << step;
+  }
+}
+
 // --- The whole diagnosis on the inverse-dynamics criterion ------------------------------------------
 
 // The noisy record as a measurement file would hold it, diagnosed with --auto on the inverse-dynamics
