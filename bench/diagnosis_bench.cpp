@@ -4,8 +4,9 @@
 // included. The single-effect diagnosis of the same data (no --auto) is the reference the ratio is taken
 // to. And `--auto` on a real-machine-sized log: 25 s of a position-controlled drive at 1 kHz (25,000
 // samples, one continuous record; tests/support/ball_drive.hpp), imported from encoder counts. And the
-// ranking of the whole library (92 candidates) on the inverse-dynamics criterion on the 7-joint arm
-// stand-in (tests/support/arm7_log.hpp), 5 s and 20 s at 1 kHz, with or without --auto.
+// ranking of every candidate on the inverse-dynamics criterion on the 7-joint arm stand-in
+// (tests/support/arm7_log.hpp; 78 of the library's 92, the actuators' gains and gears not being
+// candidates there), 5 s and 20 s at 1 kHz, with or without --auto.
 //
 //   build/bench/gpilqg_diagnosis_bench --benchmark_min_time=1
 
@@ -112,7 +113,7 @@ const test::Arm7Log& arm7_record(long milliseconds) {
 }
 
 /// The whole diagnosis on the inverse-dynamics criterion with the command line's defaults: every
-/// candidate of the library ranked (92 on the arm), and with --auto the search for several effects.
+/// candidate ranked (the counter `candidates`), and with --auto the search for several effects.
 void diagnose_arm7(benchmark::State& state, bool auto_select) {
   const test::Arm7Log& log = arm7_record(state.range(0));
   diagnosis::DiagnoseRequest request;
