@@ -3,14 +3,20 @@
 // line's defaults (GP of 300 points per state, one restart, two threads), the search for several effects
 // included. The single-effect diagnosis of the same data (no --auto) is the reference the ratio is taken
 // to. And `--auto` on a real-machine-sized log: 25 s of a position-controlled drive at 1 kHz (25,000
-// samples, one continuous record; tests/support/ball_drive.hpp), imported from encoder counts.
+// samples, one continuous record; tests/support/ball_drive.hpp), imported from encoder counts. And the
+// ranking of every candidate on the inverse-dynamics criterion on the 7-joint arm stand-in
+// (tests/support/arm7_log.hpp; 78 of the library's 92, the actuators' gains and gears not being
+// candidates there), 5 s and 20 s at 1 kHz, with or without --auto.
 //
 //   build/bench/gpilqg_diagnosis_bench --benchmark_min_time=1
 
 #include <benchmark/benchmark.h>
 
+#include <map>
 #include <stdexcept>
+#include <string>
 
+#include "arm7_log.hpp"
 #include "ball_drive.hpp"
 #include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/log_import.hpp"
@@ -95,8 +101,47 @@ void BM_DiagnoseAutoDrive(benchmark::State& state) {
   state.counters["samples"] = static_cast<double>(state.range(0));
 }
 
+/// The arm's record of `milliseconds` (one sample per millisecond), made once per length.
+const test::Arm7Log& arm7_record(long milliseconds) {
+  static std::map<long, test::Arm7Log> made;
+  auto it = made.find(milliseconds);
+  if (it != made.end()) return it->second;
+  test::Arm7Options o;
+  o.seconds = static_cast<double>(milliseconds) / 1000.0;
+  o.seed = 3;
+  return made.emplace(milliseconds, test::arm7_log(GPILQG_BENCH_SOURCE_DIR, o)).first->second;
+}
+
+/// The whole diagnosis on the inverse-dynamics criterion with the command line's defaults: every
+/// candidate ranked (the counter `candidates`), and with --auto the search for several effects.
+void diagnose_arm7(benchmark::State& state, bool auto_select) {
+  const test::Arm7Log& log = arm7_record(state.range(0));
+  diagnosis::DiagnoseRequest request;
+  request.system = log.model.system;
+  request.criterion = "inverse-dynamics";
+  request.auto_select = auto_select;
+  const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(request);
+  std::string first;
+  std::size_t candidates = 0;
+  for (auto _ : state) {
+    const diagnosis::DiagnosisReport report = diagnosis::diagnose(log.measured, options);
+    first = report.ranking.empty() ? "none" : report.ranking.front().fit.effect;
+    candidates = 0;
+    for (const auto& entry : report.ranking) candidates += 1 + entry.aliases.size();
+    benchmark::DoNotOptimize(candidates);
+  }
+  state.SetLabel("first " + first);
+  state.counters["candidates"] = static_cast<double>(candidates);
+  state.counters["samples"] = static_cast<double>(state.range(0) + 1);
+}
+
+void BM_RankArm7InverseDynamics(benchmark::State& state) { diagnose_arm7(state, false); }
+void BM_DiagnoseAutoArm7InverseDynamics(benchmark::State& state) { diagnose_arm7(state, true); }
+
 BENCHMARK(BM_DiagnoseOneEffect)->Unit(benchmark::kSecond)->Iterations(3);
 BENCHMARK(BM_DiagnoseAutoThreeEffects)->Unit(benchmark::kSecond)->Iterations(3);
 BENCHMARK(BM_DiagnoseAutoDrive)->Arg(25000)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_RankArm7InverseDynamics)->Arg(5000)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_DiagnoseAutoArm7InverseDynamics)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace

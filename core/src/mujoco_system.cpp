@@ -257,7 +257,7 @@ void MujocoSystem::generalised_force_map(const VectorCRef& x, Matrix& W, std::ve
   const Vector u0 = Vector::Zero(m->nu);
   const auto inverse_mass = [&](const Vector& xs) {
     model_->prepare(d, xs, u0);
-    mj_forward(m, d);
+    mj_fwdPosition(m, d);  // M(q) is a function of the positions: the position stage computes it
     RowMajorMatrix M(nv, nv);
     mj_fullM(m, M.data(), d->qM);
     return Matrix(M.llt().solve(Matrix::Identity(nv, nv)));

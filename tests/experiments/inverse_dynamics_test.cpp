@@ -13,14 +13,17 @@
 #include <functional>
 #include <map>
 #include <random>
+#include <set>
 
-#include <Eigen/QR>
+#include <Eigen/Dense>
 
 #include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/savitzky_golay.hpp"
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
 #include "gpilqg/experiments/diagnosis/diagnosis.hpp"
+#include "gpilqg/experiments/diagnosis/effect_fit.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 #include "test_support.hpp"
 
 namespace gpilqg {
@@ -482,17 +485,22 @@ TEST(InverseDynamicsResidual, NoiseFreeWorldWithHiddenFrictionGivesTheFrictionAs
   EXPECT_NEAR(tau, kElbowFriction, 0.01 * kElbowFriction);
 }
 
-TEST(InverseDynamicsResidual, NoisyVelocitiesGiveTheFrictionByLeastSquaresOnTheResidual) {
-  // The same record with white noise of 0.02 rad/s on the measured velocities (and 1e-4 rad on the
-  // angles): the window rule smooths, and least squares on the residual finds the hidden friction.
-  const HiddenFrictionWorld& w = hidden_friction_world();
-  std::mt19937 rng(5);
+/// The world's states with white noise of 0.02 rad/s on the velocities and 1e-4 rad on the angles.
+std::vector<Matrix> noisy_states(const HiddenFrictionWorld& w, unsigned seed) {
+  std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::vector<Matrix> noisy = w.states;
   for (Matrix& x : noisy)
     for (Eigen::Index i = 0; i < x.rows(); ++i)
       for (Eigen::Index j = 0; j < 4; ++j) x(i, j) += (j < 2 ? 1e-4 : 0.02) * gauss(rng);
-  const Transitions data = transitions_of(noisy, w.controls, w.dt);
+  return noisy;
+}
+
+TEST(InverseDynamicsResidual, NoisyVelocitiesGiveTheFrictionByLeastSquaresOnTheResidual) {
+  // The same record with white noise of 0.02 rad/s on the measured velocities (and 1e-4 rad on the
+  // angles): the window rule smooths, and least squares on the residual finds the hidden friction.
+  const HiddenFrictionWorld& w = hidden_friction_world();
+  const Transitions data = transitions_of(noisy_states(w, 5), w.controls, w.dt);
   const AccelerationEstimate estimate =
       estimate_accelerations(data, force_components(*w.model.build()).velocity_states(), w.dt);
   const Matrix r = generalised_force_residual(w.model, data, estimate.qdd, data.rows(false));
@@ -505,6 +513,158 @@ TEST(InverseDynamicsResidual, NoisyVelocitiesGiveTheFrictionByLeastSquaresOnTheR
   EXPECT_GT(estimate.windows[0].window, 3);
   EXPECT_NEAR(theta(0), kShoulderDamping, 0.05 * kShoulderDamping);
   EXPECT_NEAR(theta(1), kElbowFriction, 0.05 * kElbowFriction);
+}
+
+// --- Fits of forces linear in their parameters: least squares on the residual --------------------------
+
+/// The hidden-friction world's record with noise on the measured states, its third episode held out.
+const Transitions& friction_fit_data() {
+  static const Transitions data = [] {
+    const HiddenFrictionWorld& w = hidden_friction_world();
+    Transitions out = transitions_of(noisy_states(w, 11), w.controls, w.dt);
+    for (std::size_t t = 0; t < out.episode.size(); ++t) out.heldout[t] = out.episode[t] == 2;
+    return out;
+  }();
+  return data;
+}
+
+/// The inverse-dynamics fit context of the arm (the model without friction) on that record.
+const FitContext& friction_fit_context() {
+  static const FitContext context = [] {
+    FitContext c;
+    c.data = &friction_fit_data();
+    c.model = hidden_friction_world().model;
+    c.dt = hidden_friction_world().dt;
+    return criterion_context(c, FitCriterion::InverseDynamics, 1);
+  }();
+  return context;
+}
+
+/// The weighted least-squares fit of the residual r0 on the regressor X (both stacked over the rows,
+/// weighted), the iid 95% half-width s sqrt((X'X)^-1) widened to the delete-one-episode jackknife,
+/// computed here directly: what fit_effect and fit_jointly must give for forces linear in theta.
+struct LeastSquaresFit {
+  Vector theta, half;
+};
+
+LeastSquaresFit least_squares_fit(const Matrix& X, const Vector& r0, const std::vector<int>& episode_of_block,
+                                  Eigen::Index k) {
+  const Eigen::Index p = X.cols();
+  LeastSquaresFit out;
+  out.theta = X.colPivHouseholderQr().solve(r0);
+  const double s2 = (r0 - X * out.theta).squaredNorm() / static_cast<double>(X.rows() - p);
+  Vector variance = s2 * (X.transpose() * X).inverse().diagonal();
+  const std::set<int> episodes(episode_of_block.begin(), episode_of_block.end());
+  std::vector<Vector> replicates;
+  for (int episode : episodes) {
+    std::vector<Eigen::Index> keep;
+    for (std::size_t b = 0; b < episode_of_block.size(); ++b)
+      if (episode_of_block[b] != episode)
+        for (Eigen::Index i = 0; i < k; ++i) keep.push_back(static_cast<Eigen::Index>(b) * k + i);
+    const Matrix Xe = X(keep, Eigen::all);
+    const Vector re = r0(keep);
+    replicates.push_back(Xe.colPivHouseholderQr().solve(re));
+  }
+  Vector mean = Vector::Zero(p);
+  for (const Vector& t : replicates) mean += t / static_cast<double>(replicates.size());
+  Vector jack = Vector::Zero(p);
+  for (const Vector& t : replicates) jack += (t - mean).cwiseAbs2();
+  const auto R = static_cast<double>(replicates.size());
+  out.half = 1.96 * variance.cwiseMax(jack * (R - 1.0) / R).cwiseSqrt();
+  return out;
+}
+
+// For forces linear in their parameters the fit is one least-squares solve of the model's residual on
+// the forces' regressor (affine_force_residual.hpp). Checked against that solve done here: on the
+// forces' formulas (viscous damping: g = -qdot on its joint), and on regressors and residuals of the
+// rebuilt model (r(0) - r(1) of a force at a body's centre of mass), alone and jointly; the held-out
+// share against the rebuilt model's residuals; a force the data cannot see is not identifiable.
+TEST(InverseDynamicsFit, LinearForcesFitAsLeastSquaresOfTheResidualOnTheirRegressor) {
+  const Transitions& data = friction_fit_data();
+  const FitContext& c = friction_fit_context();
+  const std::vector<int> training = data.rows(false), heldout = data.rows(true);
+  const Eigen::Index k = 2;
+  std::vector<int> episode_of_block;
+  for (int t : training) episode_of_block.push_back(data.episode[static_cast<std::size_t>(t)]);
+  const Vector r0 = weighted_residual_of(c.model, c, training);
+  const auto regressor_of = [&](const LibraryEffect& effect, const std::vector<int>& rows) {
+    // The rebuilt model's residual is affine in theta: its difference between 0 and 1 is the column.
+    return Vector(weighted_residual_of(c.model, c, rows) -
+                  weighted_residual_of(c.model.with(effect, Vector::Ones(1)), c, rows));
+  };
+
+  // Viscous damping on the shoulder: the column is sqrt(w_0) (-shoulder_dot) on component 0.
+  const LibraryEffect viscous = find_candidate(c.model, "joint_viscous_damping:shoulder");
+  Matrix X = Matrix::Zero(r0.size(), 1);
+  for (std::size_t i = 0; i < training.size(); ++i)
+    X(static_cast<Eigen::Index>(i) * k, 0) = -std::sqrt(c.weights(0)) * data.x(training[i], 2);
+  const LeastSquaresFit expected = least_squares_fit(X, r0, episode_of_block, k);
+  const EffectFit fit = fit_effect(viscous, c);
+  std::printf("viscous: %.6f [%.6f, %.6f]; least squares %.6f +- %.6f\n", fit.estimate(0), fit.ci_low(0),
+              fit.ci_high(0), expected.theta(0), expected.half(0));
+  ASSERT_TRUE(fit.identifiable) << fit.not_identifiable;
+  EXPECT_NEAR(fit.estimate(0), expected.theta(0), 1e-9 * std::abs(expected.theta(0)));
+  EXPECT_NEAR(fit.linear_estimate(0), expected.theta(0), 1e-9 * std::abs(expected.theta(0)));
+  EXPECT_NEAR(fit.ci_high(0) - fit.estimate(0), expected.half(0), 1e-6 * expected.half(0));
+  EXPECT_NEAR(fit.estimate(0), kShoulderDamping, 0.05 * kShoulderDamping);
+  // The objective and the held-out share are the rebuilt model's.
+  const ModelSpec fitted = c.model.with(viscous, fit.estimate);
+  const double after = weighted_residual_of(fitted, c, training).squaredNorm();
+  EXPECT_NEAR(fit.training_objective_after, after, 1e-9 * after);
+  const double before_h = weighted_residual_of(c.model, c, heldout).squaredNorm();
+  const double after_h = weighted_residual_of(fitted, c, heldout).squaredNorm();
+  EXPECT_NEAR(fit.explained, 1.0 - after_h / before_h, 1e-9);
+  EXPECT_GT(fit.explained, 0.1);
+
+  // A force along x at the forearm's centre of mass (its regressor is the body's Jacobian), jointly
+  // with the shoulder's damping: two columns, the joint estimate and interval of each.
+  const LibraryEffect push = find_candidate(c.model, "external_force_x:forearm");
+  X.conservativeResize(Eigen::NoChange, 2);
+  X.col(1) = regressor_of(push, training);
+  const LeastSquaresFit both = least_squares_fit(X, r0, episode_of_block, k);
+  const EffectFit joint = fit_jointly(push, {{&viscous, Vector::Zero(1)}}, c);
+  ASSERT_EQ(joint.refitted.size(), 1u);
+  std::printf("jointly: force %.6f (least squares %.6f), damping %.6f (least squares %.6f)\n", joint.estimate(0),
+              both.theta(1), joint.refitted[0].estimate(0), both.theta(0));
+  EXPECT_NEAR(joint.estimate(0), both.theta(1), 1e-9 * std::max(1.0, std::abs(both.theta(1))));
+  EXPECT_NEAR(joint.refitted[0].estimate(0), both.theta(0), 1e-9 * std::abs(both.theta(0)));
+  EXPECT_NEAR(joint.ci_high(0) - joint.estimate(0), both.half(1), 1e-6 * both.half(1));
+  EXPECT_NEAR(joint.refitted[0].ci_high(0) - joint.refitted[0].estimate(0), both.half(0), 1e-6 * both.half(0));
+
+  // A force along the hinges' axis y moves no joint: its regressor is zero, so it is not identifiable
+  // (and nothing is NaN).
+  const EffectFit blind = fit_effect(find_candidate(c.model, "external_force_y:forearm"), c);
+  EXPECT_FALSE(blind.identifiable);
+  EXPECT_EQ(blind.not_identifiable, "it does not change the predictions") << "its regressor is not exactly zero";
+  EXPECT_EQ(blind.explained, 0.0);
+  EXPECT_TRUE(blind.estimate.allFinite());
+}
+
+// A recalibration fitted jointly with a force linear in its parameter: the force's column of the
+// regressor is its basis, the recalibration's a central difference. The estimate is the minimum of the
+// rebuilt model's training objective: moving either parameter by 1% of itself raises it.
+TEST(InverseDynamicsFit, RecalibrationWithALinearForceEndsAtTheRebuiltModelsMinimum) {
+  const FitContext& c = friction_fit_context();
+  const std::vector<int> training = friction_fit_data().rows(false);
+  const LibraryEffect mass = find_candidate(c.model, "param:forearm.mass");
+  const LibraryEffect coulomb = find_candidate(c.model, "joint_coulomb_friction:elbow");
+  const EffectFit fit = fit_jointly(mass, {{&coulomb, Vector::Zero(1)}}, c);
+  ASSERT_TRUE(fit.identifiable) << fit.not_identifiable;
+  ASSERT_EQ(fit.refitted.size(), 1u);
+  const auto objective = [&](double m, double tau) {
+    return weighted_residual_of(c.model.with(mass, Vector::Constant(1, m)).with(coulomb, Vector::Constant(1, tau)), c,
+                                training)
+        .squaredNorm();
+  };
+  const double m = fit.estimate(0), tau = fit.refitted[0].estimate(0);
+  const double at = objective(m, tau);
+  std::printf("forearm mass %.5f kg, elbow Coulomb friction %.5f N m; objective %.6g\n", m, tau, at);
+  EXPECT_NEAR(fit.training_objective_after, at, 1e-9 * at);
+  EXPECT_NEAR(tau, kElbowFriction, 0.1 * kElbowFriction);
+  for (const double step : {-0.01, 0.01}) {
+    EXPECT_GT(objective(m * (1.0 + step), tau), at) << step;
+    EXPECT_GT(objective(m, tau * (1.0 + step)), at) << step;
+  }
 }
 
 // --- The whole diagnosis on the inverse-dynamics criterion ------------------------------------------

@@ -4,8 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <atomic>
+#include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <tuple>
 
 #include <fmt/format.h>
@@ -16,6 +18,7 @@
 #include "gpilqg/core/fork_join.hpp"
 #include "gpilqg/core/generalised_forces.hpp"
 #include "gpilqg/core/system_registry.hpp"
+#include "gpilqg/experiments/diagnosis/affine_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
@@ -126,26 +129,89 @@ struct EffectSet {
   }
 };
 
-Vector weighted_residual_at(const EffectSet& set, const VectorCRef& theta, const FitContext& c,
-                            const std::vector<int>& rows, bool* finite = nullptr) {
-  const ModelSpec spec = set.model_at(c.model, theta);
-  if (c.criterion == FitCriterion::InverseDynamics) return weighted_force_residual(spec, c, rows);
-  const auto model = make_step_model(spec, c.integrator, c.dt, c.substeps);
-  return weighted_residual(*model, applied_controls(*c.data, spec.input_delay), c, rows, finite);
-}
-
-/// Weighted regressor d phi / d theta (rows.size() n x p) by central differences (one-sided when the
-/// lower step would leave the physical range).
-Matrix regressor(const EffectSet& set, const VectorCRef& theta, const FitContext& c, const std::vector<int>& rows) {
-  const auto p = theta.size();
-  Matrix J(static_cast<Eigen::Index>(rows.size()) * c.weights.size(), p);
-  for (Eigen::Index j = 0; j < p; ++j) {
-    const DifferenceStep d = difference_step(set.parameter(j), theta, j);
-    // The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
-    J.col(j) = (weighted_residual_at(set, d.minus, c, rows) - weighted_residual_at(set, d.plus, c, rows)) / d.width;
+/// The weighted residual of a set of effects as a function of its stacked parameters, and its
+/// regressor: in general the model rebuilt at every theta (ModelSpec::with) and the regressor by
+/// central differences; under inverse dynamics with forces linear in their parameters the closed
+/// form r(theta) = r(theta_0) - G (theta - theta_0) with the exact regressor sqrt(w) G
+/// (affine_force_residual.hpp), built once from theta_0. Both give the same numbers up to rounding.
+class SetResidual {
+ public:
+  SetResidual(const EffectSet& set, const Vector& theta0, const FitContext& c) : set_(set), c_(c) {
+    if (c.criterion == FitCriterion::InverseDynamics && linear_forces(set.effects))
+      affine_.emplace(set.model_at(c.model, theta0), set.effects, theta0, c);
   }
-  return J;
-}
+
+  /// sqrt(w) r at theta stacked over `rows`; `finite` as in weighted_residual. The fit asks for the
+  /// same point several times (the start, the accepted Gauss-Newton step, the interval's point): the
+  /// last few evaluations of the rebuilt model are kept.
+  Vector at(const VectorCRef& theta, const std::vector<int>& rows, bool* finite = nullptr) const {
+    if (affine_) return affine_->weighted(theta, rows);
+    for (const Evaluation& e : residuals_)
+      if (e.theta == theta && e.rows == rows) {
+        if (finite != nullptr && !e.finite) *finite = false;
+        return e.value;
+      }
+    const ModelSpec spec = set_.model_at(c_.model, theta);
+    Evaluation e{theta, rows, {}, true};
+    if (c_.criterion == FitCriterion::InverseDynamics) {
+      e.value = weighted_force_residual(spec, c_, rows);
+    } else {
+      const auto model = make_step_model(spec, c_.integrator, c_.dt, c_.substeps);
+      e.value = weighted_residual(*model, applied_controls(*c_.data, spec.input_delay), c_, rows, &e.finite);
+    }
+    if (finite != nullptr && !e.finite) *finite = false;
+    return remember(residuals_, std::move(e)).value;
+  }
+
+  /// Weighted regressor d phi / d theta at theta (rows.size() n x p): by central differences (one-sided
+  /// when the lower step would leave the physical range), or the closed form's. Under inverse dynamics
+  /// the columns of forces linear in their parameters are their weighted bases in the model at theta,
+  /// exactly (affine_force_residual.hpp), beside the differences of the other effects.
+  Matrix regressor(const VectorCRef& theta, const std::vector<int>& rows) const {
+    if (affine_) return affine_->weighted_regressor(rows);
+    for (const Evaluation& e : regressors_)
+      if (e.theta == theta && e.rows == rows) return e.value;
+    Matrix J(static_cast<Eigen::Index>(rows.size()) * c_.weights.size(), theta.size());
+    std::vector<const LibraryEffect*> forces;
+    std::vector<Eigen::Index> force_columns;
+    for (std::size_t e = 0; e < set_.effects.size(); ++e) {
+      if (c_.criterion == FitCriterion::InverseDynamics && linear_forces({set_.effects[e]})) {
+        forces.push_back(set_.effects[e]);
+        for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) force_columns.push_back(j);
+        continue;
+      }
+      for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) {
+        const DifferenceStep d = difference_step(set_.parameter(j), theta, j);
+        // The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
+        J.col(j) = (at(d.minus, rows) - at(d.plus, rows)) / d.width;
+      }
+    }
+    if (!forces.empty())
+      J(Eigen::all, force_columns) = weighted_force_regressor(set_.model_at(c_.model, theta), forces, c_, rows);
+    return remember(regressors_, Evaluation{theta, rows, std::move(J), true}).value;
+  }
+
+ private:
+  /// One evaluation of the rebuilt model's residual (or regressor) at theta on `rows`.
+  struct Evaluation {
+    Vector theta;
+    std::vector<int> rows;
+    Matrix value;
+    bool finite = true;
+  };
+  /// Keeps `e` among the last kKept evaluations of its kind; returns it.
+  static const Evaluation& remember(std::deque<Evaluation>& kept, Evaluation e) {
+    constexpr std::size_t kKept = 4;
+    if (kept.size() == kKept) kept.pop_back();
+    kept.push_front(std::move(e));
+    return kept.front();
+  }
+
+  const EffectSet& set_;
+  const FitContext& c_;
+  std::optional<AffineForceResidual> affine_;
+  mutable std::deque<Evaluation> residuals_, regressors_;
+};
 
 Vector weighted_model_residual(const FitContext& c, const std::vector<int>& rows) {
   const auto n = static_cast<Eigen::Index>(c.weights.size());
@@ -170,11 +236,11 @@ int heldout_batch_length(const FitContext& c, int rows) {
 }
 
 /// Held-out scores of theta_hat against the model (step 4).
-void score_heldout(const EffectSet& set, const Vector& theta, const FitContext& c, EffectFit& fit) {
+void score_heldout(const SetResidual& residual, const Vector& theta, const FitContext& c, EffectFit& fit) {
   const std::vector<int> rows = c.data->rows(true);
   const auto n = static_cast<Eigen::Index>(c.weights.size());
   const Vector before = weighted_model_residual(c, rows);
-  const Vector after = weighted_residual_at(set, theta, c, rows);
+  const Vector after = residual.at(theta, rows);
   const Vector sqrt_w = c.weights.cwiseSqrt();
   fit.heldout_rmse_before = Vector::Zero(n);
   fit.heldout_rmse_after = Vector::Zero(n);
@@ -223,10 +289,10 @@ void score_heldout(const EffectSet& set, const Vector& theta, const FitContext& 
 }
 
 /// The 95% interval at theta_hat (step 3): [low, high].
-std::pair<Vector, Vector> confidence_interval(const EffectSet& set, const Vector& estimate, const FitContext& c,
+std::pair<Vector, Vector> confidence_interval(const SetResidual& residual, const Vector& estimate, const FitContext& c,
                                               const std::vector<int>& rows) {
-  const Matrix J = regressor(set, estimate, c, rows);
-  const Vector r = weighted_residual_at(set, estimate, c, rows);
+  const Matrix J = residual.regressor(estimate, rows);
+  const Vector r = residual.at(estimate, rows);
   const auto p = J.cols();
   const auto n = static_cast<Eigen::Index>(c.weights.size());
   const Matrix A = J.transpose() * J;
@@ -311,10 +377,10 @@ EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& 
                      const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high, EffectFit fit);
 
 /// S(theta), or +inf where the model diverges or does not accept theta (a mass of 0, say).
-double objective_at(const EffectSet& set, const VectorCRef& theta, const FitContext& c, const std::vector<int>& rows) {
+double objective_at(const SetResidual& residual, const VectorCRef& theta, const std::vector<int>& rows) {
   try {
     bool finite = true;
-    const Vector r = weighted_residual_at(set, theta, c, rows, &finite);
+    const Vector r = residual.at(theta, rows, &finite);
     return finite ? r.squaredNorm() : std::numeric_limits<double>::infinity();
   } catch (const std::invalid_argument&) {
     return std::numeric_limits<double>::infinity();
@@ -324,13 +390,13 @@ double objective_at(const EffectSet& set, const VectorCRef& theta, const FitCont
 /// Gauss-Newton from `theta` (updated in place), at most `iterations` steps, each clamped to the
 /// physical range and halved (up to 6 times) until S falls; stops when a step lowers S by less than
 /// 1e-9 of it. Returns S at the final theta; `evaluations` counts the residual evaluations.
-double refine_gauss_newton(const EffectSet& set, Vector& theta, const Vector& lower, const Vector& upper,
-                           const FitContext& c, const std::vector<int>& rows, int iterations, int& evaluations) {
-  double at_theta = objective_at(set, theta, c, rows);
+double refine_gauss_newton(const SetResidual& residual, Vector& theta, const Vector& lower, const Vector& upper,
+                           const std::vector<int>& rows, int iterations, int& evaluations) {
+  double at_theta = objective_at(residual, theta, rows);
   ++evaluations;
   for (int k = 0; k < iterations && std::isfinite(at_theta); ++k) {
-    const Vector r = weighted_residual_at(set, theta, c, rows);
-    const Matrix J = regressor(set, theta, c, rows);
+    const Vector r = residual.at(theta, rows);
+    const Matrix J = residual.regressor(theta, rows);
     evaluations += 1 + 2 * static_cast<int>(theta.size());
     if (!J.allFinite() || !r.allFinite()) break;
     const Vector step = J.colPivHouseholderQr().solve(r);
@@ -338,7 +404,7 @@ double refine_gauss_newton(const EffectSet& set, Vector& theta, const Vector& lo
     bool lowered = false;
     for (double scale = 1.0; scale > 1.0 / 64.0 && !lowered; scale *= 0.5) {
       const Vector next = clamp_to(theta + scale * step, lower, upper);
-      const double at_next = objective_at(set, next, c, rows);
+      const double at_next = objective_at(residual, next, rows);
       ++evaluations;
       if (at_next < at_theta) {
         const bool converged = at_theta - at_next <= 1e-9 * at_theta;
@@ -445,30 +511,31 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
   const Vector null = set.null_values(c.model);
 
   // 1. Linear least squares at theta_0 (a Gauss-Newton step from a warm start for a joint fit).
-  const Matrix J = regressor(set, initial, c, training);
+  const SetResidual residual(set, initial, c);
+  const Matrix J = residual.regressor(initial, training);
   fit.regressor = J.col(0);
   fit.scale = data_scales(J, c, training, null);
   if (!(J.col(0).norm() > 0.0) || !J.allFinite()) {
     fit.identifiable = false;
     fit.not_identifiable = "it does not change the predictions";
-    fit.training_objective_after = weighted_residual_at(set, initial, c, training).squaredNorm();
+    fit.training_objective_after = residual.at(initial, training).squaredNorm();
   } else {
-    const Vector r_initial = weighted_residual_at(set, initial, c, training);
+    const Vector r_initial = residual.at(initial, training);
     const Vector delta = J.colPivHouseholderQr().solve(r_initial);
     theta_ls = clamp_to(initial + delta, lower, upper);
     // 2. Gauss-Newton on S(theta) inside the physical range, from theta_0: its first step is the
     // least-squares step above, halved when it does not lower S (a nonlinear effect far from theta_0).
     theta_hat = initial;
     fit.training_objective_after =
-        refine_gauss_newton(set, theta_hat, lower, upper, c, training,
+        refine_gauss_newton(residual, theta_hat, lower, upper, training,
                             set.linear() ? kLinearRefinements : kNonlinearRefinements, fit.evaluations);
 
     // 3. Interval, and whether the data determine the fit.
-    std::tie(ci_low, ci_high) = confidence_interval(set, theta_hat, c, training);
+    std::tie(ci_low, ci_high) = confidence_interval(residual, theta_hat, c, training);
     check_identifiable(set, theta_hat, ci_low, ci_high, null, fit);
   }
   // 4. Held-out scores; then each effect's slice.
-  score_heldout(set, theta_hat, c, fit);
+  score_heldout(residual, theta_hat, c, fit);
   return finish_fit(set, initial, null, theta_ls, theta_hat, ci_low, ci_high, std::move(fit));
 }
 
@@ -539,8 +606,9 @@ EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, co
   EffectSet set;
   set.add(effect);
   fit.training_objective_before = weighted_model_residual(c, training).squaredNorm();
-  fit.training_objective_after = weighted_residual_at(set, values, c, training).squaredNorm();
-  score_heldout(set, values, c, fit);
+  const SetResidual residual(set, values, c);
+  fit.training_objective_after = residual.at(values, training).squaredNorm();
+  score_heldout(residual, values, c, fit);
   return fit;
 }
 

@@ -23,7 +23,9 @@ const Dynamics* force_map_owner(const Dynamics& model) {
   return system;
 }
 
-const Dynamics& require_force_map(const Dynamics& model) {
+}  // namespace
+
+const Dynamics& force_map_system(const Dynamics& model) {
   const Dynamics* owner = force_map_owner(model);
   if (owner == nullptr)
     throw std::invalid_argument(fmt::format(
@@ -31,8 +33,6 @@ const Dynamics& require_force_map(const Dynamics& model) {
         "generalised forces), so it has no force residual", model.name()));
   return *owner;
 }
-
-}  // namespace
 
 std::vector<int> ForceComponents::velocity_states() const {
   std::vector<int> out;
@@ -42,7 +42,7 @@ std::vector<int> ForceComponents::velocity_states() const {
 }
 
 ForceComponents force_components(const Dynamics& model) {
-  const Dynamics& owner = require_force_map(model);
+  const Dynamics& owner = force_map_system(model);
   ForceComponents out;
   out.forces = dynamic_cast<const GeneralisedForceInput&>(owner).generalised_forces();
   const std::vector<GeneralisedCoordinate> coordinates = generalised_coordinates(owner);
@@ -62,7 +62,7 @@ ForceComponents force_components(const Dynamics& model) {
 
 Matrix generalised_force_residual(const Dynamics& model, const Transitions& data, const Matrix& applied_u,
                                   const Matrix& accelerations, const std::vector<int>& rows) {
-  const Dynamics& owner = require_force_map(model);
+  const Dynamics& owner = force_map_system(model);
   const auto& map = dynamic_cast<const GeneralisedForceInput&>(owner);
   const ForceComponents components = force_components(model);
   const auto k = static_cast<Eigen::Index>(components.forces.size());

@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include "gpilqg/core/fork_join.hpp"
+#include "gpilqg/experiments/diagnosis/affine_force_residual.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -27,6 +28,10 @@ Split residual_split(const ModelSpec& model, const FitContext& c, const std::vec
 std::pair<Matrix, Matrix> columns(const ModelSpec& base, const Split& r0, const LibraryEffect& effect, const Vector& theta0,
                                   const Vector* fitted, const FitContext& c, const std::vector<int>& train,
                                   const std::vector<int>& heldout) {
+  // Inverse dynamics with a force linear in its parameters: secant and tangent are both the force's
+  // own regressor (affine_force_residual.hpp), without evaluating the model.
+  if (c.criterion == FitCriterion::InverseDynamics && linear_forces({&effect}))
+    return {weighted_force_regressor(base, {&effect}, c, train), weighted_force_regressor(base, {&effect}, c, heldout)};
   const auto p = static_cast<Eigen::Index>(effect.parameters.size());
   Matrix JT(r0.train.size(), p), JH(r0.heldout.size(), p);
   if (p == 1 && fitted != nullptr && fitted->size() == 1 && (*fitted)(0) != theta0(0)) {

@@ -28,6 +28,13 @@
 ///    means of the per-sample reduction (batches of consecutive samples within an episode, so the
 ///    serial correlation of the residual does not inflate the significance).
 ///
+/// Inverse dynamics (FitCriterion::InverseDynamics). A force effect enters the generalised-force
+/// residual as r(theta) = r^0 - Q_e(theta), so for forces linear in their parameters the residual is
+/// affine, r(theta) = r(theta_0) - G (theta - theta_0), and J = sqrt(w) G is their forces' bases
+/// (affine_force_residual.hpp): a set of such forces is fitted without rebuilding the model (one
+/// evaluation of its residual, then matrix products; step 2 converges at its first step), and in a set
+/// with other effects their columns of J are exact while the others' are differences.
+///
 /// Joint fits. Effects already in a model are refitted together with a new one: theta stacks the
 /// parameters of every effect of the set, [theta_1; ...; theta_E], and steps 1-4 run on the stacked
 /// vector (the regressor has one column per parameter, the interval comes from the joint covariance,

@@ -57,6 +57,12 @@ struct ForceComponents {
 /// generalised-force map, or naming the component that acts on no coordinate of the state.
 ForceComponents force_components(const Dynamics& model);
 
+/// The system whose generalised-force map `model` uses: `model` itself, or the base of an
+/// EffectDynamics (effects add their forces through the base's map). Its workspaces are the ones a
+/// ForceEffect::add_force takes. Throws std::invalid_argument naming the system when it has no
+/// generalised-force map.
+const Dynamics& force_map_system(const Dynamics& model);
+
 /// r_t (file comment) for the rows `rows` of `data` (rows.size() x k, in the order of `rows`):
 /// `applied_u` the inputs the model applies at every row of data (N x m, applied_controls) and
 /// `accelerations` the measured accelerations of every row of data (N x k, column i that of

@@ -1,0 +1,76 @@
+#include "gpilqg/experiments/diagnosis/affine_force_residual.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+
+namespace gpilqg::diagnosis {
+
+namespace {
+
+/// The blocks of `rows` (k consecutive entries each) of `all`, a matrix stacked over every row of the data.
+Matrix stacked_rows(const Matrix& all, Eigen::Index k, const std::vector<int>& rows) {
+  Matrix out(static_cast<Eigen::Index>(rows.size()) * k, all.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    out.middleRows(static_cast<Eigen::Index>(i) * k, k) = all.middleRows(static_cast<Eigen::Index>(rows[i]) * k, k);
+  return out;
+}
+
+}  // namespace
+
+bool linear_forces(const std::vector<const LibraryEffect*>& effects) {
+  return std::all_of(effects.begin(), effects.end(), [](const LibraryEffect* e) {
+    return e != nullptr && e->kind == EffectKind::Force && e->force != nullptr && e->force->linear_in_parameters();
+  });
+}
+
+Matrix weighted_force_regressor(const ModelSpec& model, const std::vector<const LibraryEffect*>& effects,
+                                const FitContext& c, const std::vector<int>& rows) {
+  if (!linear_forces(effects))
+    throw std::invalid_argument("weighted_force_regressor: every effect must be a force linear in its parameters");
+  const DynamicsPtr system = model.build();
+  const Dynamics& owner = force_map_system(*system);
+  const auto workspace = owner.make_workspace();
+  const Matrix u = applied_controls(*c.data, model.input_delay);
+  const Vector sqrt_w = c.weights.cwiseSqrt();
+  const Eigen::Index k = sqrt_w.size();
+  Eigen::Index p = 0;
+  for (const LibraryEffect* e : effects) p += static_cast<Eigen::Index>(e->parameters.size());
+  Matrix out(static_cast<Eigen::Index>(rows.size()) * k, p);
+  Vector x(system->state_dim()), u_t(system->control_dim()), Q(k);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    x = c.data->x.row(rows[i]).transpose();
+    u_t = u.row(rows[i]).transpose();
+    Eigen::Index column = 0;
+    for (const LibraryEffect* e : effects) {
+      const auto size = static_cast<Eigen::Index>(e->parameters.size());
+      for (Eigen::Index j = 0; j < size; ++j, ++column) {  // g_j = Q_e(x, u; e_j), Q_e linear in theta
+        Q.setZero();
+        e->force->add_force(x, u_t, Vector::Unit(size, j), Q, nullptr, nullptr, *workspace);
+        out.block(static_cast<Eigen::Index>(i) * k, column, k, 1) = sqrt_w.cwiseProduct(Q);
+      }
+    }
+  }
+  return out;
+}
+
+AffineForceResidual::AffineForceResidual(const ModelSpec& model, const std::vector<const LibraryEffect*>& effects,
+                                         const Vector& theta0, const FitContext& c)
+    : theta0_(theta0), k_(c.weights.size()) {
+  const std::vector<int> rows = all_rows(*c.data);
+  residual_ = weighted_residual_of(model, c, rows);
+  regressor_ = weighted_force_regressor(model, effects, c, rows);
+  if (regressor_.cols() != theta0.size())
+    throw std::invalid_argument("AffineForceResidual: theta0 does not have one entry per parameter of the effects");
+}
+
+Vector AffineForceResidual::weighted(const VectorCRef& theta, const std::vector<int>& rows) const {
+  return stacked_rows(residual_, k_, rows) - weighted_regressor(rows) * (theta - theta0_);
+}
+
+Matrix AffineForceResidual::weighted_regressor(const std::vector<int>& rows) const {
+  return stacked_rows(regressor_, k_, rows);
+}
+
+}  // namespace gpilqg::diagnosis
