@@ -87,14 +87,6 @@ double typical_scale(const std::string& field, double value) {
   return std::max(std::abs(value), floor);
 }
 
-/// Whether a cubic spring is a candidate on `joint`: one to which the model gives a spring
-/// (stiffness > 0), whose force may stiffen or soften with the displacement (a Duffing oscillator).
-/// A joint without a spring has no rest position to be displaced from: a slide's origin is a
-/// convention, and a hinge may turn freely (a potential of a free angle is periodic; a cubic is not).
-bool has_spring(const mjModel* m, const std::string& joint) {
-  return m->jnt_stiffness[mj_name2id(m, mjOBJ_JOINT, joint.c_str())] > 0.0;
-}
-
 }  // namespace
 
 std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
@@ -105,13 +97,17 @@ std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
   std::vector<LibraryEffect> out;
   for (const std::string& joint : system.joint_names()) {
     const int dof = system.joint_dof(joint);
-    const bool slide = m->jnt_type[mj_name2id(m, mjOBJ_JOINT, joint.c_str())] == mjJNT_SLIDE;
+    const int id = mj_name2id(m, mjOBJ_JOINT, joint.c_str());
+    const bool slide = m->jnt_type[id] == mjJNT_SLIDE;
     out.push_back(linear_force_entry("joint_viscous_damping:" + joint, {"b", slide ? "N s/m" : "N m s/rad", 0.1, 0.0},
                                      fmt::format("Q_{0} = -b {0}_dot", joint), nv, viscous(dof, nv + dof)));
     out.push_back(coulomb_friction_entry("joint_coulomb_friction:" + joint, {"tau", slide ? "N" : "N m", 0.1, 0.0}, joint,
                                          joint + "_dot", nv, dof, nv + dof));
-    if (has_spring(m, joint)) {
-      const int id = mj_name2id(m, mjOBJ_JOINT, joint.c_str());
+    // A cubic spring where the model gives the joint a spring (stiffness > 0), whose force may stiffen
+    // or soften with the displacement (a Duffing oscillator). A joint without a spring has no rest
+    // position to be displaced from: a slide's origin is a convention, and a hinge may turn freely (a
+    // potential of a free angle is periodic; a cubic is not).
+    if (m->jnt_stiffness[id] > 0.0) {
       const int position = m->jnt_qposadr[id];
       const double reference = m->qpos_spring[position];
       const double stiffness = m->jnt_stiffness[id];

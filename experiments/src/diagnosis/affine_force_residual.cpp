@@ -38,17 +38,23 @@ Matrix weighted_force_regressor(const ModelSpec& model, const std::vector<const 
   Eigen::Index p = 0;
   for (const LibraryEffect* e : effects) p += static_cast<Eigen::Index>(e->parameters.size());
   Matrix out(static_cast<Eigen::Index>(rows.size()) * k, p);
+  // The unit parameter vectors e_j of each effect, made once rather than per row.
+  std::vector<std::vector<Vector>> units;
+  for (const LibraryEffect* e : effects) {
+    const auto size = static_cast<Eigen::Index>(e->parameters.size());
+    units.emplace_back();
+    for (Eigen::Index j = 0; j < size; ++j) units.back().push_back(Vector::Unit(size, j));
+  }
   Vector x(system->state_dim()), u_t(system->control_dim()), Q(k);
   for (std::size_t i = 0; i < rows.size(); ++i) {
     x = c.data->x.row(rows[i]).transpose();
     u_t = u.row(rows[i]).transpose();
     Eigen::Index column = 0;
-    for (const LibraryEffect* e : effects) {
-      const auto size = static_cast<Eigen::Index>(e->parameters.size());
-      for (Eigen::Index j = 0; j < size; ++j, ++column) {  // g_j = Q_e(x, u; e_j), Q_e linear in theta
+    for (std::size_t e = 0; e < effects.size(); ++e) {
+      for (const Vector& unit : units[e]) {  // g_j = Q_e(x, u; e_j), Q_e linear in theta
         Q.setZero();
-        e->force->add_force(x, u_t, Vector::Unit(size, j), Q, nullptr, nullptr, *workspace);
-        out.block(static_cast<Eigen::Index>(i) * k, column, k, 1) = sqrt_w.cwiseProduct(Q);
+        effects[e]->force->add_force(x, u_t, unit, Q, nullptr, nullptr, *workspace);
+        out.block(static_cast<Eigen::Index>(i) * k, column++, k, 1) = sqrt_w.cwiseProduct(Q);
       }
     }
   }
