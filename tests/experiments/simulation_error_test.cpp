@@ -156,7 +156,7 @@ TEST(SimulationError, TheRequestChecksCriterionAndWindow) {
   r.window.reset();
   EXPECT_EQ(diagnosis_options(r).criterion, FitCriterion::InverseDynamics);
   r.criterion = "output";
-  EXPECT_NE(message().find("--criterion 'output': expected 'auto', 'one-step', 'simulation' or 'inverse-dynamics'"),
+  EXPECT_NE(message().find("--criterion 'output': expected 'auto', 'one-step', 'simulation', 'inverse-dynamics' or 'inverse-dynamics-iv'"),
             std::string::npos) << message();
   DiagnosisOptions o;
   o.model.system = "cartpole";
@@ -176,7 +176,7 @@ TEST(SimulationErrorCli, TheCommandLineTakesTheOptionsAndNamesThemInItsErrors) {
   EXPECT_NE(one_step.err.find("--window 10: windows belong to --criterion simulation"), std::string::npos) << one_step.err;
   const auto unknown = test::run_cli(call + " --criterion pem --window 10");
   EXPECT_EQ(unknown.status, 2);
-  EXPECT_NE(unknown.err.find("--criterion 'pem': expected 'auto', 'one-step', 'simulation' or 'inverse-dynamics'"),
+  EXPECT_NE(unknown.err.find("--criterion 'pem': expected 'auto', 'one-step', 'simulation', 'inverse-dynamics' or 'inverse-dynamics-iv'"),
             std::string::npos) << unknown.err;
 }
 

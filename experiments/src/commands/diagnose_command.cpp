@@ -1,5 +1,5 @@
 /// `gpilqg diagnose --system NAME --data FILE [--model F.toml] [--add EFFECT[=VALUE]]... [--json]
-/// [--out F.h5] [--plots DIR] [--horizons LIST] [--criterion one-step|simulation --window N]`: compare
+/// [--out F.h5] [--plots DIR] [--horizons LIST] [--criterion one-step|simulation --window N|inverse-dynamics[-iv]]`: compare
 /// a model with measurements, see where it fails, learn which physical effect is missing, add it and
 /// watch the error fall (docs/command-line.md#gpilqg-diagnose---system-name---data-file-options; the
 /// effects: docs/diagnosis.md#the-physical-effects-library-coreeffect_libraryhpp-coreeffectshpp; the
@@ -187,7 +187,8 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--criterion", r.criterion,
                   "Error the effects are fitted to and scored on: one-step; simulation over --window samples from "
                   "measured states (finds effects too small to see in one step, e.g. light damping); or "
-                  "inverse-dynamics, the generalised-force residual (torque-sensing robots, measured velocities)")
+                  "inverse-dynamics, the generalised-force residual (torque-sensing robots, measured velocities), or "
+                  "inverse-dynamics-iv, its instrumental-variable form (IDIM-IV: no bias from noisy velocities)")
       ->capture_default_str();
   auto* window = cmd->add_option("--window", o->window,
                                  "Samples per simulation window, with --criterion simulation (e.g. a few periods of the "

@@ -83,9 +83,14 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
     throw InputError(std::string("--backend: ") + e.what());
   }
   const bool chosen_by_data = o.criterion == "auto";
-  const auto criterion = chosen_by_data ? std::optional<FitCriterion>(FitCriterion::OneStep) : parse_fit_criterion(o.criterion);
+  // inverse-dynamics-iv: the inverse-dynamics criterion in its instrumental-variable form.
+  const bool instruments = o.criterion == "inverse-dynamics-iv";
+  const auto criterion = chosen_by_data ? std::optional<FitCriterion>(FitCriterion::OneStep)
+                         : instruments  ? std::optional<FitCriterion>(FitCriterion::InverseDynamics)
+                                        : parse_fit_criterion(o.criterion);
   if (!criterion)
-    throw InputError("--criterion '" + o.criterion + "': expected 'auto', 'one-step', 'simulation' or 'inverse-dynamics'");
+    throw InputError("--criterion '" + o.criterion +
+                     "': expected 'auto', 'one-step', 'simulation', 'inverse-dynamics' or 'inverse-dynamics-iv'");
   if (chosen_by_data && o.window)
     throw InputError(fmt::format("--window {}: windows belong to --criterion simulation; with --criterion auto the data "
                                  "choose the criterion and its window", *o.window));
@@ -96,12 +101,13 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
     throw InputError(fmt::format("--window {}: windows belong to --criterion simulation; the criterion is {}", *o.window,
                                  fit_criterion_name(*criterion)));
   if (*criterion == FitCriterion::InverseDynamics && !find_system(o.system)->generalised_forces)
-    throw InputError(fmt::format("--criterion inverse-dynamics: system '{}' has no generalised-force map, so it has no "
-                                 "generalised-force residual; expected 'one-step' or 'simulation'", o.system));
+    throw InputError(fmt::format("--criterion {}: system '{}' has no generalised-force map, so it has no "
+                                 "generalised-force residual; expected 'one-step' or 'simulation'", o.criterion, o.system));
   if (o.window && (*o.window < 1 || *o.window > limits::kMaxHorizon))
     throw InputError(fmt::format("--window {}: expected a whole number of samples from 1 to {}", *o.window, limits::kMaxHorizon));
   d.criterion = *criterion;
   d.choose_criterion = chosen_by_data;
+  d.instruments = instruments;
   d.window = o.window ? static_cast<int>(*o.window) : 1;
   d.auto_select = o.auto_select;
   if (o.search == "subsets") d.search = SearchMethod::Subsets;

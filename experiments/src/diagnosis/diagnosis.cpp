@@ -13,6 +13,7 @@
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
 namespace gpilqg::diagnosis {
@@ -257,6 +258,14 @@ struct ModelAsGiven {
   Vector weights;                         ///< 1 / floor_i^2 of r_0 and its GP (floor_weights)
 };
 
+/// The fit context of the options' criterion (criterion_context), with the instruments of the
+/// inverse-dynamics criterion's IV form when it is asked for (instrumental_variables.hpp).
+FitContext options_context(const DiagnosisOptions& o, const FitContext& base, int* restarts = nullptr) {
+  FitContext context = criterion_context(base, o.criterion, o.window, restarts);
+  if (o.instruments && o.criterion == FitCriterion::InverseDynamics) context.instruments = simulated_instruments(context);
+  return context;
+}
+
 ModelAsGiven model_as_given(const DiagnosisOptions& o, const FitContext& settings) {
   const Transitions& data = *settings.data;
   ModelAsGiven given;
@@ -287,8 +296,7 @@ void add_requested_effects(const DiagnosisOptions& o, const ModelAsGiven& given,
       to_fit.push_back(&effect);
       continue;
     }
-    const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, given.weights, residual},
-                                                 o.criterion, o.window);
+    const FitContext context = options_context(o, {&data, R.model, o.integrator, R.dt, o.substeps, given.weights, residual});
     R.added.push_back(score_effect(effect, *request.values, context));
     R.model = R.model.with(effect, *request.values);
     residual = residual_of_model(R.model, settings);
@@ -302,8 +310,7 @@ void add_requested_effects(const DiagnosisOptions& o, const ModelAsGiven& given,
     const bool kept = std::find(kept_as_given.begin(), kept_as_given.end(), r.effect->name) != kept_as_given.end();
     if (!requested && !kept) refit.push_back(r);
   }
-  const FitContext context = criterion_context({&data, R.model, o.integrator, R.dt, o.substeps, given.weights, residual},
-                                               o.criterion, o.window);
+  const FitContext context = options_context(o, {&data, R.model, o.integrator, R.dt, o.substeps, given.weights, residual});
   const EffectFit joint = fit_jointly(*to_fit.front(), refit, context);
   R.model = R.model.with(*to_fit.front(), joint.estimate);
   for (const EffectValues& v : joint.refitted) R.model = R.model.with(named(candidates, v.effect), v.estimate);
@@ -397,8 +404,9 @@ void where(const DiagnosisOptions& o, const MeasurementSet& set, DiagnosisReport
 void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidates, DiagnosisReport& R) {
   R.criterion = o.criterion;
   R.window = o.window;
-  FitContext context = criterion_context({&R.data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual},
-                                         o.criterion, o.window, &R.window_restarts);
+  FitContext context = options_context(o, {&R.data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual},
+                                       &R.window_restarts);
+  R.instruments = context.instruments;
   context.excluded = o.exclude;
   R.excluded = o.exclude;
   // On the force residual M qdd - h(q, qdot, k u) the inertias and the actuators' gains can all shrink

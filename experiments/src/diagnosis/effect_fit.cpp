@@ -22,6 +22,7 @@
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 
@@ -288,33 +289,36 @@ void score_heldout(const SetResidual& residual, const Vector& theta, const FitCo
   fit.z_score = se > 0.0 ? fit.explained / se : (fit.explained > 0.0 ? 1e6 : 0.0);
 }
 
-/// The 95% interval at theta_hat (step 3): [low, high].
+/// The 95% interval at theta_hat (step 3): [low, high]. With instruments (Q, an orthonormal basis of
+/// Z, instrumental_variables.hpp) the IV covariance s^2 (Q'J)^-1 (J'Q)^-1 and the jackknife of the
+/// equations Q' r = 0; without (Q empty) Z = J, least squares.
 std::pair<Vector, Vector> confidence_interval(const SetResidual& residual, const Vector& estimate, const FitContext& c,
-                                              const std::vector<int>& rows) {
+                                              const std::vector<int>& rows, const Matrix& Q) {
   const Matrix J = residual.regressor(estimate, rows);
   const Vector r = residual.at(estimate, rows);
+  const Matrix& Z = Q.size() > 0 ? Q : J;
   const auto p = J.cols();
   const auto n = static_cast<Eigen::Index>(c.weights.size());
-  const Matrix A = J.transpose() * J;
-  const Eigen::LDLT<Matrix> A_ldlt(A);
+  const Matrix A = Z.transpose() * J;
+  const Matrix A_inverse = A.fullPivLu().inverse();
   const double dof = std::max<double>(1.0, static_cast<double>(J.rows() - p));
-  Vector variance = (r.squaredNorm() / dof) * A_ldlt.solve(Matrix::Identity(p, p)).diagonal();
+  Vector variance = (r.squaredNorm() / dof) * (A_inverse * (Z.transpose() * Z) * A_inverse.transpose()).diagonal();
   // Delete-one-episode jackknife, each replicate one Gauss-Newton step from theta_hat.
   std::map<int, std::pair<Matrix, Vector>> per_episode;
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const int e = c.data->episode[static_cast<std::size_t>(rows[k])];
     auto [it, inserted] = per_episode.try_emplace(e, Matrix::Zero(p, p), Vector::Zero(p));
-    const auto Jk = J.middleRows(static_cast<Eigen::Index>(k) * n, n);
-    it->second.first += Jk.transpose() * Jk;
-    it->second.second += Jk.transpose() * r.segment(static_cast<Eigen::Index>(k) * n, n);
+    const auto Zk = Z.middleRows(static_cast<Eigen::Index>(k) * n, n);
+    it->second.first += Zk.transpose() * J.middleRows(static_cast<Eigen::Index>(k) * n, n);
+    it->second.second += Zk.transpose() * r.segment(static_cast<Eigen::Index>(k) * n, n);
   }
-  const Vector g = J.transpose() * r;
+  const Vector g = Z.transpose() * r;
   const auto E = static_cast<double>(per_episode.size());
   if (E >= 2.0) {
     std::vector<Vector> replicates;
     Vector mean = Vector::Zero(p);
     for (const auto& [e, sums] : per_episode) {
-      const Vector step = (A - sums.first).ldlt().solve(g - sums.second);
+      const Vector step = (A - sums.first).fullPivLu().solve(g - sums.second);
       if (!step.allFinite()) continue;
       replicates.push_back(estimate + step);
       mean += replicates.back();
@@ -331,7 +335,7 @@ std::pair<Vector, Vector> confidence_interval(const SetResidual& residual, const
   // the data no longer see it) is no interval of zero width but an unbounded one.
   Vector half = 1.96 * variance.cwiseMax(0.0).cwiseSqrt();
   for (Eigen::Index j = 0; j < p; ++j)
-    if (!std::isfinite(half(j)) || !(A(j, j) > 0.0)) half(j) = std::numeric_limits<double>::infinity();
+    if (!std::isfinite(half(j)) || !(J.col(j).squaredNorm() > 0.0)) half(j) = std::numeric_limits<double>::infinity();
   return {estimate - half, estimate + half};
 }
 
@@ -376,35 +380,56 @@ namespace {
 EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& null, const Vector& theta_ls,
                      const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high, EffectFit fit);
 
-/// S(theta), or +inf where the model diverges or does not accept theta (a mass of 0, say).
-double objective_at(const SetResidual& residual, const VectorCRef& theta, const std::vector<int>& rows) {
+/// S(theta), or +inf where the model diverges or does not accept theta (a mass of 0, say). With
+/// instruments (Q not empty, instrumental_variables.hpp) the IV objective |Q' r(theta)|^2.
+double objective_at(const SetResidual& residual, const VectorCRef& theta, const std::vector<int>& rows,
+                    const Matrix& Q = {}) {
   try {
     bool finite = true;
     const Vector r = residual.at(theta, rows, &finite);
-    return finite ? r.squaredNorm() : std::numeric_limits<double>::infinity();
+    if (!finite) return std::numeric_limits<double>::infinity();
+    return Q.size() > 0 ? (Q.transpose() * r).squaredNorm() : r.squaredNorm();
   } catch (const std::invalid_argument&) {
     return std::numeric_limits<double>::infinity();
   }
 }
 
+/// The Gauss-Newton step d minimising |r - J d|^2, or with instruments |Q' (r - J d)|^2, which for
+/// as many instruments as parameters solves Z' (r - J d) = 0.
+Vector least_squares_step(const Matrix& J, const Vector& r, const Matrix& Q) {
+  if (Q.size() == 0) return J.colPivHouseholderQr().solve(r);
+  return (Q.transpose() * J).colPivHouseholderQr().solve(Q.transpose() * r);
+}
+
+/// Q, the instruments' basis of a set of effects at theta on `rows` (instrumental_variables.hpp): their
+/// regressor evaluated at the simulated states. Empty without instruments.
+Matrix instruments_of(const EffectSet& set, const Vector& theta, const FitContext& c, const std::vector<int>& rows) {
+  if (!c.instruments) return {};
+  const FitContext at_simulation = instrument_context(c, *c.instruments);
+  const SetResidual residual(set, theta, at_simulation);
+  return instrument_basis(residual.regressor(theta, rows), *c.instruments, rows);
+}
+
 /// Gauss-Newton from `theta` (updated in place), at most `iterations` steps, each clamped to the
 /// physical range and halved (up to 6 times) until S falls; stops when a step lowers S by less than
-/// 1e-9 of it. Returns S at the final theta; `evaluations` counts the residual evaluations.
+/// 1e-9 of it. Returns S at the final theta; `evaluations` counts the residual evaluations. With
+/// instruments (Q not empty) the same on the projected residual Q' r and regressor Q' J: the steps of
+/// the IV equations Z' r(theta) = 0 (instrumental_variables.hpp).
 double refine_gauss_newton(const SetResidual& residual, Vector& theta, const Vector& lower, const Vector& upper,
-                           const std::vector<int>& rows, int iterations, int& evaluations) {
-  double at_theta = objective_at(residual, theta, rows);
+                           const std::vector<int>& rows, int iterations, int& evaluations, const Matrix& Q = {}) {
+  double at_theta = objective_at(residual, theta, rows, Q);
   ++evaluations;
   for (int k = 0; k < iterations && std::isfinite(at_theta); ++k) {
     const Vector r = residual.at(theta, rows);
     const Matrix J = residual.regressor(theta, rows);
     evaluations += 1 + 2 * static_cast<int>(theta.size());
     if (!J.allFinite() || !r.allFinite()) break;
-    const Vector step = J.colPivHouseholderQr().solve(r);
+    const Vector step = least_squares_step(J, r, Q);
     if (!step.allFinite()) break;
     bool lowered = false;
     for (double scale = 1.0; scale > 1.0 / 64.0 && !lowered; scale *= 0.5) {
       const Vector next = clamp_to(theta + scale * step, lower, upper);
-      const double at_next = objective_at(residual, next, rows);
+      const double at_next = objective_at(residual, next, rows, Q);
       ++evaluations;
       if (at_next < at_theta) {
         const bool converged = at_theta - at_next <= 1e-9 * at_theta;
@@ -515,23 +540,31 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
   const Matrix J = residual.regressor(initial, training);
   fit.regressor = J.col(0);
   fit.scale = data_scales(J, c, training, null);
+  // IDIM-IV: the instruments of the set, fixed at theta_0 (instrumental_variables.hpp).
+  const Matrix Q = J.allFinite() ? instruments_of(set, initial, c, training) : Matrix();
   if (!(J.col(0).norm() > 0.0) || !J.allFinite()) {
     fit.identifiable = false;
     fit.not_identifiable = "it does not change the predictions";
     fit.training_objective_after = residual.at(initial, training).squaredNorm();
+  } else if (c.instruments && Q.size() == 0) {
+    fit.identifiable = false;
+    fit.not_identifiable = "it has no instrument: its regressor at the simulated states is zero or collinear";
+    fit.training_objective_after = residual.at(initial, training).squaredNorm();
   } else {
     const Vector r_initial = residual.at(initial, training);
-    const Vector delta = J.colPivHouseholderQr().solve(r_initial);
+    const Vector delta = least_squares_step(J, r_initial, Q);
     theta_ls = clamp_to(initial + delta, lower, upper);
     // 2. Gauss-Newton on S(theta) inside the physical range, from theta_0: its first step is the
     // least-squares step above, halved when it does not lower S (a nonlinear effect far from theta_0).
     theta_hat = initial;
     fit.training_objective_after =
         refine_gauss_newton(residual, theta_hat, lower, upper, training,
-                            set.linear() ? kLinearRefinements : kNonlinearRefinements, fit.evaluations);
+                            set.linear() ? kLinearRefinements : kNonlinearRefinements, fit.evaluations, Q);
+    // The IV fit minimised the projected objective; the fit's objective is the residual's own.
+    if (Q.size() > 0) fit.training_objective_after = objective_at(residual, theta_hat, training);
 
     // 3. Interval, and whether the data determine the fit.
-    std::tie(ci_low, ci_high) = confidence_interval(residual, theta_hat, c, training);
+    std::tie(ci_low, ci_high) = confidence_interval(residual, theta_hat, c, training, Q);
     check_identifiable(set, theta_hat, ci_low, ci_high, null, fit);
   }
   // 4. Held-out scores; then each effect's slice.

@@ -128,6 +128,18 @@ json where_json(const DiagnosisReport& r) {
           {"episode_rmse", episodes}};
 }
 
+/// The instruments of the IV form of inverse dynamics (instrumental_variables.hpp), or null.
+json instruments_json(const DiagnosisReport& r) {
+  if (!r.instruments) return nullptr;
+  long instrumented = 0;
+  for (const bool b : r.instruments->instrumented) instrumented += b ? 1 : 0;
+  return {{"window", r.instruments->window},
+          {"reach", r.instruments->reach},
+          {"instrumented_rows", instrumented},
+          {"rows", r.instruments->instrumented.size()},
+          {"restarts", r.instruments->restarts}};
+}
+
 json whiteness_json(const DiagnosisReport& r) {
   const Whiteness& w = r.whiteness;
   json states = json::array();
@@ -281,8 +293,9 @@ nlohmann::json report_json(const DiagnosisReport& r) {
           {"where", where_json(r)},
           {"gp_explained", r.gp_explained_total},
           {"criterion",
-           {{"name", fit_criterion_name(r.criterion)},
+           {{"name", fit_criterion_name(r.criterion) + (r.instruments ? "-iv" : "")},
             {"window", r.window},
+            {"instruments", instruments_json(r)},
             {"restarts", r.window_restarts},
             {"chosen_by", r.criterion_reason.empty() ? "user" : "data"},
             {"excluded", r.criterion_excluded},

@@ -84,8 +84,10 @@ FitContext inverse_dynamics_context(FitContext context) {
   const DynamicsPtr system = context.model.build();
   const ForceComponents components = force_components(*system);
   const auto k = static_cast<Eigen::Index>(components.forces.size());
-  context.accelerations =
-      std::make_shared<const Matrix>(estimate_accelerations(data, components.velocity_states(), context.dt).qdd);
+  const AccelerationEstimate estimate = estimate_accelerations(data, components.velocity_states(), context.dt);
+  context.accelerations = std::make_shared<const Matrix>(estimate.qdd);
+  context.acceleration_reach = 0;
+  for (const DerivativeWindow& w : estimate.windows) context.acceleration_reach = std::max(context.acceleration_reach, w.window / 2);
   const std::vector<int> rows = all_rows(data);
   context.residual = generalised_force_residual(context.model, data, *context.accelerations, rows);
   // The model's own force: the residual at zero acceleration is -W_v^-1 f_v.

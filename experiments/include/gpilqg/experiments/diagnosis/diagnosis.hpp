@@ -58,6 +58,7 @@
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/free_run.hpp"
 #include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
+#include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
@@ -93,6 +94,9 @@ struct DiagnosisOptions {
   /// over windows of `window` samples from measured states (--criterion, --window).
   FitCriterion criterion = FitCriterion::OneStep;
   int window = 1;                         ///< samples per window; 1 unless the criterion is simulation
+  /// Inverse dynamics in its instrumental-variable form (IDIM-IV, instrumental_variables.hpp;
+  /// `--criterion inverse-dynamics-iv`): instruments from the model simulated over short windows.
+  bool instruments = false;
   /// `--criterion auto`: criterion and window are chosen from the data by choose_criterion
   /// (criterion_choice.hpp) before anything else; `criterion` and `window` are then ignored.
   bool choose_criterion = false;
@@ -228,6 +232,9 @@ struct DiagnosisReport {
   /// restart from the measurement (0 for the one-step criterion, whose divergences are counted in
   /// non_finite_predictions).
   int window_restarts = 0;
+  /// Inverse dynamics in its IV form: the simulated data of the instruments (instrumental_variables.hpp);
+  /// null for least squares and the other criteria.
+  std::shared_ptr<const Instruments> instruments;
   std::vector<RankedEffect> ranking;
   std::vector<std::string> excluded;     ///< candidates left out by the user (DiagnosisOptions::exclude)
   /// Candidates the criterion cannot identify and leaves out: under inverse dynamics the actuators'

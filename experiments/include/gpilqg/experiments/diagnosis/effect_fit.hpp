@@ -55,6 +55,8 @@
 
 namespace gpilqg::diagnosis {
 
+struct Instruments;  // instrumental_variables.hpp
+
 /// The data and model a fit works on. The criterion's channels are the states (one-step, simulation)
 /// or the generalised-force components (inverse dynamics): c of them below.
 struct FitContext {
@@ -79,6 +81,12 @@ struct FitContext {
   /// (N x k, the scale of EffectFit::scale). Null for the other criteria.
   std::shared_ptr<const Matrix> accelerations = {};
   std::shared_ptr<const Matrix> own_force = {};
+  /// Inverse dynamics: h, the half-width of the widest window of the acceleration estimate (the rows
+  /// a measured sample's noise reaches); 0 for the other criteria.
+  int acceleration_reach = 0;
+  /// Inverse dynamics in its instrumental-variable form (instrumental_variables.hpp): the simulated
+  /// data the instruments are evaluated at; null for least squares.
+  std::shared_ptr<const Instruments> instruments = {};
   /// Candidates left out of every ranking and search (`--exclude`): effects the user declares
   /// physically meaningless for these data (an armature when torques are measured after the gearbox).
   std::vector<std::string> excluded = {};
