@@ -27,17 +27,6 @@ namespace {
 
 using namespace diagnosis;
 
-/// A random-phase multisine of RMS `rms` over whole periods of 5 s: 8 tones of equal amplitude at
-/// 0.2, 0.4, ..., 1.6 Hz (around the carriage's 0.71 Hz), phases fixed per episode.
-double multisine(int episode, int k, double dt, double rms) {
-  double u = 0.0;
-  for (int j = 1; j <= 8; ++j) {
-    const double phase = std::fmod(1.7 * j * j + 2.3 * episode * j + 0.5 * episode, 2.0 * M_PI);
-    u += std::sin(2.0 * M_PI * 0.2 * j * k * dt + phase);
-  }
-  return rms * u / 2.0;  // 8 tones of amplitude rms / 2: RMS sqrt(8 / 2) rms / 2 = rms
-}
-
 /// Data of the carriage with the hidden effects `truth`, driven by c0 + a multisine of RMS `rms`;
 /// velocities measured (one-step criterion), 6 episodes of 3 s.
 MeasurementSet carriage_data(const std::vector<std::pair<std::string, double>>& truth, double c0, double rms) {
@@ -46,7 +35,7 @@ MeasurementSet carriage_data(const std::vector<std::pair<std::string, double>>& 
   world.system = file;
   for (const auto& [effect, value] : truth) world = world.with(find_effect(file, effect), Vector::Constant(1, value));
   test::SlideRecording s;
-  s.command = [c0, rms](int e, int k) { return c0 + multisine(e, k, 0.01, rms); };
+  s.command = [c0, rms](int e, int k) { return c0 + test::multisine(e, k, 0.01, rms); };
   s.force_noise = 0.05;
   s.position_noise = 1e-4;
   s.velocity_noise = 2e-3;

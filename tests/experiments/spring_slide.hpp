@@ -6,6 +6,7 @@
 /// 10 ms timestep, as the diagnosis steps the model), so the only difference between world and model
 /// is the hidden effects and the noise.
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -27,6 +28,18 @@ inline std::string spring_slide_model() {
 /// The model's carriage mass [kg] and spring stiffness [N/m], as in the file.
 inline constexpr double kSlideMass = 1.0;
 inline constexpr double kSlideStiffness = 20.0;
+
+/// A random-phase multisine: 8 tones of equal amplitude at 0.2, 0.4, ..., 1.6 Hz (around the carriage's
+/// 0.71 Hz), phases fixed per episode, at sample k of step dt. Its RMS over its 5 s period is `rms`
+/// (8 tones of amplitude rms / 2); over a few seconds it is close to that.
+inline double multisine(int episode, int k, double dt, double rms) {
+  double u = 0.0;
+  for (int j = 1; j <= 8; ++j) {
+    const double phase = std::fmod(1.7 * j * j + 2.3 * episode * j + 0.5 * episode, 2.0 * M_PI);
+    u += std::sin(2.0 * M_PI * 0.2 * j * k * dt + phase);
+  }
+  return rms * u / 2.0;
+}
 
 struct SlideRecording {
   int episodes = 6;
