@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ostream>
 
 #include "diagnosis_support.hpp"
 #include "gpilqg/core/system_registry.hpp"
@@ -146,6 +147,10 @@ struct NearAlias {
   double rms;
   bool aliases;
 };
+
+std::ostream& operator<<(std::ostream& os, const NearAlias& c) {
+  return os << "s = " << c.rms << " N, " << (c.aliases ? "aliases" : "not aliases");
+}
 
 class EffectAliasThreshold : public ::testing::TestWithParam<NearAlias> {};
 
