@@ -19,7 +19,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "diagnosis_support.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"

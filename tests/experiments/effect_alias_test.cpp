@@ -17,6 +17,9 @@
 #include <cmath>
 #include <cstdio>
 #include <ostream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "diagnosis_support.hpp"
 #include "gpilqg/core/system_registry.hpp"

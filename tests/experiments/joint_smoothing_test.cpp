@@ -13,6 +13,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <string>
 
 #include "diagnosis_support.hpp"
 #include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
