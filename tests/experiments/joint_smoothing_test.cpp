@@ -3,7 +3,7 @@
 // the cart-pole with Coulomb friction on the cart (mu = 1.5 N, v0 = 0.03 m/s) and on the pole
 // (tau = 0.3 N m, v0 = 0.025 rad/s) and a constant force on the cart (0.8 N), the frictions being
 // tanh(qdot / v0) exactly as the library's. Both v0 lie inside the rule's grid (0.002 to 0.2 times the
-// RMS velocity, here 0.25 to 0.42 m/s and 0.24 to 0.33 rad/s) and between its points. The rule
+// RMS velocity, here 0.25 to 0.30 m/s and 0.26 to 0.33 rad/s) and between its points. The rule
 // promises the grid point of least training error refined by a parabola in log v0: so within a grid
 // step (a factor 2 to 2.5) of the truth, and closer where the refinement works. Each v0 fitted alone
 // is biased by the other effects (the constant force, the other friction): the set's must not be,
