@@ -444,9 +444,10 @@ double refine_gauss_newton(const SetResidual& residual, Vector& theta, const Vec
   return at_theta;
 }
 
-/// Gauss-Newton steps from theta_0: effects linear in their parameters need two (the least-squares
-/// step, then what the integrator leaves of the nonlinearity); the others (a mass, a length, a delay)
-/// up to this many.
+/// Gauss-Newton steps from theta_0: effects linear in their parameters need two on one step or the
+/// force residual (the least-squares step, then what the integrator leaves of the nonlinearity); the
+/// others (a mass, a length, a delay), and every effect under the simulation criterion, whose
+/// prediction over a window is not linear in any parameter, up to this many.
 constexpr int kLinearRefinements = 2;
 constexpr int kNonlinearRefinements = 12;
 
@@ -559,7 +560,8 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
     theta_hat = initial;
     fit.training_objective_after =
         refine_gauss_newton(residual, theta_hat, lower, upper, training,
-                            set.linear() ? kLinearRefinements : kNonlinearRefinements, fit.evaluations, Q);
+                            set.linear() && c.window == 1 ? kLinearRefinements : kNonlinearRefinements,
+                            fit.evaluations, Q);
     // The IV fit minimised the projected objective; the fit's objective is the residual's own.
     if (Q.size() > 0) fit.training_objective_after = objective_at(residual, theta_hat, training);
 

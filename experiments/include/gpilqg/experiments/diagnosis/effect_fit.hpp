@@ -18,7 +18,8 @@
 ///    step.
 /// 2. Gauss-Newton on S from theta_0, each step clamped to the parameters' physical range and halved
 ///    until S falls: two steps for effects linear in theta (the first is step 1's), up to twelve for
-///    the others; this gives the final estimate theta_hat. (A derivative-free search took 30 to 200
+///    the others and for every effect under the simulation criterion (its prediction over a window
+///    is not linear in theta); this gives the final estimate theta_hat. (A derivative-free search took 30 to 200
 ///    evaluations of S per parameter; on 25,000 samples of a MuJoCo model that was most of the time.)
 /// 3. A 95% interval from the Gauss-Newton covariance at theta_hat, s^2 (J'WJ)^-1 with
 ///    s^2 = S / (N n - p), widened to the delete-one-episode jackknife when that is larger: one-step
