@@ -270,6 +270,37 @@ TEST(CriterionChoice, SmoothMeasuredTorquesAtOneKilohertzChooseInverseDynamics) 
   EXPECT_EQ(c.facts.not_forces, "");
   EXPECT_GE(actual, kInverseDynamicsRatio);
   EXPECT_NEAR(std::log(c.facts.ratio / actual), 0.0, std::log(2.0)) << "within a factor of 2 of the actual ratio";
+  EXPECT_FALSE(c.instruments) << "velocity noise of 5e-3 rad/s biases least squares by " << c.facts.attenuation;
+}
+
+/// sigma^2 / var(v) of state `state` of `set` for white noise of std `sigma` on it: the attenuation of a
+/// least-squares friction on that velocity.
+double attenuation_of(const MeasurementSet& set, int state, double sigma) {
+  double sum = 0.0, squares = 0.0;
+  long count = 0;
+  for (const Episode& e : set.episodes) {
+    sum += e.x.col(state).sum();
+    squares += e.x.col(state).squaredNorm();
+    count += e.length();
+  }
+  const double mean = sum / static_cast<double>(count);
+  return sigma * sigma / (squares / static_cast<double>(count) - mean * mean);
+}
+
+TEST(CriterionChoice, NoisyMeasuredVelocitiesChooseTheInstrumentalVariableForm) {
+  // The same arm with velocity noise of 0.5 rad/s: least squares on the force residual would shrink a
+  // viscous friction by several percent, so the rule takes the instrumental-variable form. Its
+  // attenuation against the one of the noise put in (the larger of the two joints').
+  constexpr double kNoise = 0.5;
+  const MeasurementSet set = arm_data(0, kNoise, 2e-3);
+  const CriterionChoice c = choose_criterion(set, arm_spec());
+  const double expected = std::max(attenuation_of(set, 2, kNoise), attenuation_of(set, 3, kNoise));
+  std::printf("arm, noisy velocities: attenuation %.4g (of the noise put in %.4g): %s\n", c.facts.attenuation, expected,
+              c.reason.c_str());
+  ASSERT_EQ(c.criterion, FitCriterion::InverseDynamics) << c.reason;
+  EXPECT_TRUE(c.instruments) << c.reason;
+  EXPECT_NEAR(c.facts.attenuation, expected, 0.15 * expected);
+  EXPECT_NE(c.reason.find("instrumental-variable form"), std::string::npos) << c.reason;
 }
 
 TEST(CriterionChoice, HeldTorquesOnTheSameArmChooseOneStep) {

@@ -244,6 +244,25 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, int st
   return out;
 }
 
+/// sigma_v^2 / var(v) of one velocity state (rule 2, the IV form): the robust noise level of
+/// state_ratio over the variance of every sample of the state.
+double attenuation(const MeasurementSet& data, int state) {
+  std::vector<Vector> segments;
+  double sum = 0.0, squares = 0.0;
+  long count = 0;
+  for (const Episode& e : data.episodes) {
+    segments.push_back(e.x.col(state));
+    sum += e.x.col(state).sum();
+    squares += e.x.col(state).squaredNorm();
+    count += e.length();
+  }
+  if (count < 2) return 0.0;
+  const double mean = sum / static_cast<double>(count);
+  const double variance = squares / static_cast<double>(count) - mean * mean;
+  const double sigma = robust_noise_std(segments, 2, 4);
+  return variance > 0.0 ? sigma * sigma / variance : 0.0;
+}
+
 std::string seconds(double value) { return fmt::format("{:.3g} s", value); }
 
 std::string names(const std::vector<std::string>& list) { return fmt::format("{}", fmt::join(list, ", ")); }
@@ -372,11 +391,27 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
       facts.ratio_state, facts.acceleration_window, 1.0 / facts.dt, 100.0 * facts.control_error * facts.control_error);
   if (facts.ratio >= kInverseDynamicsRatio) {
     choice.criterion = FitCriterion::InverseDynamics;
+    for (const GeneralisedCoordinate& c : coordinates) {
+      const double lambda = attenuation(data, c.velocity);
+      if (lambda > facts.attenuation || facts.attenuation_state.empty()) {
+        facts.attenuation = lambda;
+        facts.attenuation_state = data.system.states[static_cast<std::size_t>(c.velocity)].name;
+      }
+    }
+    choice.instruments = facts.attenuation >= kInstrumentAttenuation;
+    const std::string form =
+        choice.instruments
+            ? fmt::format("; in its instrumental-variable form (IDIM-IV), since the noise of the measured {} is {:.2g}% "
+                          "of its variance, the bias least squares would have ({:g}% or more)",
+                          facts.attenuation_state, 100.0 * facts.attenuation, 100.0 * kInstrumentAttenuation)
+            : fmt::format("; by least squares, since the noise of the measured velocities biases it by {:.2g}% at "
+                          "most ({}; the instrumental-variable form from {:g}%)",
+                          100.0 * facts.attenuation, facts.attenuation_state, 100.0 * kInstrumentAttenuation);
     choice.reason = fmt::format(
         "inverse-dynamics: the controls are generalised forces, the velocities are measured, and the "
         "inverse-dynamics residual's error per sample is {:.3g} times below the one-step residual's ({}; {:.0f} "
-        "needed)",
-        facts.ratio, measured, kInverseDynamicsRatio);
+        "needed){}",
+        facts.ratio, measured, kInverseDynamicsRatio, form);
     return choice;
   }
   choice.reason = fmt::format(

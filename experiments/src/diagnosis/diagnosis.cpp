@@ -601,6 +601,7 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& op
       const CriterionChoice choice = choose_criterion(input, o.model);
       o.criterion = choice.criterion;
       o.window = choice.window;
+      o.instruments = choice.instruments;
       criterion_reason = choice.reason;
     } catch (const std::invalid_argument& e) {
       o.criterion = FitCriterion::OneStep;

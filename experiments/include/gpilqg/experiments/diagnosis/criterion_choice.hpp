@@ -59,6 +59,17 @@
 ///     integrates held controls exactly. The input delay of the model is not applied here: it shifts
 ///     the controls, not their smoothness.
 ///
+///     Its instrumental-variable form (IDIM-IV, instrumental_variables.hpp) when least squares on the
+///     force residual would be biased by the noise of the measured velocities by 1% or more
+///     (lambda >= kInstrumentAttenuation): a friction linear in a velocity v, fitted by least squares
+///     on the measured v + e, shrinks by the factor var(v) / (var(v) + sigma_v^2), so by
+///
+///       lambda = max over the velocity states of sigma_v^2 / var(v_measured)
+///
+///     to first order (sigma_v the robust noise level above, var over every sample). 1% is an accuracy
+///     below which published friction values do not go; a smaller bias is left to least squares, which
+///     needs no simulation of the model and has the smaller variance.
+///
 ///  3. One-step otherwise.
 ///
 /// The window W of the simulation criterion: two periods of the slowest motion of the velocity
@@ -91,6 +102,8 @@ namespace gpilqg::diagnosis {
 
 /// rho above which inverse-dynamics is chosen (file comment).
 inline constexpr double kInverseDynamicsRatio = 3.0;
+/// lambda at or above which inverse dynamics takes its instrumental-variable form (file comment).
+inline constexpr double kInstrumentAttenuation = 0.01;
 /// The shortest simulation window [samples].
 inline constexpr int kMinWindow = 5;
 
@@ -110,11 +123,14 @@ struct CriterionFacts {
   double slowest_period = 0.0;                ///< P of the slowest velocity state [s] (inf: slower than the episodes)
   std::string slowest_state;                  ///< that state
   int window_cap = 0;                         ///< the cap on W [samples]
+  double attenuation = 0.0;                   ///< lambda = max sigma_v^2 / var(v) (rule 2, inverse dynamics)
+  std::string attenuation_state;              ///< the velocity state of the maximum
 };
 
 struct CriterionChoice {
   FitCriterion criterion = FitCriterion::OneStep;
   int window = 1;      ///< W for the simulation criterion, else 1
+  bool instruments = false;  ///< inverse dynamics in its instrumental-variable form (rule 2)
   std::string reason;  ///< one sentence for the report: the criterion and the facts that chose it
   CriterionFacts facts;
 };
