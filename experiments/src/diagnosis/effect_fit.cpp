@@ -695,9 +695,9 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_g
   // declaration. An effect that explains nothing alone is nobody's alias.
   const LinearisedFits joint(context, fits, refit, threads);
   const auto aliases = [&](int i, int j) {
+    if (joint.gain({j}, {}) < alias_gain) return false;
     if (same_physics(*system, fits[static_cast<std::size_t>(i)].effect, fits[static_cast<std::size_t>(j)].effect))
       return true;
-    if (joint.gain({j}, {}) < alias_gain) return false;
     return joint.gain({i, j}, {i}) < alias_gain && joint.gain({i, j}, {j}) < alias_gain;
   };
   // Within a standing, the order is the cross-validated screening score on the training rows
