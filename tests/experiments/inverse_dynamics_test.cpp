@@ -331,6 +331,73 @@ TEST(InverseDynamicsResidual, MujocoArmMatchesMjInverseAndAnEffectInTheModelIsSu
   }
 }
 
+/// r_t = W_v^-1 (qdd_t - f_v(x_t, u_t)) written out: the model's forward dynamics and its generalised-force
+/// map, solved per row (generalised_force_residual.hpp's definition).
+Matrix solved_force_residual(const Dynamics& model, const Transitions& data, const Matrix& qdd) {
+  const Dynamics& owner = force_map_system(model);
+  const auto& map = dynamic_cast<const GeneralisedForceInput&>(owner);
+  const std::vector<int> velocity = force_components(model).velocity_states();
+  const auto k = static_cast<Eigen::Index>(velocity.size());
+  Matrix out(data.size(), k);
+  Vector xdot(model.state_dim());
+  Matrix W;
+  for (int t = 0; t < data.size(); ++t) {
+    const Vector x = data.x.row(t).transpose();
+    model.evaluate(x, data.u.row(t).transpose(), xdot);
+    map.generalised_force_map(x, W, nullptr);
+    Matrix W_v(k, k);
+    Vector e(k);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      W_v.row(c) = W.row(velocity[static_cast<std::size_t>(c)]);
+      e(c) = qdd(t, c) - xdot(velocity[static_cast<std::size_t>(c)]);
+    }
+    out.row(t) = W_v.fullPivLu().solve(e).transpose();
+  }
+  return out;
+}
+
+// MuJoCo's direct inverse dynamics (MujocoSystem::inverse_dynamics, no factorisation) is the solved
+// forward dynamics' residual to rounding, with an actuator gain, a force at a body, Coulomb friction and
+// recalibrated masses, armature and damping; where the model has constraint rows (frictionloss) it has
+// no direct form and the solved one is used.
+TEST(InverseDynamicsResidual, DirectMujocoInverseDynamicsIsTheSolvedForwardDynamics) {
+  const int T = 40;
+  Matrix x(T, 4), u(T, 2);
+  for (int i = 0; i < T; ++i) {
+    x.row(i) = test::random_vector(4, -2.0, 2.0, 1300 + i).transpose();
+    u.row(i) = test::random_vector(2, -3.0, 3.0, 1600 + i).transpose();
+  }
+  const Transitions data = transitions_of({x}, {u}, 0.01);
+  Matrix qdd(data.size(), 2);
+  for (int r = 0; r < data.size(); ++r) qdd.row(r) = test::random_vector(2, -30.0, 30.0, 1900 + r).transpose();
+  std::vector<int> rows;
+  for (int r = 0; r < data.size(); ++r) rows.push_back(r);
+
+  ModelSpec bare;
+  bare.system = arm_path();
+  ModelSpec decorated = bare;
+  decorated.actuator_gain = 1.3;
+  decorated.parameters = {{"forearm.mass", 0.9}, {"elbow.armature", 0.02}, {"shoulder.damping", 0.2}};
+  decorated.forces.push_back({"joint_coulomb_friction:elbow", Vector::Constant(1, 0.4)});
+  decorated.forces.push_back({"external_force_x:forearm", Vector::Constant(1, 1.5)});
+  ModelSpec friction_loss = bare;
+  friction_loss.parameters = {{"elbow.frictionloss", 0.3}};
+  for (const ModelSpec* model : {&bare, &decorated, &friction_loss}) {
+    const DynamicsPtr system = model->build();
+    const Matrix direct = generalised_force_residual(*system, data, data.u, qdd, rows);
+    const Matrix solved = solved_force_residual(*system, data, qdd);
+    for (int t = 0; t < data.size(); ++t)
+      EXPECT_MATRIX_NEAR(direct.row(t).transpose(), solved.row(t).transpose(), 1e-9 * (1.0 + solved.row(t).norm()));
+    // Whether the direct form applies: not with frictionloss's constraint rows.
+    const auto& owner = dynamic_cast<const GeneralisedForceInput&>(force_map_system(*system));
+    const auto workspace = force_map_system(*system).make_workspace();
+    Vector Q(2);
+    EXPECT_EQ(owner.inverse_dynamics(data.x.row(0).transpose(), data.u.row(0).transpose(), qdd.row(0).transpose(), Q,
+                                     *workspace),
+              model != &friction_loss);
+  }
+}
+
 /// A system without a generalised-force map: xdot = u.
 class Integrator1D final : public Dynamics {
  public:
