@@ -734,6 +734,40 @@ TEST(InverseDynamicsFit, RecalibrationWithALinearForceEndsAtTheRebuiltModelsMini
   }
 }
 
+// Parameters of the model whose residual is affine in them (a mass with its inertia, an armature, a
+// damping, a stiffness, alone or with a linear force) are fitted in the closed form from probes of the
+// model; the fit is the rebuilt model's at every theta (the general path) to rounding. Frictionloss
+// (MuJoCo's dry friction, a constraint of the forward solver) is not affine: both paths are the
+// rebuilt model's and agree exactly.
+TEST(InverseDynamicsFit, ProbedClosedFormIsTheRebuiltModelsFit) {
+  const FitContext& closed = friction_fit_context();
+  FitContext rebuilt = closed;
+  rebuilt.probe_affine = false;
+  const LibraryEffect coulomb = find_candidate(closed.model, "joint_coulomb_friction:elbow");
+  for (const char* name : {"param:forearm.mass", "param:upper_arm.mass", "param:elbow.armature", "param:shoulder.damping",
+                           "param:elbow.stiffness", "param:elbow.frictionloss"}) {
+    const LibraryEffect effect = find_candidate(closed.model, name);
+    for (const bool with_force : {false, true}) {
+      const std::vector<RefitEffect> refit =
+          with_force ? std::vector<RefitEffect>{{&coulomb, Vector::Zero(1)}} : std::vector<RefitEffect>{};
+      const EffectFit a = fit_jointly(effect, refit, closed), b = fit_jointly(effect, refit, rebuilt);
+      std::printf("%s%s: %.8g [%.6g, %.6g] (rebuilt %.8g [%.6g, %.6g]), explained %.6f (%.6f)\n", name,
+                  with_force ? " with elbow Coulomb" : "", a.estimate(0), a.ci_low(0), a.ci_high(0), b.estimate(0),
+                  b.ci_low(0), b.ci_high(0), a.explained, b.explained);
+      ASSERT_EQ(a.identifiable, b.identifiable) << name;
+      const double scale = std::max(1e-3, std::abs(b.estimate(0)));
+      EXPECT_NEAR(a.estimate(0), b.estimate(0), 1e-7 * scale) << name;
+      EXPECT_NEAR(a.ci_high(0) - a.ci_low(0), b.ci_high(0) - b.ci_low(0), 1e-5 * (b.ci_high(0) - b.ci_low(0))) << name;
+      EXPECT_NEAR(a.explained, b.explained, 1e-9) << name;
+      EXPECT_NEAR(a.training_objective_after, b.training_objective_after, 1e-9 * b.training_objective_after) << name;
+      if (with_force) {
+        ASSERT_EQ(a.refitted.size(), 1u);
+        EXPECT_NEAR(a.refitted[0].estimate(0), b.refitted[0].estimate(0), 1e-7 * std::abs(b.refitted[0].estimate(0)));
+      }
+    }
+  }
+}
+
 // --- The whole diagnosis on the inverse-dynamics criterion ------------------------------------------
 
 // The noisy record as a measurement file would hold it, diagnosed with --auto on the inverse-dynamics
