@@ -142,6 +142,6 @@ BENCHMARK(BM_DiagnoseOneEffect)->Unit(benchmark::kSecond)->Iterations(3);
 BENCHMARK(BM_DiagnoseAutoThreeEffects)->Unit(benchmark::kSecond)->Iterations(3);
 BENCHMARK(BM_DiagnoseAutoDrive)->Arg(25000)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_RankArm7InverseDynamics)->Arg(5000)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
-BENCHMARK(BM_DiagnoseAutoArm7InverseDynamics)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_DiagnoseAutoArm7InverseDynamics)->Arg(5000)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace

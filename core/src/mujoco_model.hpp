@@ -82,6 +82,7 @@ class MujocoModel {
 /// A MujocoSystem's workspace: the caller's own mjData.
 struct MujocoWorkspace final : DynamicsWorkspace {
   MujocoModel::DataPtr data;
+  Vector scratch;  ///< nv entries for MujocoSystem::inverse_dynamics
 };
 
 }  // namespace gpilqg

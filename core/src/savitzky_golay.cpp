@@ -15,15 +15,32 @@ SavitzkyGolayDerivative::SavitzkyGolayDerivative(int window, int order) : window
   if (order < 1 || order >= window)
     throw std::invalid_argument("Savitzky-Golay order " + std::to_string(order) + "; expected 1 <= order < window (" +
                                 std::to_string(window) + ")");
+  // One least-squares fit in the centred, scaled variable s_j = (j - h) / h (a well-conditioned design
+  // B_{jk} = s_j^k), whose pseudo-inverse B^+ serves every position e: (j - e)^k = (h s_j + h - e)^k =
+  // sum_l C(k, l) h^l (h - e)^(k - l) s_j^l, so A_e = B T_e with T_e upper triangular, A_e^+ = T_e^-1 B^+,
+  // and the weights at e are row 1 of that: (B^+)' v with T_e' v = e_1.
+  const int h = window / 2, p = order + 1;
+  Matrix B(window, p);
+  for (int j = 0; j < window; ++j) {
+    const double s = static_cast<double>(j - h) / h;
+    double power = 1.0;
+    for (int k = 0; k < p; ++k, power *= s) B(j, k) = power;
+  }
+  const Matrix pinv = B.colPivHouseholderQr().solve(Matrix::Identity(window, window));  // p x w
+  Matrix T = Matrix::Zero(p, p);
+  Vector unit = Vector::Unit(p, 1);
   weights_.reserve(static_cast<std::size_t>(window));
   for (int e = 0; e < window; ++e) {
-    // A_{jk} = (j - e)^k; the least-squares solution of A a = I gives the pseudo-inverse A^+,
-    // whose row 1 maps the samples to the fitted slope at e.
-    Matrix A(window, order + 1);
-    for (int j = 0; j < window; ++j)
-      for (int k = 0; k <= order; ++k) A(j, k) = std::pow(static_cast<double>(j - e), k);
-    const Matrix pinv = A.colPivHouseholderQr().solve(Matrix::Identity(window, window));
-    weights_.push_back(pinv.row(1).transpose());
+    const double shift = static_cast<double>(h - e);
+    for (int k = 0; k < p; ++k) {
+      double binomial = 1.0;  // C(k, l)
+      for (int l = 0; l <= k; ++l) {
+        T(l, k) = binomial * std::pow(static_cast<double>(h), l) * std::pow(shift, k - l);
+        binomial = binomial * static_cast<double>(k - l) / static_cast<double>(l + 1);
+      }
+    }
+    const Vector v = T.transpose().triangularView<Eigen::Lower>().solve(unit);
+    weights_.push_back(pinv.transpose() * v);
   }
 }
 

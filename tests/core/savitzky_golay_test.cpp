@@ -7,6 +7,9 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <utility>
+
+#include <Eigen/QR>
 
 #include "gpilqg/core/savitzky_golay.hpp"
 
@@ -85,6 +88,22 @@ TEST(SavitzkyGolay, NoiseGainMatchesClosedFormAndMonteCarlo) {
   EXPECT_NEAR(measured / sg.noise_gain(dt), 1.0, 0.01) << measured << " vs " << sg.noise_gain(dt);
   // The ends are off-centre and noisier.
   EXPECT_GT(sg.end_noise_gain(dt), sg.noise_gain(dt));
+}
+
+// The weights of every position from the one centred factorisation are those of a least-squares fit
+// solved at that position itself (row 1 of the pseudo-inverse of A_jk = (j - e)^k), to rounding.
+TEST(SavitzkyGolay, WeightsAreTheFitSolvedAtEveryPosition) {
+  for (const auto& [window, order] : {std::pair{3, 1}, std::pair{7, 2}, std::pair{21, 4}, std::pair{61, 2}, std::pair{61, 4}}) {
+    const SavitzkyGolayDerivative filter(window, order);
+    for (int e = 0; e < window; ++e) {
+      Matrix A(window, order + 1);
+      for (int j = 0; j < window; ++j)
+        for (int k = 0; k <= order; ++k) A(j, k) = std::pow(static_cast<double>(j - e), k);
+      const Vector solved = A.colPivHouseholderQr().solve(Matrix::Identity(window, window)).row(1).transpose();
+      EXPECT_LE((filter.weights(e) - solved).norm(), 1e-9 * solved.norm()) << "window " << window << ", order "
+                                                                             << order << ", position " << e;
+    }
+  }
 }
 
 TEST(SavitzkyGolay, RejectsBadSettingsAndShortSignals) {

@@ -332,6 +332,71 @@ TEST(InverseDynamicsResidual, MujocoArmMatchesMjInverseAndAnEffectInTheModelIsSu
   }
 }
 
+/// r_t = W_v^-1 (qdd_t - f_v(x_t, u_t)) written out: the model's forward dynamics and its generalised-force
+/// map, solved per row (generalised_force_residual.hpp's definition).
+Matrix solved_force_residual(const Dynamics& model, const Transitions& data, const Matrix& qdd) {
+  const Dynamics& owner = force_map_system(model);
+  const auto& map = dynamic_cast<const GeneralisedForceInput&>(owner);
+  const std::vector<int> velocity = force_components(model).velocity_states();
+  const auto k = static_cast<Eigen::Index>(velocity.size());
+  Matrix out(data.size(), k);
+  Vector xdot(model.state_dim());
+  Matrix W;
+  for (int t = 0; t < data.size(); ++t) {
+    const Vector x = data.x.row(t).transpose();
+    model.evaluate(x, data.u.row(t).transpose(), xdot);
+    map.generalised_force_map(x, W, nullptr);
+    Matrix W_v(k, k);
+    Vector e(k);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      W_v.row(c) = W.row(velocity[static_cast<std::size_t>(c)]);
+      e(c) = qdd(t, c) - xdot(velocity[static_cast<std::size_t>(c)]);
+    }
+    out.row(t) = W_v.fullPivLu().solve(e).transpose();
+  }
+  return out;
+}
+
+// MuJoCo's direct inverse dynamics (MujocoSystem::inverse_dynamics, no factorisation) is the solved
+// forward dynamics' residual to rounding, with an actuator gain, a force at a body, Coulomb friction and
+// recalibrated masses, armature and damping, and with the constraint rows of frictionloss (whose forces
+// the forward solver gives).
+TEST(InverseDynamicsResidual, DirectMujocoInverseDynamicsIsTheSolvedForwardDynamics) {
+  const int T = 40;
+  Matrix x(T, 4), u(T, 2);
+  for (int i = 0; i < T; ++i) {
+    x.row(i) = test::random_vector(4, -2.0, 2.0, 1300 + i).transpose();
+    u.row(i) = test::random_vector(2, -3.0, 3.0, 1600 + i).transpose();
+  }
+  const Transitions data = transitions_of({x}, {u}, 0.01);
+  Matrix qdd(data.size(), 2);
+  for (int r = 0; r < data.size(); ++r) qdd.row(r) = test::random_vector(2, -30.0, 30.0, 1900 + r).transpose();
+  std::vector<int> rows;
+  for (int r = 0; r < data.size(); ++r) rows.push_back(r);
+
+  ModelSpec bare;
+  bare.system = arm_path();
+  ModelSpec decorated = bare;
+  decorated.actuator_gain = 1.3;
+  decorated.parameters = {{"forearm.mass", 0.9}, {"elbow.armature", 0.02}, {"shoulder.damping", 0.2}};
+  decorated.forces.push_back({"joint_coulomb_friction:elbow", Vector::Constant(1, 0.4)});
+  decorated.forces.push_back({"external_force_x:forearm", Vector::Constant(1, 1.5)});
+  ModelSpec friction_loss = bare;
+  friction_loss.parameters = {{"elbow.frictionloss", 0.3}};
+  for (const ModelSpec* model : {&bare, &decorated, &friction_loss}) {
+    const DynamicsPtr system = model->build();
+    const Matrix direct = generalised_force_residual(*system, data, data.u, qdd, rows);
+    const Matrix solved = solved_force_residual(*system, data, qdd);
+    for (int t = 0; t < data.size(); ++t)
+      EXPECT_MATRIX_NEAR(direct.row(t).transpose(), solved.row(t).transpose(), 1e-9 * (1.0 + solved.row(t).norm()));
+    const auto& owner = dynamic_cast<const GeneralisedForceInput&>(force_map_system(*system));
+    const auto workspace = force_map_system(*system).make_workspace();
+    Vector Q(2);
+    EXPECT_TRUE(owner.inverse_dynamics(data.x.row(0).transpose(), data.u.row(0).transpose(), qdd.row(0).transpose(), Q,
+                                       *workspace));
+  }
+}
+
 /// A system without a generalised-force map: xdot = u.
 class Integrator1D final : public Dynamics {
  public:
@@ -764,6 +829,40 @@ TEST(InverseDynamicsFit, InstrumentsFromTheSimulatedModelRemoveTheNoiseBiasOfLea
   EXPECT_LT(ls_mean, 0.95 * kShoulderDamping);
   EXPECT_GE(iv_holds, 3);
   EXPECT_LE(ls_holds, 1);
+}
+
+// Parameters of the model whose residual is affine in them (a mass with its inertia, an armature, a
+// damping, a stiffness, alone or with a linear force) are fitted in the closed form from probes of the
+// model; the fit is the rebuilt model's at every theta (the general path) to rounding. Frictionloss
+// (MuJoCo's dry friction, a constraint of the forward solver) is not affine: both paths are the
+// rebuilt model's and agree exactly.
+TEST(InverseDynamicsFit, ProbedClosedFormIsTheRebuiltModelsFit) {
+  const FitContext& closed = friction_fit_context();
+  FitContext rebuilt = closed;
+  rebuilt.probe_affine = false;
+  const LibraryEffect coulomb = find_candidate(closed.model, "joint_coulomb_friction:elbow");
+  for (const char* name : {"param:forearm.mass", "param:upper_arm.mass", "param:elbow.armature", "param:shoulder.damping",
+                           "param:elbow.stiffness", "param:elbow.frictionloss"}) {
+    const LibraryEffect effect = find_candidate(closed.model, name);
+    for (const bool with_force : {false, true}) {
+      const std::vector<RefitEffect> refit =
+          with_force ? std::vector<RefitEffect>{{&coulomb, Vector::Zero(1)}} : std::vector<RefitEffect>{};
+      const EffectFit a = fit_jointly(effect, refit, closed), b = fit_jointly(effect, refit, rebuilt);
+      std::printf("%s%s: %.8g [%.6g, %.6g] (rebuilt %.8g [%.6g, %.6g]), explained %.6f (%.6f)\n", name,
+                  with_force ? " with elbow Coulomb" : "", a.estimate(0), a.ci_low(0), a.ci_high(0), b.estimate(0),
+                  b.ci_low(0), b.ci_high(0), a.explained, b.explained);
+      ASSERT_EQ(a.identifiable, b.identifiable) << name;
+      const double scale = std::max(1e-3, std::abs(b.estimate(0)));
+      EXPECT_NEAR(a.estimate(0), b.estimate(0), 1e-7 * scale) << name;
+      EXPECT_NEAR(a.ci_high(0) - a.ci_low(0), b.ci_high(0) - b.ci_low(0), 1e-5 * (b.ci_high(0) - b.ci_low(0))) << name;
+      EXPECT_NEAR(a.explained, b.explained, 1e-9) << name;
+      EXPECT_NEAR(a.training_objective_after, b.training_objective_after, 1e-9 * b.training_objective_after) << name;
+      if (with_force) {
+        ASSERT_EQ(a.refitted.size(), 1u);
+        EXPECT_NEAR(a.refitted[0].estimate(0), b.refitted[0].estimate(0), 1e-7 * std::abs(b.refitted[0].estimate(0)));
+      }
+    }
+  }
 }
 
 // --- The whole diagnosis on the inverse-dynamics criterion ------------------------------------------

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 
@@ -69,6 +70,14 @@ AffineForceResidual::AffineForceResidual(const ModelSpec& model, const std::vect
   regressor_ = weighted_force_regressor(model, effects, c, rows);
   if (regressor_.cols() != theta0.size())
     throw std::invalid_argument("AffineForceResidual: theta0 does not have one entry per parameter of the effects");
+}
+
+AffineForceResidual::AffineForceResidual(Vector theta0, Eigen::Index k, Vector residual, Matrix regressor)
+    : theta0_(std::move(theta0)), k_(k), residual_(std::move(residual)), regressor_(std::move(regressor)) {
+  if (k_ <= 0 || residual_.size() % k_ != 0 || regressor_.rows() != residual_.size() || regressor_.cols() != theta0_.size())
+    throw std::invalid_argument(
+        "AffineForceResidual: expected a residual of N k entries and a regressor of N k rows and one column per "
+        "parameter");
 }
 
 Vector AffineForceResidual::weighted(const VectorCRef& theta, const std::vector<int>& rows) const {

@@ -137,9 +137,32 @@ struct EffectSet {
 /// (affine_force_residual.hpp), built once from theta_0. Both give the same numbers up to rounding.
 class SetResidual {
  public:
-  SetResidual(const EffectSet& set, const Vector& theta0, const FitContext& c) : set_(set), c_(c) {
-    if (c.criterion == FitCriterion::InverseDynamics && linear_forces(set.effects))
+  /// `probe`: under inverse dynamics, try the closed form for sets with parameters of the model too
+  /// (probed_affine_residual); the fit checks it again at its estimate (matches_at).
+  SetResidual(const EffectSet& set, const Vector& theta0, const FitContext& c, bool probe = true) : set_(set), c_(c) {
+    if (c.criterion != FitCriterion::InverseDynamics) return;
+    if (linear_forces(set.effects)) {
       affine_.emplace(set.model_at(c.model, theta0), set.effects, theta0, c);
+    } else if (probe && c.probe_affine) {
+      affine_ = probed_affine_residual(theta0);
+      probed_ = affine_.has_value();
+    }
+  }
+
+  /// True when the closed form stands on probes of the model (not only on forces linear by construction).
+  bool probed() const { return probed_; }
+
+  /// Whether the rebuilt model's residual at theta equals the closed form's on every row, to rounding
+  /// (affine_to_rounding). True when there is no probed closed form.
+  bool matches_at(const VectorCRef& theta) const {
+    if (!probed_) return true;
+    const std::vector<int> rows = all_rows(*c_.data);
+    try {
+      return affine_to_rounding(weighted_force_residual(set_.model_at(c_.model, theta), c_, rows),
+                                affine_->weighted(theta, rows), affine_->weighted(theta0_, rows));
+    } catch (const std::invalid_argument&) {
+      return false;
+    }
   }
 
   /// sqrt(w) r at theta stacked over `rows`; `finite` as in weighted_residual. The fit asks for the
@@ -208,9 +231,62 @@ class SetResidual {
     return kept.front();
   }
 
+  /// The closed form r(theta) = r(theta0) - G (theta - theta0) of affine_force_residual.hpp for a set
+  /// with effects other than linear forces, when the data show it to be affine: the columns of the
+  /// linear forces are their bases; the column of every other parameter j is the secant
+  /// (r(theta0) - r(theta0 + s_j e_j)) / s_j of the rebuilt model at a step of its scale s_j. The
+  /// closed form must then predict the rebuilt model at theta0 + 2 s (every parameter moved, forces by
+  /// their scale) to rounding; otherwise, or when a probe leaves the physical range, none (the rebuilt
+  /// model at every theta). Costs 2 + (parameters that are not linear forces) evaluations of the model.
+  std::optional<AffineForceResidual> probed_affine_residual(const Vector& theta0) {
+    theta0_ = theta0;
+    const std::vector<int> rows = all_rows(*c_.data);
+    const auto p = theta0.size();
+    Vector step(p);
+    for (Eigen::Index j = 0; j < p; ++j) step(j) = set_.parameter(j).scale;
+    if (!step.allFinite() || !(step.minCoeff() > 0.0)) return std::nullopt;
+    try {
+      const Vector r0 = weighted_force_residual(set_.model_at(c_.model, theta0), c_, rows);
+      Matrix G(r0.size(), p);
+      std::vector<const LibraryEffect*> forces;
+      std::vector<Eigen::Index> force_columns;
+      for (std::size_t e = 0; e < set_.effects.size(); ++e) {
+        if (linear_forces({set_.effects[e]})) {
+          forces.push_back(set_.effects[e]);
+          for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) force_columns.push_back(j);
+          continue;
+        }
+        for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) {
+          Vector theta = theta0;
+          theta(j) += step(j);
+          G.col(j) = (r0 - weighted_force_residual(set_.model_at(c_.model, theta), c_, rows)) / step(j);
+        }
+      }
+      if (!forces.empty())
+        G(Eigen::all, force_columns) = weighted_force_regressor(set_.model_at(c_.model, theta0), forces, c_, rows);
+      const Vector far = theta0 + 2.0 * step;
+      if (!affine_to_rounding(weighted_force_residual(set_.model_at(c_.model, far), c_, rows), r0 - G * (far - theta0), r0))
+        return std::nullopt;
+      return AffineForceResidual(theta0, c_.weights.size(), r0, std::move(G));
+    } catch (const std::invalid_argument&) {  // a probe outside the physical range, or a singular model
+      return std::nullopt;
+    }
+  }
+
+  /// True when `actual` and `predicted`, residuals at some theta, agree to rounding: their difference
+  /// is below kAffineTolerance of the larger of the change from `base` (the residual at theta0) and
+  /// `base` itself, in the Euclidean norm.
+  static bool affine_to_rounding(const Vector& actual, const Vector& predicted, const Vector& base) {
+    constexpr double kAffineTolerance = 1e-9;
+    const double size = std::max((actual - base).norm(), base.norm());
+    return actual.allFinite() && (actual - predicted).norm() <= kAffineTolerance * size;
+  }
+
   const EffectSet& set_;
   const FitContext& c_;
   std::optional<AffineForceResidual> affine_;
+  bool probed_ = false;
+  Vector theta0_;
   mutable std::deque<Evaluation> residuals_, regressors_;
 };
 
@@ -521,8 +597,8 @@ void check_identifiable(const EffectSet& set, const Vector& theta_hat, const Vec
   }
 }
 
-/// Steps 1-4 on the stacked parameters of `set`, from `initial`.
-EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext& c) {
+/// Steps 1-4 on the stacked parameters of `set`, from `initial`; `probe` as in SetResidual.
+EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext& c, bool probe = true) {
   if (c.data == nullptr) throw std::invalid_argument("fit_effect: no data");
   const auto p = set.size();
   const std::vector<int> training = c.data->rows(false);
@@ -537,7 +613,7 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
   const Vector null = set.null_values(c.model);
 
   // 1. Linear least squares at theta_0 (a Gauss-Newton step from a warm start for a joint fit).
-  const SetResidual residual(set, initial, c);
+  const SetResidual residual(set, initial, c, probe);
   const Matrix J = residual.regressor(initial, training);
   fit.regressor = J.col(0);
   fit.scale = data_scales(J, c, training, null);
@@ -569,6 +645,9 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
     std::tie(ci_low, ci_high) = confidence_interval(residual, theta_hat, c, training, Q);
     check_identifiable(set, theta_hat, ci_low, ci_high, null, fit);
   }
+  // A closed form that stood on probes of the model must hold at the estimate too; where it does not,
+  // the fit is the rebuilt model's.
+  if (residual.probed() && !residual.matches_at(theta_hat)) return fit_set(set, initial, c, false);
   // 4. Held-out scores; then each effect's slice.
   score_heldout(residual, theta_hat, c, fit);
   return finish_fit(set, initial, null, theta_ls, theta_hat, ci_low, ci_high, std::move(fit));
@@ -641,7 +720,7 @@ EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, co
   EffectSet set;
   set.add(effect);
   fit.training_objective_before = weighted_model_residual(c, training).squaredNorm();
-  const SetResidual residual(set, values, c);
+  const SetResidual residual(set, values, c, false);
   fit.training_objective_after = residual.at(values, training).squaredNorm();
   score_heldout(residual, values, c, fit);
   return fit;

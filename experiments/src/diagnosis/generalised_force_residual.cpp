@@ -82,6 +82,13 @@ Matrix generalised_force_residual(const Dynamics& model, const Transitions& data
 
   const auto model_workspace = model.make_workspace();
   const auto map_workspace = owner.make_workspace();
+  // The direct form where the owner has one (GeneralisedForceInput::inverse_dynamics): `model` is the
+  // owner, or effects over it, which apply k u to it and add their forces Q_e.
+  const auto* decorated = dynamic_cast<const EffectDynamics*>(&model);
+  const bool direct = &owner == &model || (decorated != nullptr && &decorated->base() == &owner);
+  const double gain = decorated != nullptr ? decorated->actuator_gain() : 1.0;
+  const bool effects = decorated != nullptr && !decorated->effects().empty();
+  Vector qdd(k), Q(k), Q_e(k);
   Vector x(n);
   Vector u(model.control_dim());
   Vector xdot(n);
@@ -97,6 +104,20 @@ Matrix generalised_force_residual(const Dynamics& model, const Transitions& data
           fmt::format("inverse-dynamics residual: row {}; the data have {} transitions", t, data.size()));
     x = data.x.row(t).transpose();
     u = applied_u.row(t).transpose();
+    qdd = accelerations.row(t).transpose();
+    if (direct && map.inverse_dynamics(x, gain * u, qdd, Q, *map_workspace)) {
+      if (effects) {
+        decorated->generalised_force(x, u, Q_e, *model_workspace);
+        Q -= Q_e;
+      }
+      if (!Q.allFinite())
+        throw std::invalid_argument(fmt::format(
+            "inverse-dynamics residual: at row {} (episode {}, t = {}) the model's acceleration or the measured one "
+            "is not finite; no force residual there", t, data.episode[static_cast<std::size_t>(t)],
+            data.t.size() > t ? data.t(t) : 0.0));
+      out.row(static_cast<Eigen::Index>(i)) = Q.transpose();
+      continue;
+    }
     model.evaluate(x, u, xdot, nullptr, *model_workspace);
     map.generalised_force_map(x, W, nullptr, *map_workspace);
     for (Eigen::Index c = 0; c < k; ++c) {

@@ -1,12 +1,14 @@
 #include "gpilqg/experiments/diagnosis/subset_search.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <utility>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "gpilqg/core/fork_join.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
@@ -160,19 +162,28 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     searched = k;
     if (o.progress && !exhaustive)
       o.progress(fmt::format("sets of {}: grown from the best set of {} (too many to search them all)", k, k - 1));
+    // The sets' exact fits are independent: o.threads at once, then compared in the order of `sets`.
+    std::vector<EffectFit> exact(sets.size());
+    std::atomic<std::size_t> next{0};
+    ForkJoin workers;
+    workers.run(std::max(1, std::min<int>(o.threads, static_cast<int>(sets.size()))), [&](int, int) {
+      for (std::size_t s = next++; s < sets.size(); s = next++) {
+        const std::vector<int>& subset = sets[s];
+        const EffectFit& lead = singles[static_cast<std::size_t>(subset.front())];
+        std::vector<RefitEffect> rest;
+        for (std::size_t i = 1; i < subset.size(); ++i) {
+          const EffectFit& member = singles[static_cast<std::size_t>(subset[i])];
+          rest.push_back({&named(candidates, member.effect), member.estimate});
+        }
+        rest.insert(rest.end(), present.begin(), present.end());
+        exact[s] = fit_jointly(named(candidates, lead.effect), rest, accepted_context, lead.estimate);
+      }
+    });
     EffectFit best;
     bool have = false;
-    for (const std::vector<int>& subset : sets) {
-      const EffectFit& lead = singles[static_cast<std::size_t>(subset.front())];
-      std::vector<RefitEffect> rest;
-      for (std::size_t i = 1; i < subset.size(); ++i) {
-        const EffectFit& member = singles[static_cast<std::size_t>(subset[i])];
-        rest.push_back({&named(candidates, member.effect), member.estimate});
-      }
-      rest.insert(rest.end(), present.begin(), present.end());
-      EffectFit exact = fit_jointly(named(candidates, lead.effect), rest, accepted_context, lead.estimate);
+    for (EffectFit& fit : exact) {
       // Chosen on the training rows (sets of one size, one start): the held-out rows only judge.
-      if (!have || exact.training_objective_after < best.training_objective_after) best = std::move(exact);
+      if (!have || fit.training_objective_after < best.training_objective_after) best = std::move(fit);
       have = true;
     }
     if (!have) break;

@@ -48,6 +48,19 @@ class GeneralisedForceInput {
     generalised_force_map(x, W, d_dx);
   }
 
+  /// Its inverse dynamics, for systems that compute it directly: the generalised force
+  ///
+  ///   Q = W_v(x)^-1 (qdd - f_v(x, u)) = M(q) qdd - h(q, q_dot, u)
+  ///
+  /// (k entries) that gives the accelerations `qdd` (one per component, in component order) at
+  /// (x, u), where f_v and W_v are the velocity rows of the state derivative and of
+  /// generalised_force_map. Returns false, with Q unspecified, where the system has no direct form
+  /// at (x, u) and the caller must solve W_v Q = qdd - f_v itself; the default always does.
+  virtual bool inverse_dynamics(const VectorCRef& /*x*/, const VectorCRef& /*u*/, const VectorCRef& /*qdd*/,
+                                VectorRef /*Q*/, DynamicsWorkspace&) const {
+    return false;
+  }
+
   /// The coordinates the force components act on, for systems whose components do not follow the
   /// naming convention of generalised_coordinates() (the quadrotor: F_x acts on px and vx, tau_x on
   /// rx and wx). Empty by default: the convention applies.

@@ -19,6 +19,10 @@
 ///   first (last) w samples is evaluated off-centre at e = 0 .. h-1 (e = h+1 .. w-1). That keeps
 ///   every sample and is still exact for polynomials of degree <= order, but it is noisier
 ///   (end_noise_gain) and, for higher-degree signals, less accurate than the centred fit.
+///
+/// Cost of the weights: one QR factorisation of the centred design (w x (order + 1), in (j - h) / h,
+/// well conditioned at any w) for every position, each position's weights then a triangular solve of
+/// order + 1 unknowns and one product: O(w^2 order) for the filter, against O(w^3 order) for a fit per position.
 
 #include <vector>
 

@@ -23,6 +23,14 @@
 ///
 /// Cost: one evaluation of the model's residual at theta_0 (M and h once per sample) and each
 /// effect's force once per sample and parameter; every r(theta) after that is a matrix-vector product.
+///
+/// Parameters of the model itself can enter the inverse dynamics linearly too: M(q) qdd + c(q, qdot)
+/// is linear in each body's standard inertial parameters (its mass, first moments and inertia tensor;
+/// MuJoCo's mass recalibration scales the mass and the inertia together at a fixed centre of mass),
+/// and the armature, joint damping and spring stiffness enter as forces. Their residual is the same
+/// affine function, with the column -(d r / d theta_j) the secant of two evaluations. That they are
+/// affine is not assumed: effect_fit.cpp checks it on the data (probed_affine_residual) and otherwise
+/// uses the rebuilt model at every theta.
 
 #include <vector>
 
@@ -48,6 +56,9 @@ class AffineForceResidual {
   /// values. Evaluates its residual (weighted_residual_of) and the regressor at every row once.
   AffineForceResidual(const ModelSpec& model, const std::vector<const LibraryEffect*>& effects, const Vector& theta0,
                       const FitContext& c);
+  /// The same from its pieces: `residual` sqrt(w) r(theta0) and `regressor` sqrt(w) G at every row
+  /// (N k entries and N k x theta0.size()), `k` force components.
+  AffineForceResidual(Vector theta0, Eigen::Index k, Vector residual, Matrix regressor);
 
   /// sqrt(w_i) r_{t,i}(theta) stacked over `rows` (index t k + i).
   Vector weighted(const VectorCRef& theta, const std::vector<int>& rows) const;

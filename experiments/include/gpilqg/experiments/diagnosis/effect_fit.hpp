@@ -91,6 +91,11 @@ struct FitContext {
   /// Candidates left out of every ranking and search (`--exclude`): effects the user declares
   /// physically meaningless for these data (an armature when torques are measured after the gearbox).
   std::vector<std::string> excluded = {};
+  /// Inverse dynamics: fit a set with parameters of the model (a mass, an armature) in the closed form
+  /// of affine_force_residual.hpp when the data show its residual to be affine in them (effect_fit.cpp
+  /// probes it, and checks it again at the estimate). False: the rebuilt model at every theta, the
+  /// general path, which gives the same fit to rounding where the closed form holds.
+  bool probe_affine = true;
 };
 
 /// The model integrated as configured.

@@ -68,7 +68,7 @@ struct SelectionOptions {
   double min_explained = 0.05;  ///< step 3: explained >= this ...
   double min_z = 3.0;           ///< ... and z >= this
   int max_steps = 32;           ///< at most this many effects (a 7-joint arm's friction alone takes 14)
-  int threads = 1;              ///< candidates fitted at once
+  int threads = 1;              ///< candidates fitted at once (and the subset search's exact fits of one size)
   std::function<void(const std::string&)> progress;
 };
 

@@ -31,8 +31,13 @@
 ///   components, as W = [0; M^-1] is).
 /// - The model is evaluated at the measured state x_t as it is: no filtering of x or u here.
 ///
-/// Cost: one evaluation of f and of W per row, in one workspace each per call, and one k x k
-/// factorisation per row.
+/// Cost: where the system computes its inverse dynamics directly (GeneralisedForceInput::
+/// inverse_dynamics: a MuJoCo model), that and the effects' forces per row,
+/// r_t = ID(x_t, k u_t, qdd_t) - Q_e(x_t, u_t) (k the actuator gain): for MuJoCo without constraint
+/// rows the position and velocity stages and one product with M, no factorisation; with them one
+/// forward pass and one product with M. Elsewhere one evaluation of
+/// f and of W per row, in one workspace each per call, and one k x k factorisation per row. Both are
+/// the same r_t up to rounding (tests/experiments/inverse_dynamics_test.cpp compares them).
 
 #include <vector>
 
