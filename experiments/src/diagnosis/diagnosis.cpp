@@ -425,6 +425,7 @@ void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidat
     }
   R.criterion_weights = context.weights;
   R.accelerations = context.accelerations;
+  R.initial_state = context.initial_state;
   if (o.criterion == FitCriterion::InverseDynamics) {
     for (const Quantity& q : force_components(*R.model.build()).forces) {
       R.channel_names.push_back(q.name);
@@ -532,11 +533,17 @@ double flexible_share(const ModelSpec& model, const Matrix& residual, const Resi
   const Matrix u = applied_controls(R.data, model.input_delay);
   const Matrix plain = simulated_predictions(*make_step_model(model, o.integrator, R.dt, o.substeps), R.data, u, rows, o.window);
   const Matrix flexible = simulated_predictions(*gp.model, R.data, u, rows, o.window);
+  Matrix measured(static_cast<Eigen::Index>(rows.size()), R.data.x_next.cols());
+  for (std::size_t k = 0; k < rows.size(); ++k) measured.row(static_cast<Eigen::Index>(k)) = R.data.x_next.row(rows[k]);
+  Matrix plain_errors = measured - plain, flexible_errors = measured - flexible;
+  if (R.initial_state) {
+    plain_errors = without_start_error(*R.initial_state, rows, plain_errors, R.criterion_weights);
+    flexible_errors = without_start_error(*R.initial_state, rows, flexible_errors, R.criterion_weights);
+  }
   double before = 0.0, after = 0.0;
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    const auto row = R.data.x_next.row(rows[k]);
-    before += (row - plain.row(static_cast<Eigen::Index>(k))).cwiseAbs2().dot(R.weights);
-    after += (row - flexible.row(static_cast<Eigen::Index>(k))).cwiseAbs2().dot(R.weights);
+  for (Eigen::Index k = 0; k < measured.rows(); ++k) {
+    before += plain_errors.row(k).cwiseAbs2().dot(R.weights);
+    after += flexible_errors.row(k).cwiseAbs2().dot(R.weights);
   }
   return before > 0.0 ? 1.0 - after / before : 0.0;
 }

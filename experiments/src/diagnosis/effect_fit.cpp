@@ -22,6 +22,7 @@
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/initial_state.hpp"
 #include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
@@ -46,7 +47,9 @@ Matrix criterion_residual(const ModelSpec& model, const FitContext& settings, in
     if (diverged != nullptr) *diverged = 0;
     return generalised_force_residual(model, *settings.data, *settings.accelerations, all_rows(*settings.data));
   }
-  return settings.data->x_next - model_predictions(model, settings, diverged);
+  const Matrix errors = settings.data->x_next - model_predictions(model, settings, diverged);
+  if (!settings.initial_state) return errors;
+  return without_start_error(*settings.initial_state, all_rows(*settings.data), errors, settings.weights);
 }
 
 namespace {
@@ -80,6 +83,7 @@ Vector weighted_residual(const StepModel& model, const Matrix& u, const FitConte
     for (std::size_t k = 0; k < rows.size(); ++k)
       out.segment(static_cast<Eigen::Index>(k) * n, n) = sqrt_w.cwiseProduct(
           (c.data->x_next.row(rows[k]) - predicted.row(static_cast<Eigen::Index>(k))).transpose());
+    if (c.initial_state) remove_start_error(*c.initial_state, rows, out);
     return out;
   }
   const auto workspace = model.make_workspace();

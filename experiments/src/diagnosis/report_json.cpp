@@ -297,6 +297,8 @@ nlohmann::json report_json(const DiagnosisReport& r) {
             {"window", r.window},
             {"instruments", instruments_json(r)},
             {"restarts", r.window_restarts},
+            {"starts", r.criterion == FitCriterion::InverseDynamics ? json(nullptr)
+                       : json(r.initial_state ? "estimated" : "measured")},
             {"chosen_by", r.criterion_reason.empty() ? "user" : "data"},
             {"excluded", r.criterion_excluded},
             {"reason", r.criterion_reason.empty() ? json(nullptr) : json(r.criterion_reason)}}},

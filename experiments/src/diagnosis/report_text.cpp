@@ -228,7 +228,8 @@ void which_section(const DiagnosisReport& r, std::string& out) {
     out += fmt::format("   not candidates on this criterion (the force residual and the inertias scale with them): {}\n",
                        fmt::join(r.criterion_excluded, ", "));
   if (r.criterion == FitCriterion::Simulation)
-    out += fmt::format("   criterion: simulation error over windows of {} samples ({:g} s) from measured states{}\n",
+    out += fmt::format("   criterion: simulation error over windows of {} samples ({:g} s), each window's start "
+                       "estimated{}\n",
                        r.window, r.window * r.dt,
                        r.window_restarts > 0 ? fmt::format(", {} restarts after a diverged state", r.window_restarts) : "");
   // Columns as wide as the longest name and parameter text (a MuJoCo model's effects have long names).

@@ -7,6 +7,7 @@
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
 #include "gpilqg/experiments/diagnosis/derivative_window.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/initial_state.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -124,7 +125,15 @@ FitContext criterion_context(FitContext context, FitCriterion criterion, int win
   // Held-out batches are whole windows (heldout_batch_length in effect_fit.cpp): the errors within a
   // window are strongly correlated.
   int bad = 0;
-  if (context.data != nullptr) context.residual = context.data->x_next - model_predictions(context.model, context, &bad);
+  if (context.data != nullptr) {
+    const Transitions& data = *context.data;
+    const auto model = make_step_model(context.model, context.integrator, context.dt, context.substeps);
+    context.initial_state = nullptr;
+    if (context.estimate_starts)
+      context.initial_state = std::make_shared<const InitialStateSensitivity>(initial_state_sensitivity(
+          *model, data, applied_controls(data, context.model.input_delay), window, context.weights));
+    context.residual = criterion_residual(context.model, context, &bad);
+  }
   if (restarts != nullptr) *restarts = bad;
   return context;
 }

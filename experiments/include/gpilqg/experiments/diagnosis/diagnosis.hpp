@@ -58,6 +58,7 @@
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/free_run.hpp"
 #include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
+#include "gpilqg/experiments/diagnosis/initial_state.hpp"
 #include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
@@ -228,6 +229,9 @@ struct DiagnosisReport {
   Vector criterion_weights;
   /// Inverse dynamics: the measured accelerations (N x k) the residuals are computed with.
   std::shared_ptr<const Matrix> accelerations;
+  /// Simulation: the sensitivities of the windows to their starts, whose first-order effect every
+  /// simulation error of the diagnosis leaves out (initial_state.hpp).
+  std::shared_ptr<const InitialStateSensitivity> initial_state;
   /// Simulation criterion: simulated states of the diagnosed model that diverged, each followed by a
   /// restart from the measurement (0 for the one-step criterion, whose divergences are counted in
   /// non_finite_predictions).

@@ -56,7 +56,8 @@
 
 namespace gpilqg::diagnosis {
 
-struct Instruments;  // instrumental_variables.hpp
+struct Instruments;              // instrumental_variables.hpp
+struct InitialStateSensitivity;  // initial_state.hpp
 
 /// The data and model a fit works on. The criterion's channels are the states (one-step, simulation)
 /// or the generalised-force components (inverse dynamics): c of them below.
@@ -88,6 +89,12 @@ struct FitContext {
   /// Inverse dynamics in its instrumental-variable form (instrumental_variables.hpp): the simulated
   /// data the instruments are evaluated at; null for least squares.
   std::shared_ptr<const Instruments> instruments = {};
+  /// Simulation: the sensitivities of the base model's windows to their starts, whose first-order
+  /// effect is removed from every window's errors (initial_state.hpp); null: the measured starts.
+  std::shared_ptr<const InitialStateSensitivity> initial_state = {};
+  /// Simulation: whether criterion_context estimates the windows' starts (sets initial_state); false:
+  /// every window from its measured start, as simulated_predictions runs it.
+  bool estimate_starts = true;
   /// Candidates left out of every ranking and search (`--exclude`): effects the user declares
   /// physically meaningless for these data (an armature when torques are measured after the gearbox).
   std::vector<std::string> excluded = {};

@@ -22,6 +22,12 @@
 /// windows are fixed by the position in the episode, the prediction of a row is the same whether it
 /// is computed over all rows or over the training or held-out rows alone.
 ///
+/// The start. The measured x_{s0} carries the sensor's noise, and its error grows along the window
+/// (on a chaotic system, exponentially). criterion_context therefore estimates each window's start to
+/// first order about the measured one (initial_state.hpp): every simulation error of the fit, the
+/// ranking and the verdict is the error from the best start near x_{s0}, as `pem` estimates the initial
+/// state. simulated_predictions itself starts from the measurement.
+///
 /// Everything else of the fit is unchanged, with e_r in place of the one-step residual: the weighted
 /// objective S(theta) = sum_r sum_i w_i e_{r,i}^2, its least-squares regressor J = d x_hat / d theta
 /// (now the sensitivity of the simulation, accumulated through the window), the BOBYQA refit, the
@@ -70,7 +76,9 @@ std::vector<int> all_rows(const Transitions& data);
 
 /// `context` set to the criterion. One-step: window = 1, the rest as given (its residual is the
 /// one-step residual). Simulation: window = `window`, the held-out batch rounded up to a multiple of
-/// the window, and `residual` recomputed as the simulation error of context.model (model_predictions);
+/// the window, initial_state the sensitivities of context.model's windows to their starts, and
+/// `residual` recomputed as the simulation error of context.model with the starts estimated
+/// (criterion_residual, initial_state.hpp);
 /// `restarts` (when not null) receives the restarts of that simulation. Inverse dynamics
 /// (generalised_force_residual.hpp): the accelerations of the force components' velocity states
 /// (accelerations.hpp), `residual` the generalised-force residual of context.model (N x k), `weights`
