@@ -131,11 +131,9 @@ json where_json(const DiagnosisReport& r) {
 /// The instruments of the IV form of inverse dynamics (instrumental_variables.hpp), or null.
 json instruments_json(const DiagnosisReport& r) {
   if (!r.instruments) return nullptr;
-  long instrumented = 0;
-  for (const bool b : r.instruments->instrumented) instrumented += b ? 1 : 0;
   return {{"window", r.instruments->window},
           {"reach", r.instruments->reach},
-          {"instrumented_rows", instrumented},
+          {"instrumented_rows", r.instruments->instrumented_rows()},
           {"rows", r.instruments->instrumented.size()},
           {"restarts", r.instruments->restarts}};
 }

@@ -216,11 +216,9 @@ void which_section(const DiagnosisReport& r, std::string& out) {
     out += "   criterion: inverse dynamics, the generalised-force residual M(q) qdd - h(q, qdot, u) with qdd a zero-phase "
            "derivative of the measured velocities\n";
   if (r.instruments) {
-    long instrumented = 0;
-    for (const bool b : r.instruments->instrumented) instrumented += b ? 1 : 0;
     out += fmt::format("   instrumental variables (IDIM-IV): instruments from the model simulated over windows of {} samples "
                        "from measured states, {} of {} rows instrumented{}\n",
-                       r.instruments->window, instrumented, r.instruments->instrumented.size(),
+                       r.instruments->window, r.instruments->instrumented_rows(), r.instruments->instrumented.size(),
                        r.instruments->restarts > 0 ? fmt::format(", {} restarts after a diverged state", r.instruments->restarts)
                                                    : "");
   }

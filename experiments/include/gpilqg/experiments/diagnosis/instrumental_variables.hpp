@@ -38,6 +38,8 @@
 #include <memory>
 #include <vector>
 
+#include <algorithm>
+
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
 
 namespace gpilqg::diagnosis {
@@ -54,6 +56,9 @@ struct Instruments {
   int window = 0;  ///< W = 4 (h + 1), of each of the two grids
   int reach = 0;   ///< h
   int restarts = 0;  ///< simulated states that diverged, each followed by a restart from the measurement
+
+  /// The rows with an instrument (true entries of `instrumented`).
+  long instrumented_rows() const { return static_cast<long>(std::count(instrumented.begin(), instrumented.end(), true)); }
 };
 
 /// The instruments of an inverse-dynamics context (criterion_context with FitCriterion::InverseDynamics):
