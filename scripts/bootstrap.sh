@@ -16,7 +16,7 @@ packages=(
   cmake make g++ pkg-config
   libeigen3-dev libsuitesparse-dev libnlopt-cxx-dev libhdf5-dev libbenchmark-dev libgtest-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev python3-h5py python3-matplotlib
-  libmujoco-dev libtinyxml2-dev
+  libmujoco-dev libtinyxml2-dev libboost-dev
   pybind11-dev python3-pybind11 python3-pytest python3-sklearn python3-pandas libmatio-dev
   openmpi-bin libopenmpi-dev
   libopenblas-pthread-dev

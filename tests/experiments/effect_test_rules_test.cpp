@@ -16,10 +16,25 @@
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
+#include "gpilqg/experiments/diagnosis/student_t.hpp"
 #include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
 namespace gpilqg {
 namespace {
+
+// The small-sample quantiles of the jackknife intervals (student_t.hpp) against a printed table of
+// Student's t_{0.975} (Abramowitz & Stegun, table 26.10).
+TEST(BatchStatistics, StudentsQuantilesMatchTheTable) {
+  using namespace diagnosis;
+  const std::map<int, double> t975 = {{1, 12.706}, {2, 4.303}, {3, 3.182}, {6, 2.447}, {10, 2.228}, {30, 2.042}, {120, 1.980}};
+  for (const auto& [dof, value] : t975) {
+    EXPECT_NEAR(student_t_quantile(0.975, dof), value, 5e-4) << dof;
+    EXPECT_NEAR(batch_half_width(2.0, dof + 1), 2.0 * value, 1e-3) << dof;
+  }
+  EXPECT_THROW(batch_half_width(1.0, 1), std::invalid_argument);
+  EXPECT_NEAR(student_t_quantile(0.995, 3), 5.841, 5e-4);
+  EXPECT_THROW(student_t_quantile(1.0, 3), std::invalid_argument);
+}
 
 using diagnosis::compare_heldout;
 using diagnosis::EffectFit;

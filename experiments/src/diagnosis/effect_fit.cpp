@@ -26,6 +26,7 @@
 #include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
+#include "gpilqg/experiments/diagnosis/student_t.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -383,6 +384,7 @@ std::pair<Vector, Vector> confidence_interval(const SetResidual& residual, const
   const Matrix A_inverse = A.fullPivLu().inverse();
   const double dof = std::max<double>(1.0, static_cast<double>(J.rows() - p));
   Vector variance = (r.squaredNorm() / dof) * (A_inverse * (Z.transpose() * Z) * A_inverse.transpose()).diagonal();
+  Vector quantile = Vector::Constant(p, 1.96);  // the Gauss-Newton variance's: normal
   // Delete-one-episode jackknife, each replicate one Gauss-Newton step from theta_hat.
   std::map<int, std::pair<Matrix, Vector>> per_episode;
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -408,12 +410,18 @@ std::pair<Vector, Vector> confidence_interval(const SetResidual& residual, const
       Vector jack = Vector::Zero(p);
       for (const Vector& t : replicates) jack += (t - mean).cwiseAbs2();
       const auto R = static_cast<double>(replicates.size());
-      variance = variance.cwiseMax(jack * (R - 1.0) / R);
+      jack *= (R - 1.0) / R;
+      // Where the jackknife is the larger, its R replicates give it R - 1 degrees of freedom: the
+      // quantile is Student's (student_t.hpp), 4.30 for R = 3, 2.45 for R = 7.
+      const double t = batch_half_width(1.0, static_cast<int>(replicates.size()));
+      for (Eigen::Index j = 0; j < p; ++j)
+        quantile(j) = jack(j) > variance(j) ? t : quantile(j);
+      variance = variance.cwiseMax(jack);
     }
   }
   // A covariance that is not finite (a regressor of zero at theta_hat: a fit that ran away to where
   // the data no longer see it) is no interval of zero width but an unbounded one.
-  Vector half = 1.96 * variance.cwiseMax(0.0).cwiseSqrt();
+  Vector half = quantile.cwiseProduct(variance.cwiseMax(0.0).cwiseSqrt());
   for (Eigen::Index j = 0; j < p; ++j)
     if (!std::isfinite(half(j)) || !(J.col(j).squaredNorm() > 0.0)) half(j) = std::numeric_limits<double>::infinity();
   return {estimate - half, estimate + half};

@@ -23,7 +23,9 @@
 ///    evaluations of S per parameter; on 25,000 samples of a MuJoCo model that was most of the time.)
 /// 3. A 95% interval from the Gauss-Newton covariance at theta_hat, s^2 (J'WJ)^-1 with
 ///    s^2 = S / (N n - p), widened to the delete-one-episode jackknife when that is larger: one-step
-///    residuals of one episode are correlated, so the iid interval alone is too narrow.
+///    residuals of one episode are correlated, so the iid interval alone is too narrow. The quantile
+///    is 1.96 for the Gauss-Newton variance and Student's t_{0.975, R - 1} for a jackknife of R
+///    replicates (student_t.hpp).
 /// 4. On the held-out episodes: RMSE per state before and after, and the weighted fraction of
 ///    squared residual explained, 1 - S_after / S_before, with a 95% interval and a z score from batch
 ///    means of the per-sample reduction (batches of consecutive samples within an episode, so the
