@@ -43,13 +43,22 @@ Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int
                               diverged, model.input_delay);
 }
 
+namespace {
+
+/// Whether the simulation errors of `c` leave out the start error: sensitivities of c's own windows.
+bool estimates_starts(const FitContext& c) {
+  return c.initial_state && c.window > 1 && c.initial_state->window == c.window;
+}
+
+}  // namespace
+
 Matrix criterion_residual(const ModelSpec& model, const FitContext& settings, int* diverged) {
   if (settings.criterion == FitCriterion::InverseDynamics) {
     if (diverged != nullptr) *diverged = 0;
     return generalised_force_residual(model, *settings.data, *settings.accelerations, all_rows(*settings.data));
   }
   const Matrix errors = settings.data->x_next - model_predictions(model, settings, diverged);
-  if (!settings.initial_state) return errors;
+  if (!estimates_starts(settings)) return errors;
   return without_start_error(*settings.initial_state, all_rows(*settings.data), errors, settings.weights);
 }
 
@@ -84,7 +93,7 @@ Vector weighted_residual(const StepModel& model, const Matrix& u, const FitConte
     for (std::size_t k = 0; k < rows.size(); ++k)
       out.segment(static_cast<Eigen::Index>(k) * n, n) = sqrt_w.cwiseProduct(
           (c.data->x_next.row(rows[k]) - predicted.row(static_cast<Eigen::Index>(k))).transpose());
-    if (c.initial_state) remove_start_error(*c.initial_state, rows, out);
+    if (estimates_starts(c)) remove_start_error(*c.initial_state, rows, out);
     return out;
   }
   const auto workspace = model.make_workspace();

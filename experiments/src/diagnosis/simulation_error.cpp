@@ -114,6 +114,7 @@ FitContext inverse_dynamics_context(FitContext context) {
 FitContext criterion_context(FitContext context, FitCriterion criterion, int window, int* restarts) {
   if (window < 1) throw std::invalid_argument("criterion_context: the window must be >= 1 row");
   if (restarts != nullptr) *restarts = 0;
+  context.initial_state = nullptr;  // set below for the simulation criterion
   if (criterion == FitCriterion::InverseDynamics) return inverse_dynamics_context(std::move(context));
   if (criterion == FitCriterion::OneStep) {
     context.window = 1;
@@ -127,11 +128,10 @@ FitContext criterion_context(FitContext context, FitCriterion criterion, int win
   int bad = 0;
   if (context.data != nullptr) {
     const Transitions& data = *context.data;
-    const auto model = make_step_model(context.model, context.integrator, context.dt, context.substeps);
-    context.initial_state = nullptr;
     if (context.estimate_starts)
       context.initial_state = std::make_shared<const InitialStateSensitivity>(initial_state_sensitivity(
-          *model, data, applied_controls(data, context.model.input_delay), window, context.weights));
+          *make_step_model(context.model, context.integrator, context.dt, context.substeps), data,
+          applied_controls(data, context.model.input_delay), window, context.weights));
     context.residual = criterion_residual(context.model, context, &bad);
   }
   if (restarts != nullptr) *restarts = bad;
