@@ -98,12 +98,13 @@ cart_coulomb_friction = { mu = 3.0, v0 = 0.05 }
 
 def test_plan_diagnose_equals_the_command_line_and_the_model_is_a_simulator(tmp_path):
     # A world with a longer pole and cart friction; plan --diagnose on its log, from the command line
-    # and from Python: the same diagnosed model file and policy.
+    # and from Python: the same diagnosed model file and policy. Sixteen rollouts: the held-out test needs
+    # about ten batches of ten rows to call a finding.
     (tmp_path / "world.toml").write_text(WORLD)
     config = write_toml(tmp_path / "plan.toml", PLAN)
     assert cli("plan", config, "--out", tmp_path / "p0.h5")[0] == 0
     status, _, err = cli("rollout", "--system", "cartpole", "--world-model", tmp_path / "world.toml", "--policy",
-                         tmp_path / "p0.h5", "--episodes", "4", "--exploration", "8", "--observation-noise", "0.001",
+                         tmp_path / "p0.h5", "--episodes", "16", "--exploration", "8", "--observation-noise", "0.001",
                          "--seed", "3", "--out", tmp_path / "d0.h5")
     assert status == 0, err
     status, out, err = cli("plan", config, "--data", tmp_path / "d0.h5", "--diagnose", "--write-model",

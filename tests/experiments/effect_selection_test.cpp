@@ -176,7 +176,7 @@ TEST(EffectSelection, AUserDeclaredEffectIsFoundWithALibraryEffect) {
   std::ofstream(dir / "model.toml") << declaration;
   std::ofstream(dir / "world.toml") << declaration << "\n[effects]\ncart_spring = -30.0\ncart_coulomb_friction = 1.0\n";
   const ModelSpec world = diagnosis::read_model_file(dir / "world.toml", "cartpole");
-  const MeasurementSet data = data_of(world, 16, 8, 150, 0.02);
+  const MeasurementSet data = data_of(world, 16, 16, 200, 0.02);
   diagnosis::DiagnosisOptions o = auto_options("cartpole");
   o.model = diagnosis::read_model_file(dir / "model.toml", "cartpole");
   const DiagnosisReport r = diagnosis::diagnose(data, o);

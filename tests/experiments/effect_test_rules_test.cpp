@@ -33,6 +33,12 @@ TEST(BatchStatistics, StudentsQuantilesMatchTheTable) {
   }
   EXPECT_THROW(batch_half_width(1.0, 1), std::invalid_argument);
   EXPECT_NEAR(student_t_quantile(0.995, 3), 5.841, 5e-4);
+  // t_{0.995, 3} = 5.841 and t_{0.999, 3} = 10.215 have the tails of z = 2.5758 and 3.0902.
+  EXPECT_NEAR(normal_equivalent(5.841, 4), 2.5758, 1e-3);
+  EXPECT_NEAR(normal_equivalent(10.215, 4), 3.0902, 1e-3);
+  EXPECT_NEAR(normal_equivalent(-10.215, 4), -3.0902, 1e-3);
+  EXPECT_NEAR(normal_equivalent(3.0, 100000), 3.0, 1e-3);
+  EXPECT_EQ(normal_equivalent(1e300, 3), 37.0);
   EXPECT_THROW(student_t_quantile(1.0, 3), std::invalid_argument);
 }
 
@@ -258,7 +264,7 @@ TEST(EffectTest, OneOfTwoHiddenEffectsIsPartlyExplained) {
 TEST(EffectTest, TwoFitsAreComparedBatchByBatchOnTheSameHeldOutRows) {
   // Closed form: batches b = 1 each; the first fit removes 0.5 of every batch, the second 0.3 or 0.5
   // in turn. Difference 0.1 (= 0.4 / 4), residuals of the batch differences +-0.1, so the variance
-  // of the ratio is K / (K - 1) * 0.04 / B^2 = 4/3 * 0.04 / 16 and the half-width 1.96 times its root.
+  // of the ratio is K / (K - 1) * 0.04 / B^2 = 4/3 * 0.04 / 16 and the half-width t_{0.975, 3} times its root.
   EffectFit a, b;
   a.heldout_batch_before = b.heldout_batch_before = Vector::Ones(4);
   a.heldout_batch_reduction = Vector::Constant(4, 0.5);
@@ -266,7 +272,7 @@ TEST(EffectTest, TwoFitsAreComparedBatchByBatchOnTheSameHeldOutRows) {
   const HeldoutComparison c = compare_heldout(a, b);
   ASSERT_TRUE(c.comparable);
   EXPECT_NEAR(c.difference, 0.1, 1e-15);
-  EXPECT_NEAR(c.difference_ci, 1.96 * std::sqrt(4.0 / 3.0 * 0.04) / 4.0, 1e-15);
+  EXPECT_NEAR(c.difference_ci, 3.182446305284263 * std::sqrt(4.0 / 3.0 * 0.04) / 4.0, 1e-12);  // t_{0.975, 3}
   // The same reductions in every batch: the difference is certain, however much each share varies.
   b.heldout_batch_reduction = a.heldout_batch_reduction.array() - 0.1;
   a.heldout_batch_reduction = (Vector(4) << 0.9, 0.1, 0.8, 0.2).finished();

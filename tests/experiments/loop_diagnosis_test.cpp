@@ -116,11 +116,12 @@ TEST(LoopDiagnosis, FindsTheLongerPoleAndTheCartFrictionInRolloutsOfTheWorld) {
   std::filesystem::remove_all(folder);
 }
 
-/// The tiny run of the experiment tests in the world above, diagnosing after round 0 of four rollouts.
+/// The tiny run of the experiment tests in the world above, diagnosing after round 0 of sixteen rollouts
+/// (240 transitions: the held-out test needs about ten batches of ten rows to call a finding).
 RunConfig diagnosing_config(const std::filesystem::path& folder) {
   std::string text = test::kTinyRun;
   const std::string loop = "[loop]\niterations = 2\nrollouts = 1\n";
-  text.replace(text.find(loop), loop.size(), "[loop]\niterations = 2\nrollouts = 4\nexploration = [8.0]\n");
+  text.replace(text.find(loop), loop.size(), "[loop]\niterations = 2\nrollouts = 16\nexploration = [8.0]\n");
   text.replace(text.find("[pddp]\n"), 7, "[pddp]\nenabled = false\n");
   text += fmt::format("[world]\nmodel = \"{}\"\n[diagnosis]\nafter_round = 0\n", write_world(folder).string());
   return parse_run_config("cartpole", text, (folder / "run.toml").string());
@@ -193,7 +194,7 @@ TEST(LoopDiagnosisCli, PlanDiagnosesTheLogsWritesTheModelAndTheNextRoundPlansOnI
     return r;
   };
   const auto rollout = [&](const std::string& policy, const std::string& log) {
-    cli(fmt::format("rollout --system cartpole --world-model {} --policy {} --out {} --seed 3 --episodes 4 "
+    cli(fmt::format("rollout --system cartpole --world-model {} --policy {} --out {} --seed 3 --episodes 16 "
                     "--exploration 8 --observation-noise 0.001",
                     test::quote(dir / "world.toml"), test::quote(dir / policy), test::quote(dir / log)));
   };

@@ -375,8 +375,10 @@ void score_heldout(const SetResidual& residual, const Vector& theta, const FitCo
   const double se = std::sqrt(K / (K - 1.0) * spread) / b_total;
   fit.heldout_batch_before = Eigen::Map<const Vector>(b_batches.data(), static_cast<Eigen::Index>(b_batches.size()));
   fit.heldout_batch_reduction = Eigen::Map<const Vector>(d_batches.data(), static_cast<Eigen::Index>(d_batches.size()));
-  fit.explained_ci = 1.96 * se;
-  fit.z_score = se > 0.0 ? fit.explained / se : (fit.explained > 0.0 ? 1e6 : 0.0);
+  // K batches: Student's t with K - 1 degrees of freedom, z its normal equivalent (student_t.hpp).
+  const int batches = static_cast<int>(d_batches.size());
+  fit.explained_ci = batch_half_width(se, batches);
+  fit.z_score = se > 0.0 ? normal_equivalent(fit.explained / se, batches) : (fit.explained > 0.0 ? 1e6 : 0.0);
 }
 
 /// The 95% interval at theta_hat (step 3): [low, high]. With instruments (Q, an orthonormal basis of

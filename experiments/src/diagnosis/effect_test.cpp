@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/experiments/diagnosis/student_t.hpp"
+
 namespace gpilqg::diagnosis {
 
 bool interval_contains_null(const EffectValues& v) {
@@ -76,7 +78,7 @@ HeldoutComparison compare_heldout(const EffectFit& a, const EffectFit& b) {
   c.difference = d.sum() / before;
   const double spread = (d - c.difference * a.heldout_batch_before).squaredNorm();
   const auto k = static_cast<double>(K);
-  c.difference_ci = 1.96 * std::sqrt(k / (k - 1.0) * spread) / before;
+  c.difference_ci = batch_half_width(std::sqrt(k / (k - 1.0) * spread) / before, static_cast<int>(K));
   return c;
 }
 

@@ -1,9 +1,11 @@
 #include "gpilqg/experiments/diagnosis/student_t.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
 namespace gpilqg::diagnosis {
@@ -26,6 +28,18 @@ double student_t_quantile(double p, double dof) {
 double batch_half_width(double se, int batches) {
   check_batches(batches);
   return student_t_quantile(0.975, batches - 1.0) * se;
+}
+
+double normal_equivalent(double t, int batches) {
+  check_batches(batches);
+  if (std::isnan(t) || std::isinf(t)) return t;
+  constexpr double kCap = 37.0;  // Phi(-37) ~ 6e-300: beyond it the tail is not a double
+  const boost::math::students_t_distribution<double> student(batches - 1.0);
+  // The smaller tail, for accuracy: z = -Phi^-1(Q(|t|)) with the sign of t.
+  const double tail = boost::math::cdf(boost::math::complement(student, std::abs(t)));
+  if (!(tail > 0.0)) return std::copysign(kCap, t);
+  const double z = -boost::math::quantile(boost::math::normal_distribution<double>(), std::min(tail, 0.5));
+  return std::copysign(std::min(z, kCap), t);
 }
 
 }  // namespace gpilqg::diagnosis

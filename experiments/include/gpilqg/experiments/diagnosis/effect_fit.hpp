@@ -29,7 +29,8 @@
 /// 4. On the held-out episodes: RMSE per state before and after, and the weighted fraction of
 ///    squared residual explained, 1 - S_after / S_before, with a 95% interval and a z score from batch
 ///    means of the per-sample reduction (batches of consecutive samples within an episode, so the
-///    serial correlation of the residual does not inflate the significance).
+///    serial correlation of the residual does not inflate the significance): with K batches, Student's
+///    quantile on K - 1 degrees of freedom and z the normal equivalent of the studentised mean.
 ///
 /// Inverse dynamics (FitCriterion::InverseDynamics). A force effect enters the generalised-force
 /// residual as r(theta) = r^0 - Q_e(theta), so for forces linear in their parameters the residual is
@@ -164,7 +165,7 @@ struct EffectFit {
   Vector heldout_rmse_after;   ///< n
   double explained = 0.0;      ///< 1 - S_after / S_before on the held-out rows
   double explained_ci = 0.0;   ///< half-width of its 95% interval
-  double z_score = 0.0;        ///< mean reduction / its batch-means standard error
+  double z_score = 0.0;        ///< normal equivalent of mean reduction / its batch-means standard error
   /// The held-out batches of the significance test (step 4), in order: each batch's weighted
   /// squared residual of the model (before) and its reduction by the fit (before - after). Every fit
   /// of one context has the same batches, so two fits can be compared batch by batch

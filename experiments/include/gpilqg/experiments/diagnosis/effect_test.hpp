@@ -69,7 +69,7 @@ EffectTestResult test_effect(const EffectFit& fit, const EffectTestThresholds& t
 struct HeldoutComparison {
   bool comparable = false;
   double difference = 0.0;     ///< a.explained - b.explained
-  double difference_ci = 0.0;  ///< 95% half-width
+  double difference_ci = 0.0;  ///< 95% half-width, Student's quantile on K - 1 degrees of freedom (student_t.hpp)
 };
 HeldoutComparison compare_heldout(const EffectFit& a, const EffectFit& b);
 
