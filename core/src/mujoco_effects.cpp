@@ -164,8 +164,12 @@ SystemEntry mujoco_system_entry(const std::string& path) {
   };
   entry.effects = mujoco_effect_library(*file);
   complete_system_entry(entry);
-  for (const std::string& joint : file->joint_names())
+  // A joint's damping is viscous friction, its frictionloss dry (Coulomb) friction: the library's forces
+  // of the same physics, never both in one set.
+  for (const std::string& joint : file->joint_names()) {
     entry.same_physics.push_back({"param:" + joint + ".damping", "joint_viscous_damping:" + joint});
+    entry.same_physics.push_back({"param:" + joint + ".frictionloss", "joint_coulomb_friction:" + joint});
+  }
   for (const std::string& actuator : file->actuator_names())
     entry.same_physics.push_back({"param:" + actuator + ".gear", "actuator_gain:" + actuator});
   return entry;

@@ -25,6 +25,7 @@
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
+#include "gpilqg/experiments/diagnosis/student_t.hpp"
 #include "test_support.hpp"
 
 namespace gpilqg {
@@ -83,6 +84,73 @@ TEST(InverseDynamicsAccelerations, ExactForPolynomialsOfTheFilterOrderAtEverySam
     ASSERT_EQ(estimate.qdd.rows(), data.size());
     for (int r = 0; r < data.size(); ++r) EXPECT_NEAR(estimate.qdd(r, 0), a(data.t(r)), 1e-8) << "order " << order << " row " << r;
   }
+}
+
+// Parallel filtering (accelerations.hpp): the acceleration estimate is a weighted mean of the
+// acceleration over its window, and filtered_controls applies the same weights to the controls. A
+// second derivation: velocities integrated exactly from random controls, v1' = u1 and
+// v2' = u1 - 2 u2, continuous (piecewise linear: each step's increment is dt times the mean of its
+// ends) or held (each step's increment is dt times its first control). The estimate of both columns
+// (one window for both) must be G times the filtered controls at every row, the ends included.
+TEST(InverseDynamicsAccelerations, ParallelFilteringSeesTheControlsAsTheEstimateSeesTheAcceleration) {
+  const double dt = 0.002;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (const ControlHold hold : {ControlHold::Continuous, ControlHold::ZeroOrder}) {
+    std::vector<Matrix> states, controls;
+    for (const int T : {400, 260}) {
+      Matrix u(T, 2), x(T, 2);
+      for (int s = 0; s < T; ++s) u.row(s) << std::sin(0.05 * s) + 0.3 * gauss(rng), 0.5 * gauss(rng);
+      u.row(T - 1) = u.row(T - 2);  // no control after the last row: the filter holds the last one
+      x.row(0) << 0.4, -0.2;
+      for (int s = 0; s + 1 < T; ++s) {
+        const Eigen::RowVector2d mean = hold == ControlHold::Continuous ? Eigen::RowVector2d(0.5 * (u.row(s) + u.row(s + 1)))
+                                                                        : Eigen::RowVector2d(u.row(s));
+        x(s + 1, 0) = x(s, 0) + dt * mean(0);
+        x(s + 1, 1) = x(s, 1) + dt * (mean(0) - 2.0 * mean(1));
+      }
+      states.push_back(x);
+      controls.push_back(u);
+    }
+    const Transitions data = transitions_of(states, controls, dt);
+    for (const int window : {5, 21, 61}) {
+      // The estimate of both columns with this window, episode by episode (the rows of one episode
+      // and its last x_next are its samples).
+      const SavitzkyGolayDerivative filter(window, 2);
+      Matrix qdd(data.size(), 2);
+      for (std::size_t e = 0, row = 0; e < states.size(); ++e) {
+        const auto rows = static_cast<Eigen::Index>(states[e].rows() - 1);
+        for (int j = 0; j < 2; ++j) qdd.col(j).segment(static_cast<Eigen::Index>(row), rows) =
+            filter.differentiate(states[e].col(j), dt).head(rows);
+        row += static_cast<std::size_t>(rows);
+      }
+      const Matrix filtered = filtered_controls(data, data.u, window, 2, hold);
+      for (int r = 0; r < data.size(); ++r) {
+        EXPECT_NEAR(qdd(r, 0), filtered(r, 0), 1e-8) << "window " << window << " row " << r;
+        EXPECT_NEAR(qdd(r, 1), filtered(r, 0) - 2.0 * filtered(r, 1), 1e-8) << "window " << window << " row " << r;
+      }
+      // Not trivially so: the filtered controls are far from the controls themselves.
+      EXPECT_GT((filtered - data.u).cwiseAbs().maxCoeff(), 0.3) << window;
+      for (int p = 0; p < window; ++p) EXPECT_NEAR(acceleration_weights(filter, p, hold).sum(), 1.0, 1e-12);
+    }
+  }
+}
+
+// Every column is differentiated with one window, the widest of the columns' own choices: a noisy
+// column beside a clean one sets it for both.
+TEST(InverseDynamicsAccelerations, EveryColumnTakesTheWidestWindow) {
+  const double dt = 0.01;
+  const auto v = [](double t) { return std::sin(1.3 * t); };
+  Matrix x(400, 2);
+  x.col(0) = sampled(v, 400, dt, 0.0, 1);
+  x.col(1) = sampled(v, 400, dt, 0.02, 2);
+  const Transitions data = transitions_of({x}, {Matrix::Zero(400, 1)}, dt);
+  const AccelerationEstimate estimate = estimate_accelerations(data, {0, 1}, dt);
+  ASSERT_EQ(estimate.windows.size(), 2u);
+  EXPECT_LT(estimate.windows[0].window, estimate.windows[1].window);
+  EXPECT_EQ(estimate.window, estimate.windows[1].window);
+  const Vector clean = SavitzkyGolayDerivative(estimate.window, 2).differentiate(x.col(0), dt);
+  EXPECT_MATRIX_NEAR(estimate.qdd.col(0), clean.head(data.size()), 1e-12);
 }
 
 TEST(InverseDynamicsAccelerations, ZeroLagOnANoisySinusoidWhereACausalWindowWouldLag) {
@@ -491,7 +559,7 @@ std::string arm_2ms_path() {
 struct HiddenFrictionWorld {
   ModelSpec model;
   DynamicsPtr world;
-  std::vector<Matrix> states, controls;  ///< three episodes of 3 s at 500 Hz
+  std::vector<Matrix> states, controls;  ///< five episodes of 3 s at 500 Hz
   double dt = 0.002;  ///< the elbow's friction turns within v0 = 0.1 rad/s, a few milliseconds at these speeds
 };
 
@@ -504,7 +572,7 @@ const HiddenFrictionWorld& hidden_friction_world() {
     world.forces.push_back({"joint_coulomb_friction:elbow", Vector::Constant(1, kElbowFriction)});
     world.smoothing["joint_coulomb_friction:elbow"] = kElbowSmoothing;
     w.world = world.build();
-    for (int e = 0; e < 3; ++e) {
+    for (int e = 0; e < 5; ++e) {
       Matrix x, u;
       simulate_world(*w.world, w.dt, 1501, e, x, u);
       w.states.push_back(x);
@@ -648,7 +716,13 @@ LeastSquaresFit least_squares_fit(const Matrix& X, const Vector& r0, const std::
   Vector jack = Vector::Zero(p);
   for (const Vector& t : replicates) jack += (t - mean).cwiseAbs2();
   const auto R = static_cast<double>(replicates.size());
-  out.half = 1.96 * variance.cwiseMax(jack * (R - 1.0) / R).cwiseSqrt();
+  jack *= (R - 1.0) / R;
+  // The normal quantile, or Student's on R - 1 degrees of freedom where the jackknife is the larger
+  // (student_t.hpp, checked against the table in its own test).
+  out.half.resize(p);
+  for (Eigen::Index j = 0; j < p; ++j)
+    out.half(j) = jack(j) > variance(j) ? student_t_quantile(0.975, R - 1.0) * std::sqrt(jack(j))
+                                        : 1.96 * std::sqrt(variance(j));
   return out;
 }
 

@@ -1,5 +1,6 @@
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -66,19 +67,62 @@ AccelerationEstimate estimate_accelerations(const Transitions& data, const std::
 
   AccelerationEstimate out;
   out.velocity_states = velocity_states;
+  out.order = order;
   out.qdd.resize(data.size(), static_cast<Eigen::Index>(velocity_states.size()));
+  std::vector<std::vector<Vector>> samples(velocity_states.size());
   for (std::size_t k = 0; k < velocity_states.size(); ++k) {
-    std::vector<Vector> samples;
-    samples.reserve(segments.size());
-    for (const RowSegment& s : segments) samples.push_back(column_samples(data, s, velocity_states[k]));
-    const DerivativeWindow window = choose_derivative_window(samples, dt, order);
-    const SavitzkyGolayDerivative filter(window.window, order);
+    for (const RowSegment& s : segments) samples[k].push_back(column_samples(data, s, velocity_states[k]));
+    out.windows.push_back(choose_derivative_window(samples[k], dt, order));
+    out.window = std::max(out.window, out.windows.back().window);
+  }
+  if (velocity_states.empty()) return out;
+  const SavitzkyGolayDerivative filter(out.window, order);
+  for (std::size_t k = 0; k < velocity_states.size(); ++k)
     for (std::size_t s = 0; s < segments.size(); ++s) {
-      const Vector derivative = filter.differentiate(samples[s], dt);
+      const Vector derivative = filter.differentiate(samples[k][s], dt);
       const int rows = segments[s].end - segments[s].first;
       out.qdd.col(static_cast<Eigen::Index>(k)).segment(segments[s].first, rows) = derivative.head(rows);
     }
-    out.windows.push_back(window);
+  return out;
+}
+
+Vector acceleration_weights(const SavitzkyGolayDerivative& filter, int position, ControlHold hold) {
+  const int w = filter.window();
+  const Vector& c = filter.weights(position);
+  // k_s = sum_{j > s} c_j: the weight of the increment from sample s to s + 1 (s = 0 .. w-2).
+  Vector k = Vector::Zero(w);  // k(w - 1) = 0: no increment leaves the last sample
+  for (int s = w - 2; s >= 0; --s) k(s) = k(s + 1) + c(s + 1);
+  if (hold == ControlHold::ZeroOrder) return k;
+  Vector m(w);
+  for (int r = 0; r < w; ++r) m(r) = 0.5 * (k(r) + (r > 0 ? k(r - 1) : 0.0));
+  return m;
+}
+
+Matrix filtered_controls(const Transitions& data, const Matrix& u, int window, int order, ControlHold hold) {
+  if (u.rows() != data.size())
+    throw std::invalid_argument(
+        fmt::format("filtered controls: {} rows of controls for {} transitions; expected one per transition", u.rows(),
+                    data.size()));
+  const SavitzkyGolayDerivative filter(window, order);
+  std::vector<Vector> weights;
+  for (int p = 0; p < window; ++p) weights.push_back(acceleration_weights(filter, p, hold));
+  const int h = window / 2;
+  Matrix out(u.rows(), u.cols());
+  for (const RowSegment& s : row_segments(data)) {
+    if (s.samples() < window)
+      throw std::invalid_argument(fmt::format(
+          "filtered controls: episode {} (rows {} to {}) has {} samples; the window spans {}", s.episode, s.first,
+          s.end - 1, s.samples(), window));
+    const int rows = s.end - s.first;
+    for (int t = 0; t < rows; ++t) {
+      // The window of sample t: centred, or the first / last w samples near the ends.
+      const int start = std::clamp(t - h, 0, s.samples() - window);
+      const Vector& m = weights[static_cast<std::size_t>(t - start)];
+      auto row = out.row(s.first + t);
+      row.setZero();
+      for (int r = 0; r < window; ++r)  // the segment's last sample takes its last row's control
+        row += m(r) * u.row(s.first + std::min(start + r, rows - 1));
+    }
   }
   return out;
 }

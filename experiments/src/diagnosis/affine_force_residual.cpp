@@ -33,7 +33,7 @@ Matrix weighted_force_regressor(const ModelSpec& model, const std::vector<const 
   const DynamicsPtr system = model.build();
   const Dynamics& owner = force_map_system(*system);
   const auto workspace = owner.make_workspace();
-  const Matrix u = applied_controls(*c.data, model.input_delay);
+  const Matrix u = force_controls(model, c);
   const Vector sqrt_w = c.weights.cwiseSqrt();
   const Eigen::Index k = sqrt_w.size();
   Eigen::Index p = 0;

@@ -11,6 +11,7 @@
 #include "gpilqg/core/effects.hpp"
 #include "gpilqg/core/generalised_forces.hpp"
 #include "gpilqg/core/savitzky_golay.hpp"
+#include "gpilqg/experiments/diagnosis/accelerations.hpp"
 #include "gpilqg/experiments/diagnosis/derivative_window.hpp"
 #include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
 #include "gpilqg/experiments/diagnosis/motion_period.hpp"
@@ -143,28 +144,9 @@ std::string why_not_forces(const Dynamics& model, const std::vector<GeneralisedC
 struct StateRatio {
   double ratio = 0.0;
   int window = 0;
-  double control_error = 0.0;
+  double control_error = 0.0;  ///< sqrt(mean a_h^2) / E_ID
+  double smear_error = 0.0;    ///< sqrt(mean a_s^2) / E_ID
 };
-
-/// The symmetric smoothing kernel kk_{-h..h} (2h + 1 weights summing to 1) that the centred
-/// Savitzky-Golay derivative of window w applies to the acceleration: with c_j its weights (per unit
-/// step), the derivative is sum_{s=-h..h-1} k_s a_s over the velocity increments of the steps
-/// [t+s, t+s+1], k_s = sum_{j >= max(s+1, -s)} c_j; each increment holds the mean of the acceleration
-/// at its two ends (a continuous signal), so kk_r = (k_r + k_{r-1}) / 2.
-Vector acceleration_kernel(int window) {
-  const int h = window / 2;
-  const SavitzkyGolayDerivative filter(window, 2);
-  const Vector c = filter.weights(h);
-  Vector k = Vector::Zero(2 * h);  // k_s at index s + h, s = -h .. h-1
-  for (int s = -h; s < h; ++s)
-    for (int j = std::max(s + 1, -s); j <= h; ++j) k(s + h) += c(h + j);
-  Vector kernel = Vector::Zero(2 * h + 1);  // kk_r at index r + h
-  for (int r = -h; r <= h; ++r) {
-    const double right = r < h ? k(r + h) : 0.0, left = r > -h ? k(r - 1 + h) : 0.0;
-    kernel(r + h) = 0.5 * (right + left);
-  }
-  return kernel;
-}
 
 /// The white-noise level of a sampled signal robust to isolated corners and steps: for each order
 /// k = k_min..k_max the median of |Delta^k y| pooled over the segments, over its value for white noise
@@ -193,13 +175,22 @@ double robust_noise_std(const std::vector<Vector>& segments, int k_min, int k_ma
   return std::isfinite(best) ? best : 0.0;
 }
 
-StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, int state, double dt) {
+/// The segments of state column `state` long enough to be differentiated.
+std::vector<Vector> state_segments(const MeasurementSet& data, int state) {
   std::vector<Vector> segments;
   for (const Episode& e : data.episodes)
     if (e.length() >= shortest_differentiable_segment(2)) segments.push_back(e.x.col(state));
+  return segments;
+}
+
+/// rho of velocity state `state` with the acceleration estimate of window `window` (the one window of
+/// every coordinate, accelerations.hpp).
+StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, int state, double dt, int window) {
+  const std::vector<Vector> segments = state_segments(data, state);
   StateRatio out;
   if (segments.empty()) return out;
-  // The noise of the controls, which both residuals carry alike (b_v n_u in acceleration units).
+  // The noise of the controls, which both residuals carry (b_v n_u in acceleration units), the
+  // inverse-dynamics one seen through the filter (|m|^2 of its variance).
   const int m = model.control_dim();
   Vector control_noise(m);
   for (int j = 0; j < m; ++j) {
@@ -207,40 +198,65 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, int st
     for (const Episode& e : data.episodes) columns.push_back(e.u.col(j));
     control_noise(j) = robust_noise_std(columns, 1, 2);
   }
-  const DerivativeWindow dw = choose_derivative_window(segments, dt, 2);
-  out.window = dw.window;
-  const int h = dw.window / 2;
-  const Vector kernel = acceleration_kernel(dw.window);
+  out.window = window;
+  const int h = window / 2;
+  const SavitzkyGolayDerivative filter(window, 2);
+  // The weights on the accelerations at every place in the window (accelerations.hpp), for a
+  // continuous control and for one held over each step.
+  std::vector<Vector> continuous, held;
+  for (int p = 0; p < window; ++p) {
+    continuous.push_back(acceleration_weights(filter, p, ControlHold::Continuous));
+    held.push_back(acceleration_weights(filter, p, ControlHold::ZeroOrder));
+  }
 
-  long interior = 0;
+  long rows = 0;
   for (const Episode& e : data.episodes)
-    if (e.length() >= dw.window) interior += e.length() - 2 * h;
-  const long stride = std::max(1L, interior / kControlErrorRows);
+    if (e.length() >= window) rows += e.length();
+  const long stride = std::max(1L, rows / kControlErrorRows);
   DynamicsJacobians jac;
   Vector xdot(model.state_dim());
   const auto workspace = model.make_workspace();
-  double sum = 0.0, shared = 0.0;
+  double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0;
   long count = 0, position = 0;
   for (const Episode& e : data.episodes) {
-    if (e.length() < dw.window) continue;
-    for (Eigen::Index t = h; t + h < e.length(); ++t, ++position) {
+    if (e.length() < window) continue;
+    // The model's acceleration of the state at every sample of the episode, as measured.
+    Vector own(e.length());
+    for (Eigen::Index r = 0; r < e.length(); ++r) {
+      model.evaluate(e.x.row(r).transpose(), e.u.row(r).transpose(), xdot, nullptr, *workspace);
+      own(r) = xdot(state);
+    }
+    // Every sample at its place p in its window: centred, or off-centre at the episode's ends, where
+    // the estimate is noisier and no longer zero-phase (on short episodes most samples are there).
+    for (Eigen::Index t = 0; t < e.length(); ++t, ++position) {
       if (position % stride != 0) continue;
-      const Vector smoothed = e.u.middleRows(t - h, dw.window).transpose() * kernel;
-      const Vector du = smoothed - e.u.row(t).transpose();
-      model.evaluate(e.x.row(t).transpose(), e.u.row(t).transpose(), xdot, &jac, *workspace);
-      sum += std::pow(jac.fu.row(state).dot(du), 2);
-      shared += jac.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
+      const Eigen::Index start = std::clamp<Eigen::Index>(t - h, 0, e.length() - window);
+      const auto p = static_cast<std::size_t>(t - start);
+      const auto u = e.u.middleRows(start, window).transpose();
+      // The two holds' filtered controls differ by what the data cannot tell apart.
+      const Vector du = u * (continuous[p] - held[p]);
+      // What the filter smears: the window's mean of the model's acceleration against the model's
+      // acceleration at x_t under the window's mean control (0 when nothing but the control changes).
+      const Vector filtered_u = u * continuous[p];
+      model.evaluate(e.x.row(t).transpose(), filtered_u, xdot, &jac, *workspace);
+      smear += std::pow(own.segment(start, window).dot(continuous[p]) - xdot(state), 2);
+      hold += std::pow(jac.fu.row(state).dot(du), 2);
+      const double noise = jac.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
+      shared += noise;
+      filtered_noise += noise * continuous[p].squaredNorm();
+      gain += filter.weights(static_cast<int>(p)).squaredNorm();
       ++count;
     }
   }
-  const double control_mse = count > 0 ? sum / static_cast<double>(count) : 0.0;
+  const double n = std::max(1.0, static_cast<double>(count));
+  const double hold_mse = hold / n, smear_mse = smear / n, shared_mse = shared / n;
   const double sigma = robust_noise_std(segments, 2, 4);
-  const double e1_squared =
-      2.0 * sigma * sigma / (dt * dt) + (count > 0 ? shared / static_cast<double>(count) : 0.0);
-  const double eid_squared = dw.risk + control_mse;
+  const double e1_squared = 2.0 * sigma * sigma / (dt * dt) + shared_mse;
+  const double eid_squared = sigma * sigma * gain / n / (dt * dt) + smear_mse + hold_mse + filtered_noise / n;
   out.ratio = eid_squared > 0.0 ? std::sqrt(e1_squared / eid_squared)
                                 : (e1_squared > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
-  out.control_error = eid_squared > 0.0 ? std::sqrt(control_mse / eid_squared) : 0.0;
+  out.control_error = eid_squared > 0.0 ? std::sqrt(hold_mse / eid_squared) : 0.0;
+  out.smear_error = eid_squared > 0.0 ? std::sqrt(smear_mse / eid_squared) : 0.0;
   return out;
 }
 
@@ -370,14 +386,22 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
                                 facts.not_forces);
     return choice;
   }
+  // The one window of the acceleration estimate: the widest of the coordinates' own (accelerations.hpp).
+  int window = 0;
+  for (const GeneralisedCoordinate& c : coordinates) {
+    const std::vector<Vector> segments = state_segments(data, c.velocity);
+    if (!segments.empty()) window = std::max(window, choose_derivative_window(segments, facts.dt, 2).window);
+  }
   facts.ratio = std::numeric_limits<double>::infinity();
   for (const GeneralisedCoordinate& c : coordinates) {
-    const StateRatio r = state_ratio(*dynamics, data, c.velocity, facts.dt);
+    if (window == 0) break;
+    const StateRatio r = state_ratio(*dynamics, data, c.velocity, facts.dt, window);
     if (r.ratio < facts.ratio || facts.ratio_state.empty()) {
       facts.ratio = r.ratio;
       facts.ratio_state = data.system.states[static_cast<std::size_t>(c.velocity)].name;
       facts.acceleration_window = r.window;
       facts.control_error = r.control_error;
+      facts.smear_error = r.smear_error;
     }
   }
   if (facts.acceleration_window == 0) {
@@ -387,8 +411,10 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
     return choice;
   }
   const std::string measured = fmt::format(
-      "{}: acceleration window of {} samples at {:.4g} Hz, {:.0f}% of its mean squared error from the controls changing within it",
-      facts.ratio_state, facts.acceleration_window, 1.0 / facts.dt, 100.0 * facts.control_error * facts.control_error);
+      "{}: acceleration window of {} samples at {:.4g} Hz; of its mean squared error {:.0f}% from the motion within "
+      "the window, {:.0f}% from not knowing how the controls are held",
+      facts.ratio_state, facts.acceleration_window, 1.0 / facts.dt, 100.0 * facts.smear_error * facts.smear_error,
+      100.0 * facts.control_error * facts.control_error);
   if (facts.ratio >= kInverseDynamicsRatio) {
     choice.criterion = FitCriterion::InverseDynamics;
     for (const GeneralisedCoordinate& c : coordinates) {

@@ -37,6 +37,30 @@ double centred_estimate(const Vector& c, const Vector& y, Eigen::Index i) {
   return c.dot(y.segment(i - half, c.size()));
 }
 
+/// R_hat(w) of the file comment with the noise level `sigma`; +inf when no sample has both filters
+/// centred.
+double estimated_risk(const std::vector<Vector>& segments, double dt, int order, int window, double sigma) {
+  const int needed = shortest_differentiable_segment(order);
+  const double noise_variance = sigma * sigma / (dt * dt);  // per unit squared weight
+  const SavitzkyGolayDerivative filter(window, order);
+  // The reference: degree order + 2 on the same window (or the shortest it has).
+  const SavitzkyGolayDerivative reference(std::max(window, needed), order + 2);
+  const int half = reference.window() / 2;
+  const Vector c = centred_weights(filter, half);
+  const Vector difference = c - centred_weights(reference, half);
+  double sum = 0.0;
+  Eigen::Index count = 0;
+  for (const Vector& y : segments)
+    for (Eigen::Index i = half; i + half < y.size(); ++i) {
+      const double d = centred_estimate(difference, y, i) / dt;
+      sum += d * d;
+      ++count;
+    }
+  if (count == 0) return std::numeric_limits<double>::infinity();
+  const double squared_bias = std::max(0.0, sum / static_cast<double>(count) - noise_variance * difference.squaredNorm());
+  return noise_variance * c.squaredNorm() + squared_bias;
+}
+
 }  // namespace
 
 double difference_noise_std(const std::vector<Vector>& segments) {
@@ -78,7 +102,6 @@ DerivativeWindow choose_derivative_window(const std::vector<Vector>& segments, d
   }
 
   const double sigma = difference_noise_std(segments);
-  const double noise_variance = sigma * sigma / (dt * dt);  // per unit squared weight
 
   DerivativeWindow best;
   best.order = order;
@@ -87,28 +110,13 @@ DerivativeWindow choose_derivative_window(const std::vector<Vector>& segments, d
   int candidates = 0;
   for (int h = smallest_window(order) / 2; 2 * h + 1 <= shortest;
        h = std::max(h + 1, static_cast<int>(std::lround(1.2 * h)))) {
-    const SavitzkyGolayDerivative filter(2 * h + 1, order);
-    // The reference: degree order + 2 on the same window (or the shortest it has).
-    const SavitzkyGolayDerivative reference(std::max(2 * h + 1, needed), order + 2);
-    const int half = reference.window() / 2;
-    const Vector c = centred_weights(filter, half);
-    const Vector difference = c - centred_weights(reference, half);
-    double sum = 0.0;
-    Eigen::Index count = 0;
-    for (const Vector& y : segments)
-      for (Eigen::Index i = half; i + half < y.size(); ++i) {
-        const double d = centred_estimate(difference, y, i) / dt;
-        sum += d * d;
-        ++count;
-      }
-    if (count == 0) break;
-    const double squared_bias = std::max(0.0, sum / static_cast<double>(count) - noise_variance * difference.squaredNorm());
-    const double risk = noise_variance * c.squaredNorm() + squared_bias;
+    const double risk = estimated_risk(segments, dt, order, 2 * h + 1, sigma);
+    if (!std::isfinite(risk)) break;
     ++candidates;
     if (risk < best.risk) {
       best.window = 2 * h + 1;
       best.risk = risk;
-      best.noise_gain = filter.noise_gain(dt);
+      best.noise_gain = SavitzkyGolayDerivative(2 * h + 1, order).noise_gain(dt);
     } else if (risk > 4.0 * best.risk) {
       break;
     }

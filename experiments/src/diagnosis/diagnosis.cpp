@@ -425,6 +425,9 @@ void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidat
     }
   R.criterion_weights = context.weights;
   R.accelerations = context.accelerations;
+  R.acceleration_window = context.acceleration_window;
+  R.filtered_controls = context.filtered_controls;
+  R.filtered_delay = context.filtered_delay;
   R.initial_state = context.initial_state;
   if (o.criterion == FitCriterion::InverseDynamics) {
     for (const Quantity& q : force_components(*R.model.build()).forces) {
@@ -526,6 +529,9 @@ double flexible_share(const ModelSpec& model, const Matrix& residual, const Resi
     FitContext c{&R.data, model, o.integrator, R.dt, o.substeps, R.criterion_weights, Matrix()};
     c.criterion = FitCriterion::InverseDynamics;
     c.accelerations = R.accelerations;
+    c.acceleration_window = R.acceleration_window;
+    c.filtered_controls = R.filtered_controls;
+    c.filtered_delay = R.filtered_delay;
     const Matrix force = criterion_residual(model, c);
     return weighted_heldout_explained(R.data, force, gp_column_means(R.data, force, o.gp), R.criterion_weights);
   }

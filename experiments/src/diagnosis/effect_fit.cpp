@@ -22,6 +22,7 @@
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/accelerations.hpp"
 #include "gpilqg/experiments/diagnosis/initial_state.hpp"
 #include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
@@ -55,7 +56,8 @@ bool estimates_starts(const FitContext& c) {
 Matrix criterion_residual(const ModelSpec& model, const FitContext& settings, int* diverged) {
   if (settings.criterion == FitCriterion::InverseDynamics) {
     if (diverged != nullptr) *diverged = 0;
-    return generalised_force_residual(model, *settings.data, *settings.accelerations, all_rows(*settings.data));
+    return generalised_force_residual(model, *settings.data, force_controls(model, settings), *settings.accelerations,
+                                      all_rows(*settings.data));
   }
   const Matrix errors = settings.data->x_next - model_predictions(model, settings, diverged);
   if (!estimates_starts(settings)) return errors;
@@ -68,7 +70,7 @@ namespace {
 /// k c + i). A model that does not accept the data (a singular map, a force that is not finite) is an
 /// std::invalid_argument, which the objective turns into +inf.
 Vector weighted_force_residual(const ModelSpec& model, const FitContext& c, const std::vector<int>& rows) {
-  const Matrix r = generalised_force_residual(model, *c.data, *c.accelerations, rows);
+  const Matrix r = generalised_force_residual(model, *c.data, force_controls(model, c), *c.accelerations, rows);
   const Vector sqrt_w = c.weights.cwiseSqrt();
   const auto k = static_cast<Eigen::Index>(sqrt_w.size());
   Vector out(static_cast<Eigen::Index>(rows.size()) * k);
@@ -466,6 +468,15 @@ EffectFit led_by(EffectFit fit, const EffectValues& values) {
 
 EffectValues own_values(const EffectFit& fit) {
   return {fit.effect, fit.parameters, fit.initial, fit.estimate, fit.ci_low, fit.ci_high, fit.smoothing, fit.null_value};
+}
+
+Matrix force_controls(const ModelSpec& model, const FitContext& settings) {
+  if (settings.acceleration_window == 0) return applied_controls(*settings.data, model.input_delay);
+  if (settings.filtered_controls && settings.filtered_delay == model.input_delay &&
+      settings.filtered_controls->rows() == settings.data->size())
+    return *settings.filtered_controls;
+  return filtered_controls(*settings.data, applied_controls(*settings.data, model.input_delay),
+                           settings.acceleration_window);
 }
 
 Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows) {

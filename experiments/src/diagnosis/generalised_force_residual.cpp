@@ -138,8 +138,13 @@ Matrix generalised_force_residual(const Dynamics& model, const Transitions& data
 
 Matrix generalised_force_residual(const ModelSpec& model, const Transitions& data, const Matrix& accelerations,
                                   const std::vector<int>& rows) {
+  return generalised_force_residual(model, data, applied_controls(data, model.input_delay), accelerations, rows);
+}
+
+Matrix generalised_force_residual(const ModelSpec& model, const Transitions& data, const Matrix& controls,
+                                  const Matrix& accelerations, const std::vector<int>& rows) {
   const DynamicsPtr system = model.build();
-  return generalised_force_residual(*system, data, applied_controls(data, model.input_delay), accelerations, rows);
+  return generalised_force_residual(*system, data, controls, accelerations, rows);
 }
 
 }  // namespace gpilqg::diagnosis

@@ -95,6 +95,10 @@ FitContext instrument_context(const FitContext& context, const Instruments& inst
   c.data = &instruments.data;
   c.accelerations = instruments.accelerations;
   c.instruments = nullptr;
+  // The simulated accelerations are the model's own at each state, not a window's mean: the
+  // instruments take the controls as applied.
+  c.acceleration_window = 0;
+  c.filtered_controls = nullptr;
   return c;
 }
 

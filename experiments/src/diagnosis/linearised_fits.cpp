@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <stdexcept>
 
 #include <Eigen/Dense>
 
@@ -54,57 +55,69 @@ std::pair<Matrix, Matrix> columns(const ModelSpec& base, const Split& r0, const 
 }  // namespace
 
 LinearisedFits::LinearisedFits(const FitContext& c, const std::vector<EffectFit>& fits,
-                               const std::vector<RefitEffect>& refit, int threads) {
+                               const std::vector<RefitEffect>& refit, int threads, bool keep_columns)
+    : keep_columns_(keep_columns) {
   const std::vector<int> train = c.data->rows(false), heldout = c.data->rows(true);
   ModelSpec base = c.model;
   for (const RefitEffect& r : refit) base = base.with(*r.effect, r.start);
   const Split r0 = residual_split(base, c, train, heldout);
 
   // Candidates first, then the refitted effects; each block of columns computed on its own.
-  struct Block {
-    LibraryEffect effect;
-    Vector theta0;
-    const Vector* fitted = nullptr;
-    bool usable = true;
-  };
-  std::vector<Block> blocks;
   for (const EffectFit& f : fits) {
     names_.push_back(f.effect);
     LibraryEffect effect = find_candidate(c.model, f.effect);
     const Vector theta0 = base.current_values(effect);
-    blocks.push_back({std::move(effect), theta0, &f.estimate, f.identifiable});
+    blocks_.push_back({std::move(effect), theta0, f.estimate, f.identifiable});
     offset_.push_back(offset_.back() + static_cast<Eigen::Index>(f.parameters.size()));
   }
   for (const RefitEffect& r : refit) {
-    blocks.push_back({*r.effect, r.start, nullptr, true});
+    blocks_.push_back({*r.effect, r.start, Vector(), true});
     refit_columns_ += static_cast<Eigen::Index>(r.effect->parameters.size());
   }
   const Eigen::Index P = offset_.back() + refit_columns_;
   Matrix JT = Matrix::Zero(r0.train.size(), P), JH = Matrix::Zero(r0.heldout.size(), P);
-  std::vector<Eigen::Index> at(blocks.size());
-  for (std::size_t b = 0, col = 0; b < blocks.size(); ++b) {
-    at[b] = static_cast<Eigen::Index>(col);
-    col += blocks[b].effect.parameters.size();
-  }
   std::atomic<std::size_t> next{0};
   ForkJoin workers;
-  workers.run(std::max(1, std::min<int>(threads, static_cast<int>(blocks.size()))), [&](int, int) {
-    for (std::size_t b = next++; b < blocks.size(); b = next++) {
-      if (!blocks[b].usable) continue;
-      auto [T, H] = columns(base, r0, blocks[b].effect, blocks[b].theta0, blocks[b].fitted, c, train, heldout);
+  workers.run(std::max(1, std::min<int>(threads, static_cast<int>(blocks_.size()))), [&](int, int) {
+    for (std::size_t b = next++; b < blocks_.size(); b = next++) {
+      if (!blocks_[b].usable) continue;
+      auto [T, H] = columns(base, r0, blocks_[b].effect, blocks_[b].theta0, &blocks_[b].fitted, c, train, heldout);
       if (!T.allFinite() || !H.allFinite()) continue;
-      JT.middleCols(at[b], T.cols()) = T;
-      JH.middleCols(at[b], H.cols()) = H;
+      JT.middleCols(first_column(b), T.cols()) = T;
+      JH.middleCols(first_column(b), H.cols()) = H;
     }
   });
+  accumulate(c, train, JT, JH, r0.train, r0.heldout);
+  if (keep_columns_) {
+    JT_ = std::move(JT);
+    JH_ = std::move(JH);
+    r0_train_ = r0.train;
+    r0_heldout_ = r0.heldout;
+  }
+}
+
+Eigen::Index LinearisedFits::first_column(std::size_t block) const {
+  Eigen::Index col = 0;
+  for (std::size_t b = 0; b < block; ++b) col += static_cast<Eigen::Index>(blocks_[b].effect.parameters.size());
+  return col;
+}
+
+void LinearisedFits::accumulate(const FitContext& c, const std::vector<int>& train, const Matrix& JT, const Matrix& JH,
+                                const Vector& r_train, const Vector& r_heldout) {
+  const Eigen::Index P = JT.cols();
   gram_train_ = JT.transpose() * JT;
   gram_heldout_ = JH.transpose() * JH;
-  cross_train_ = JT.transpose() * r0.train;
-  cross_heldout_ = JH.transpose() * r0.heldout;
-  base_heldout_ = r0.heldout.squaredNorm();
-  base_train_ = r0.train.squaredNorm();
+  cross_train_ = JT.transpose() * r_train;
+  cross_heldout_ = JH.transpose() * r_heldout;
+  base_heldout_ = r_heldout.squaredNorm();
+  base_train_ = r_train.squaredNorm();
 
   // The screening folds: the training episodes dealt in turn into K = min(5, episodes) folds.
+  fold_gram_.clear();
+  fold_cross_.clear();
+  fold_base_.clear();
+  rest_gram_.clear();
+  rest_cross_.clear();
   std::vector<int> episodes;
   for (int r : train) {
     const int e = c.data->episode[static_cast<std::size_t>(r)];
@@ -120,7 +133,7 @@ LinearisedFits::LinearisedFits(const FitContext& c, const std::vector<EffectFit>
     const int e = c.data->episode[static_cast<std::size_t>(train[k])];
     const auto f = static_cast<std::size_t>((std::find(episodes.begin(), episodes.end(), e) - episodes.begin()) % K);
     const auto rows = JT.middleRows(static_cast<Eigen::Index>(k) * n, n);
-    const auto r = r0.train.segment(static_cast<Eigen::Index>(k) * n, n);
+    const auto r = r_train.segment(static_cast<Eigen::Index>(k) * n, n);
     fold_gram_[f].noalias() += rows.transpose() * rows;
     fold_cross_[f].noalias() += rows.transpose() * r;
     fold_base_[f] += r.squaredNorm();
@@ -129,6 +142,27 @@ LinearisedFits::LinearisedFits(const FitContext& c, const std::vector<EffectFit>
     rest_gram_.push_back(gram_train_ - fold_gram_[f]);
     rest_cross_.push_back(cross_train_ - fold_cross_[f]);
   }
+}
+
+void LinearisedFits::relinearise(int candidate, const FitContext& c) {
+  if (!keep_columns_) throw std::logic_error("LinearisedFits::relinearise: the columns were not kept");
+  if (candidate < 0 || candidate >= size()) throw std::out_of_range("LinearisedFits::relinearise: no such candidate");
+  const auto b = static_cast<std::size_t>(candidate);
+  Block& block = blocks_[b];
+  if (!block.usable) return;
+  const std::vector<int> train = c.data->rows(false), heldout = c.data->rows(true);
+  ModelSpec base = c.model;
+  for (std::size_t r = static_cast<std::size_t>(size()); r < blocks_.size(); ++r)
+    base = base.with(blocks_[r].effect, blocks_[r].theta0);
+  block.effect = find_candidate(c.model, names_[b]);
+  auto [T, H] = columns(base, {r0_train_, r0_heldout_}, block.effect, block.theta0, &block.fitted, c, train, heldout);
+  if (!T.allFinite() || !H.allFinite()) {
+    T.setZero();
+    H.setZero();
+  }
+  JT_.middleCols(first_column(b), T.cols()) = T;
+  JH_.middleCols(first_column(b), H.cols()) = H;
+  accumulate(c, train, JT_, JH_, r0_train_, r0_heldout_);
 }
 
 int LinearisedFits::index(const std::string& name) const {

@@ -1,5 +1,6 @@
 #include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
+#include "gpilqg/experiments/diagnosis/affine_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 
 #include <algorithm>
@@ -23,13 +24,19 @@ double training_rms(const Transitions& data, int velocity) {
 namespace {
 
 /// min over tau of S(tau) for `effect` at smoothing `v0` added to the model (linear least squares on
-/// the one column the effect adds: S = |r|^2 - (J'r)^2 / J'J).
+/// the one column the effect adds: S = |r|^2 - (J'r)^2 / J'J). J is the secant of the residual over
+/// one parameter scale, or under inverse dynamics the force's own regressor (the same column, the
+/// residual being affine in the force's level there, without evaluating the model).
 double profiled_objective(const FitContext& c, const LibraryEffect& coulomb, double v0, const Vector& r0,
                           const std::vector<int>& rows) {
   const LibraryEffect effect = with_smoothing(coulomb, v0);
-  const double h = effect.parameters[0].scale;
-  const Vector r = weighted_residual_of(c.model.with(effect, Vector::Constant(1, h)), c, rows);
-  const Vector J = (r0 - r) / h;
+  Vector J;
+  if (c.criterion == FitCriterion::InverseDynamics && linear_forces({&effect})) {
+    J = weighted_force_regressor(c.model, {&effect}, c, rows).col(0);  // the force's own regressor
+  } else {
+    const double h = effect.parameters[0].scale;
+    J = (r0 - weighted_residual_of(c.model.with(effect, Vector::Constant(1, h)), c, rows)) / h;
+  }
   const double jj = J.squaredNorm();
   if (!(jj > 0.0) || !std::isfinite(jj)) return r0.squaredNorm();
   const double jr = J.dot(r0);
@@ -100,15 +107,28 @@ std::map<std::string, double> joint_smoothing(const FitContext& c, const EffectF
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
   FitContext trial = c;
   std::map<std::string, double> out;
-  for (const EffectFit& member : members) {
-    const LibraryEffect effect = find_candidate(c.model, member.effect);
+  // The set linearised once; a grid value replaces only the Coulomb member's own columns (its
+  // smoothing moves nothing else), unless the member is a force of the model itself, whose residual
+  // its smoothing then changes too.
+  LinearisedFits fits(trial, members, {}, 1, true);
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    const LibraryEffect effect = find_candidate(c.model, members[m].effect);
     if (!effect.smoothing) continue;
+    const bool in_model = std::any_of(c.model.forces.begin(), c.model.forces.end(),
+                                      [&](const auto& force) { return force.first == effect.name; });
+    const auto objective = [&](double width) {
+      trial.model.smoothing[effect.name] = width;
+      if (in_model) return LinearisedFits(trial, members, {}).training_left(all);
+      fits.relinearise(static_cast<int>(m), trial);
+      return fits.training_left(all);
+    };
     const double v0 = minimising_smoothing(training_rms(*c.data, effect.smoothing->velocity), effect.smoothing->width,
-                                           [&](double width) {
-                                             trial.model.smoothing[effect.name] = width;
-                                             return LinearisedFits(trial, members, {}).training_left(all);
-                                           });
+                                           objective);
     trial.model.smoothing[effect.name] = v0;
+    if (in_model)
+      fits = LinearisedFits(trial, members, {}, 1, true);
+    else
+      fits.relinearise(static_cast<int>(m), trial);
     out[effect.name] = v0;
   }
   return out;

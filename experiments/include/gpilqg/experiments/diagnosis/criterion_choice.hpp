@@ -30,27 +30,43 @@
 ///
 ///       E_1^2  = 2 sigma_v^2 / dt^2         the one-step residual's noise: the difference of two
 ///                + mean_t |b_v(x_t) o sigma_u|^2   velocity samples of white noise sigma_v, over dt, and
-///                                           the noise of the measured controls (sigma_u per control),
-///                                           which both residuals carry alike. sigma_v and sigma_u are
-///                                           medians of differences (robust_noise_std in the .cpp), so
-///                                           the corners and steps held controls leave are not taken
-///                                           for noise;
-///       E_ID^2 = R_hat(w) + mean_t a_c,t^2  the acceleration estimate's error: its estimated mean
-///                                           squared error (noise and bias, derivative_window.hpp, at
-///                                           the window w the rule chooses) plus the error a control
-///                                           that changes within the window causes,
-///       a_c,t  = b_v(x_t) (K * u - u)_t,    K the smoothing the Savitzky-Golay derivative of window w
-///                                           applies to the acceleration (its weights on the velocity
-///                                           increments, centred, summing to 1).
+///                                           the noise of the measured controls (sigma_u per control).
+///                                           sigma_v and sigma_u are medians of differences
+///                                           (robust_noise_std in the .cpp), so the corners and steps
+///                                           held controls leave are not taken for noise;
+///       E_ID^2 = sigma_v^2 mean_t |c_t|^2 / dt^2   the acceleration estimate's noise (c_t the weights
+///                                           of the one window w of every coordinate at sample t's
+///                                           place in it, off-centre at an episode's ends, where they
+///                                           are larger; w the widest of the coordinates' own choices,
+///                                           accelerations.hpp; the estimate has no bias against the
+///                                           window's mean acceleration, which is what the filtered
+///                                           residual compares),
+///                + mean_t a_s,t^2           what the filter smears,
+///                + mean_t a_h,t^2           what the data cannot tell about the controls' hold,
+///                + |m|^2 mean_t |b_v o sigma_u|^2   and the controls' noise seen through the filter;
+///       a_s,t  = sum_r m_r f_v(x_r, u_r) - f_v(x_t, sum_r m_r u_r), the window's mean of the model's
+///                                           acceleration against the model's acceleration at x_t
+///                                           under the window's mean control: the residual the
+///                                           filtered criterion would leave on a true model, zero when
+///                                           only the control changes within the window;
+///       a_h,t  = b_v(x_t) ((m - m_0) * u)_t,  m and m_0 the weights of acceleration_weights for a
+///                                           continuous control and for one held over each step, at
+///                                           the window's centre.
 ///
-///     A held command (zero-order hold) makes the acceleration jump at every change; the centred
-///     estimate mixes both sides, and a_c measures exactly that. Controls sampled from a continuous
-///     signal (measured joint torques) leave a_c of second order in the window. sigma_v and R_hat are
-///     estimated from the velocity column itself, so rho depends on the noise, the sampling rate and
-///     the motion only through the data: on the two-link arm at 1 kHz with smooth measured torques
-///     rho = 13.6, and the actual ratio of the two residuals' errors under the true model is 13.6;
-///     with the torques held for 20 ms rho = 0.90 (actual 0.72); the cart-pole test data (50 Hz, held
-///     5 samples) give 0.18 (tests/experiments/criterion_choice_test.cpp).
+///     The inverse-dynamics residual sees the controls through the weights the acceleration estimate
+///     puts on the accelerations (parallel filtering, accelerations.hpp), so a control that changes
+///     within the window costs nothing as long as the state barely moves over it (a_s) and the
+///     control is the signal the weights assume (a_h: the filter assumes a continuous one, measured
+///     torques; a command held over each step differs from that by half a sample at every change).
+///     sigma_v is estimated from the velocity column itself and a_s, a_h from the model at the
+///     measured states, so rho depends on the noise, the sampling rate and the motion only through
+///     the data. On the two-link arm at 1 kHz with smooth measured torques rho = 10.9, and the actual
+///     ratio of the two residuals' errors under the true model is 11.5; with the torques held for
+///     20 ms rho = 2.23 (actual 2.0); on the two-link arm's 50 Hz command-line data (held commands,
+///     a window of 173 samples) the motion within the window gives 0.46; the cart-pole test data
+///     (50 Hz, held 5 samples) give 0.21; the cart-pole loop's rollouts of 16 samples at 20 Hz, where
+///     most samples lie within a window of an end, 2.76 (tests/experiments/criterion_choice_test.cpp,
+///     loop_diagnosis_test.cpp).
 ///
 ///     Why 3: the pure noise ratio of the shortest window (w = 3) is sqrt(2) / (dt G(3)) = 2, so rho >= 3
 ///     needs a longer window, i.e. a signal smooth over several samples; and a factor 3 in error
@@ -119,7 +135,8 @@ struct CriterionFacts {
   double ratio = 0.0;                         ///< rho = min over velocity states of E_1 / E_ID (0: not measured)
   std::string ratio_state;                    ///< the velocity state of the minimum
   int acceleration_window = 0;                ///< its derivative window w [samples]
-  double control_error = 0.0;                 ///< sqrt(mean a_c^2) / E_ID there: the held controls' share
+  double control_error = 0.0;                 ///< sqrt(mean a_h^2) / E_ID there: the hold's share
+  double smear_error = 0.0;                   ///< sqrt(mean a_s^2) / E_ID there: the motion's share
   double slowest_period = 0.0;                ///< P of the slowest velocity state [s] (inf: slower than the episodes)
   std::string slowest_state;                  ///< that state
   int window_cap = 0;                         ///< the cap on W [samples]

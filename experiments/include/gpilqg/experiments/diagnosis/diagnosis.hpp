@@ -229,6 +229,11 @@ struct DiagnosisReport {
   Vector criterion_weights;
   /// Inverse dynamics: the measured accelerations (N x k) the residuals are computed with.
   std::shared_ptr<const Matrix> accelerations;
+  /// Inverse dynamics: the window of their estimate and the controls seen through it (FitContext's
+  /// acceleration_window, filtered_controls and filtered_delay: parallel filtering, accelerations.hpp).
+  int acceleration_window = 0;
+  std::shared_ptr<const Matrix> filtered_controls;
+  double filtered_delay = 0.0;
   /// Simulation: the sensitivities of the windows to their starts, whose first-order effect every
   /// simulation error of the diagnosis leaves out (initial_state.hpp).
   std::shared_ptr<const InitialStateSensitivity> initial_state;

@@ -89,6 +89,12 @@ struct FitContext {
   /// Inverse dynamics: h, the half-width of the widest window of the acceleration estimate (the rows
   /// a measured sample's noise reaches); 0 for the other criteria.
   int acceleration_reach = 0;
+  /// Inverse dynamics: the one window of the acceleration estimate (accelerations.hpp), whose weights
+  /// the controls are seen through (parallel filtering, force_controls); 0: the controls as applied.
+  int acceleration_window = 0;
+  /// Inverse dynamics: force_controls for the delay `filtered_delay`, made once by criterion_context.
+  std::shared_ptr<const Matrix> filtered_controls = {};
+  double filtered_delay = 0.0;
   /// Inverse dynamics in its instrumental-variable form (instrumental_variables.hpp): the simulated
   /// data the instruments are evaluated at; null for least squares.
   std::shared_ptr<const Instruments> instruments = {};
@@ -107,6 +113,12 @@ struct FitContext {
   /// general path, which gives the same fit to rounding where the closed form holds.
   bool probe_affine = true;
 };
+
+/// The controls of the inverse-dynamics residual of `model` on settings.data: applied_controls with
+/// model.input_delay, seen through the acceleration estimate's weights (filtered_controls,
+/// accelerations.hpp: parallel filtering) when settings.acceleration_window > 0; settings'
+/// filtered_controls when they were made for that delay.
+Matrix force_controls(const ModelSpec& model, const FitContext& settings);
 
 /// The model integrated as configured.
 std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integrator integrator, double dt, int substeps);

@@ -82,4 +82,9 @@ Matrix generalised_force_residual(const Dynamics& model, const Transitions& data
 Matrix generalised_force_residual(const ModelSpec& model, const Transitions& data, const Matrix& accelerations,
                                   const std::vector<int>& rows);
 
+/// The same with the controls given (N x m, one row per transition): force_controls of effect_fit.hpp,
+/// the applied controls seen through the acceleration estimate's filter (accelerations.hpp).
+Matrix generalised_force_residual(const ModelSpec& model, const Transitions& data, const Matrix& controls,
+                                  const Matrix& accelerations, const std::vector<int>& rows);
+
 }  // namespace gpilqg::diagnosis

@@ -42,9 +42,18 @@ class LinearisedFits {
  public:
   /// Linearises the candidates `fits` (each fitted alone or with `refit`, as rank_effects does) around
   /// context.model with every `refit` effect at its start. Candidates whose fit is not identifiable
-  /// keep zero columns (they explain nothing). `threads` candidates at once.
+  /// keep zero columns (they explain nothing). `threads` candidates at once. `keep_columns`: keep the
+  /// columns and the base residual, so that relinearise can replace one candidate's columns (memory:
+  /// one double per weighted residual entry and column, on both row sets).
   LinearisedFits(const FitContext& context, const std::vector<EffectFit>& fits, const std::vector<RefitEffect>& refit,
-                 int threads = 1);
+                 int threads = 1, bool keep_columns = false);
+
+  /// Candidate `candidate`'s columns computed again with the effect as `context.model` defines it (a
+  /// Coulomb member at another smoothing velocity), every Gram matrix and fold updated; the other
+  /// columns and the base residual r are kept, so `context` must give the same r (its model differs
+  /// from the one linearised around only in the candidate's own definition). Needs keep_columns.
+  /// Costs one candidate's columns instead of every candidate's and r's.
+  void relinearise(int candidate, const FitContext& context);
 
   /// The candidates, in the order of `fits`.
   const std::vector<std::string>& names() const { return names_; }
@@ -74,7 +83,19 @@ class LinearisedFits {
   double gain(const std::vector<int>& subset, const std::vector<int>& reference) const;
 
  private:
+  /// One candidate or refitted effect: its definition, its value in the base model, its fitted value
+  /// (empty for the refitted effects) and whether its fit was usable (else its columns stay 0).
+  struct Block {
+    LibraryEffect effect;
+    Vector theta0;
+    Vector fitted;
+    bool usable = true;
+  };
   std::vector<std::string> names_;
+  std::vector<Block> blocks_;  ///< the candidates, then the refitted effects
+  bool keep_columns_ = false;
+  Matrix JT_, JH_;             ///< with keep_columns: the columns on the training and held-out rows
+  Vector r0_train_, r0_heldout_;
   std::vector<Eigen::Index> offset_{0};  ///< candidate e owns columns [offset_[e], offset_[e + 1]); then the refitted
   Eigen::Index refit_columns_ = 0;
   Matrix gram_train_, gram_heldout_;
@@ -85,6 +106,11 @@ class LinearisedFits {
   std::vector<Matrix> rest_gram_;  ///< G_T - G_f: the other folds'
   std::vector<Vector> rest_cross_;
   std::vector<double> fold_base_;
+  /// The first column of block `block`.
+  Eigen::Index first_column(std::size_t block) const;
+  /// Every Gram matrix, cross product and fold from the columns and the base residual.
+  void accumulate(const FitContext& c, const std::vector<int>& train, const Matrix& JT, const Matrix& JH,
+                  const Vector& r_train, const Vector& r_heldout);
   /// The columns of `subset` with the refitted effects'.
   std::vector<Eigen::Index> columns_of(const std::vector<int>& subset) const;
   /// What the least-squares solution of (gram_fit, cross_fit) over `cols` leaves of (gram, cross, base).
