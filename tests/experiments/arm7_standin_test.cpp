@@ -11,8 +11,10 @@
 #include <string>
 
 #include <Eigen/QR>
+#include <nlohmann/json.hpp>
 
 #include "arm7_log.hpp"
+#include "gpilqg/core/measurements.hpp"
 #include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
 #include "gpilqg/experiments/diagnosis/diagnosis.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
@@ -218,6 +220,59 @@ TEST(Arm7StandIn, InverseDynamicsDiagnosisFitsEachFrictionAsTheProjectionOfItsJo
       EXPECT_NEAR(both(0), log.truth.viscous(j), 0.3 * log.truth.viscous(j)) << joint;
     }
   }
+}
+
+// --- (d) the user's command with its defaults ----------------------------------------------------------
+
+// `gpilqg diagnose --auto` with nothing else, as a user runs it on a 10 s log of the arm (95 s on two
+// cores; 20 s take 131 s, bench/diagnosis_bench.cpp): the data choose
+// the inverse-dynamics criterion (measured velocities, link-side torques as controls), and the effects
+// chosen are dry (Coulomb) friction on every joint, each level within 10% of the hidden one, plus viscous
+// friction on joints whose b the record resolves (each within 25%, or its interval holding the hidden b),
+// and nothing else: no inertia, no mass, no force at a body. The dry friction may be named as MuJoCo's
+// frictionloss, the same physics (docs/own-system.md).
+TEST(Arm7StandInCli, TheDefaultsChooseInverseDynamicsAndFindTheDryFrictionOfEveryJoint) {
+  test::Arm7Options o;
+  o.seconds = 10.0;  // 5 s do not separate viscous from dry friction: the dry levels come out 10-40% high
+  o.seed = 5;
+  const test::Arm7Log log = test::arm7_log(test::source_dir(), o);
+  const std::filesystem::path dir = test::temporary_dir("arm7_defaults");
+  write_measurements_hdf5(dir / "arm7.h5", log.measured);
+  const auto start = std::chrono::steady_clock::now();
+  const test::CommandResult r = test::run_cli("diagnose --system " + test::quote(log.model.system) + " --data " +
+                                              test::quote(dir / "arm7.h5") + " --auto --json");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(report["criterion"]["name"], "inverse-dynamics") << report["criterion"].dump();
+  const nlohmann::json& verdict = report["verdict"];
+  std::printf("diagnose --auto: %.1f s; verdict %s with %zu effects\n", seconds,
+              verdict["status"].get<std::string>().c_str(), verdict["members"].size());
+  std::vector<bool> dry(test::kArm7Joints, false);
+  for (const nlohmann::json& member : verdict["members"]) {
+    const std::string effect = member["effect"].get<std::string>();
+    const auto& [name, value] = *member["parameters"].items().begin();
+    const double low = member["parameter_ci95"][name][0].get<double>(), high = member["parameter_ci95"][name][1].get<double>();
+    std::printf("  %s = %.4g [%.4g, %.4g]\n", effect.c_str(), value.get<double>(), low, high);
+    int joint = -1;
+    for (int j = 0; j < test::kArm7Joints; ++j)
+      if (effect.ends_with(":" + log.truth.joints[static_cast<std::size_t>(j)]) ||
+          effect.starts_with("param:" + log.truth.joints[static_cast<std::size_t>(j)] + "."))
+        joint = j;
+    ASSERT_GE(joint, 0) << effect << " is on no joint: spurious";
+    const bool coulomb = effect.starts_with("joint_coulomb_friction:") || effect.ends_with(".frictionloss");
+    const bool viscous = effect.starts_with("joint_viscous_damping:") || effect.ends_with(".damping");
+    ASSERT_TRUE(coulomb || viscous) << effect << ": only friction is hidden";
+    if (coulomb) {
+      dry[static_cast<std::size_t>(joint)] = true;
+      EXPECT_NEAR(value.get<double>(), log.truth.coulomb(joint), 0.10 * log.truth.coulomb(joint)) << effect;
+    } else {
+      const double b = log.truth.viscous(joint);
+      EXPECT_TRUE(std::abs(value.get<double>() - b) <= 0.25 * b || (low <= b && b <= high)) << effect << ", hidden " << b;
+    }
+  }
+  for (int j = 0; j < test::kArm7Joints; ++j)
+    EXPECT_TRUE(dry[static_cast<std::size_t>(j)]) << "no dry friction on " << log.truth.joints[static_cast<std::size_t>(j)];
 }
 
 }  // namespace
