@@ -264,6 +264,8 @@ TEST(Arm7StandInCli, TheDefaultsChooseInverseDynamicsAndFindTheDryFrictionOfEver
     const bool viscous = effect.starts_with("joint_viscous_damping:") || effect.ends_with(".damping");
     ASSERT_TRUE(coulomb || viscous) << effect << ": only friction is hidden";
     if (coulomb) {
+      // frictionloss and Coulomb friction are the same physics: never both on one joint.
+      EXPECT_FALSE(dry[static_cast<std::size_t>(joint)]) << "two dry frictions on " << effect;
       dry[static_cast<std::size_t>(joint)] = true;
       EXPECT_NEAR(value.get<double>(), log.truth.coulomb(joint), 0.10 * log.truth.coulomb(joint)) << effect;
     } else {

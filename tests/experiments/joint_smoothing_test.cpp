@@ -122,15 +122,7 @@ TEST(JointSmoothing, ReplacingOneMembersColumnsIsTheSetLinearisedAfresh) {
   const DiagnosisReport r = diagnose(friction_data(5), o);
   const FitContext context{&r.data, r.model, o.integrator, r.dt, o.substeps, r.weights, r.residual};
   const EffectFit set = fit_set(r.model, context);
-  std::vector<EffectFit> members{set};
-  for (const EffectValues& v : set.refitted) {
-    EffectFit member;
-    member.effect = v.effect;
-    member.parameters = v.parameters;
-    member.initial = v.initial;
-    member.estimate = v.estimate;
-    members.push_back(member);
-  }
+  const std::vector<EffectFit> members = member_fits(set);
   ASSERT_EQ(members[0].effect, "cart_coulomb_friction");
   LinearisedFits kept(context, members, {}, 1, true);
   FitContext moved = context;

@@ -165,6 +165,19 @@ void LinearisedFits::relinearise(int candidate, const FitContext& c) {
   accumulate(c, train, JT_, JH_, r0_train_, r0_heldout_);
 }
 
+std::vector<EffectFit> member_fits(const EffectFit& fit) {
+  std::vector<EffectFit> members{fit};
+  for (const EffectValues& v : fit.refitted) {
+    EffectFit member;
+    member.effect = v.effect;
+    member.parameters = v.parameters;
+    member.initial = v.initial;
+    member.estimate = v.estimate;
+    members.push_back(std::move(member));
+  }
+  return members;
+}
+
 int LinearisedFits::index(const std::string& name) const {
   const auto it = std::find(names_.begin(), names_.end(), name);
   return it == names_.end() ? -1 : static_cast<int>(it - names_.begin());

@@ -93,16 +93,7 @@ ModelSpec with_fitted_smoothing(const FitContext& c) {
 namespace gpilqg::diagnosis {
 
 std::map<std::string, double> joint_smoothing(const FitContext& c, const EffectFit& fit) {
-  // The set as effect fits (LinearisedFits takes each one's name, value and size).
-  std::vector<EffectFit> members{fit};
-  for (const EffectValues& v : fit.refitted) {
-    EffectFit member;
-    member.effect = v.effect;
-    member.parameters = v.parameters;
-    member.initial = v.initial;
-    member.estimate = v.estimate;
-    members.push_back(std::move(member));
-  }
+  const std::vector<EffectFit> members = member_fits(fit);
   std::vector<int> all(members.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
   FitContext trial = c;

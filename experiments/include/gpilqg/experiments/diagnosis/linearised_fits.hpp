@@ -38,6 +38,10 @@
 
 namespace gpilqg::diagnosis {
 
+/// A joint fit as one effect fit per member (the fit itself, then each refitted effect with its name,
+/// parameters, start and estimate): the candidates of a LinearisedFits of that set.
+std::vector<EffectFit> member_fits(const EffectFit& fit);
+
 class LinearisedFits {
  public:
   /// Linearises the candidates `fits` (each fitted alone or with `refit`, as rank_effects does) around
