@@ -126,7 +126,7 @@ void diagnose_arm7(benchmark::State& state, bool auto_select) {
   for (auto _ : state) {
     const diagnosis::DiagnosisReport report = diagnosis::diagnose(log.measured, options);
     first = report.ranking.empty() ? "none" : report.ranking.front().fit.effect;
-    criterion = diagnosis::fit_criterion_name(report.criterion);
+    criterion = report.criterion->name();
     candidates = 0;
     for (const auto& entry : report.ranking) candidates += 1 + entry.aliases.size();
     found = report.verdict.effects.size();

@@ -17,6 +17,7 @@
 #include "gpilqg/core/measurements.hpp"
 #include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
 #include "gpilqg/experiments/diagnosis/diagnosis.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "test_support.hpp"
 
@@ -174,8 +175,8 @@ TEST(Arm7StandIn, InverseDynamicsDiagnosisFitsEachFrictionAsTheProjectionOfItsJo
     measured_qd.row(static_cast<Eigen::Index>(i)) = data.x.row(rows[i]).tail(7);
   }
   // The diagnosis's residual of the model on its training rows (its accelerations), for the joint fit.
-  ASSERT_TRUE(r.accelerations);
-  const Matrix residual = generalised_force_residual(log.model, data, *r.accelerations, rows);
+  ASSERT_TRUE(r.criterion->inverse_dynamics());
+  const Matrix residual = generalised_force_residual(log.model, data, r.criterion->inverse_dynamics()->accelerations(), rows);
 
   for (int j = 0; j < 7; ++j) {
     const std::string joint = log.truth.joints[static_cast<std::size_t>(j)];

@@ -20,6 +20,8 @@
 #include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/savitzky_golay.hpp"
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/criterion_context.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
 #include "gpilqg/experiments/diagnosis/diagnosis.hpp"
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
@@ -686,6 +688,51 @@ const FitContext& friction_fit_context() {
   return context;
 }
 
+// Each criterion is one object (criteria/criterion.hpp) that the fits take row by row and the report
+// and the starts of every fit take whole: its rows for a fit must be its residual, weighted, for any
+// model (here the arm with a damping it was not made for), under each of the three criteria, with the
+// simulation's estimated starts and the filtered controls of inverse dynamics included.
+TEST(Criteria, EachCriterionsWeightedRowsAreItsResidualWeightedForAnyModel) {
+  const Transitions& data = friction_fit_data();
+  FitContext base;
+  base.data = &data;
+  base.model.system = arm_2ms_path();  // the state criteria step the model at the records' step
+  base.dt = hidden_friction_world().dt;
+  base.weights = Vector::Constant(4, 1.0);
+  base.weights << 1e8, 1e8, 1e2, 1e2;  // positions 1e-4 rad, velocities 0.1 rad/s
+  base.residual = criterion_residual(base.model, base);  // a context's default criterion: one-step
+  const ModelSpec other = base.model.with(find_candidate(base.model, "joint_viscous_damping:elbow"), Vector::Constant(1, 0.3));
+  const std::vector<int> rows = all_rows(data);
+  for (const auto& [criterion, window] : {std::pair{FitCriterion::OneStep, 1}, std::pair{FitCriterion::Simulation, 50},
+                                          std::pair{FitCriterion::InverseDynamics, 1}}) {
+    const FitContext c = criterion_context(base, criterion, window);
+    EXPECT_EQ(c.criterion->kind(), criterion);
+    EXPECT_EQ(c.criterion->window(), window);
+    // The context's residual is the criterion's residual of its own model.
+    EXPECT_LT((c.residual - c.criterion->residual(c.model, c)).norm(), 1e-12 * (1.0 + c.residual.norm()));
+    const Matrix r = c.criterion->residual(other, c);
+    const Vector weighted = c.criterion->weighted_residual(other, c, rows);
+    const auto k = static_cast<Eigen::Index>(c.weights.size());
+    ASSERT_EQ(r.cols(), k);
+    ASSERT_EQ(weighted.size(), r.rows() * k);
+    Vector expected(weighted.size());
+    for (Eigen::Index t = 0; t < r.rows(); ++t)
+      expected.segment(t * k, k) = c.weights.cwiseSqrt().cwiseProduct(r.row(t).transpose());
+    std::printf("%s: |sqrt(w) r| = %.6g, difference %.3g\n", c.criterion->name().c_str(), expected.norm(),
+                (weighted - expected).norm());
+    EXPECT_GT(expected.norm(), 0.0);
+    EXPECT_LT((weighted - expected).norm(), 1e-9 * expected.norm()) << c.criterion->name();
+  }
+  // Only inverse dynamics rules out the gains (its residual is homogeneous in them and the inertias).
+  const std::vector<LibraryEffect> candidates = candidate_effects(base.model);
+  EXPECT_TRUE(criterion_context(base, FitCriterion::OneStep, 1).criterion->unidentifiable(candidates).empty());
+  const std::vector<std::string> gains =
+      criterion_context(base, FitCriterion::InverseDynamics, 1).criterion->unidentifiable(candidates);
+  EXPECT_FALSE(gains.empty());
+  for (const std::string& name : gains)
+    EXPECT_TRUE(name.starts_with("actuator_gain:") || name.ends_with(".gear") || name.ends_with(".gain")) << name;
+}
+
 /// The weighted least-squares fit of the residual r0 on the regressor X (both stacked over the rows,
 /// weighted), the iid 95% half-width s sqrt((X'X)^-1) widened to the delete-one-episode jackknife,
 /// computed here directly: what fit_effect and fit_jointly must give for forces linear in theta.
@@ -845,9 +892,9 @@ DampingFits fit_damping_both_ways(double velocity_noise, unsigned seed) {
   base.dt = w.dt;
   const FitContext ls = criterion_context(base, FitCriterion::InverseDynamics, 1);
   FitContext iv = ls;
-  iv.instruments = simulated_instruments(ls);
-  const Instruments& z = *iv.instruments;
-  EXPECT_EQ(z.window, 4 * (ls.acceleration_reach + 1));
+  iv.criterion = ls.criterion->inverse_dynamics()->with_instruments(ls);
+  const Instruments& z = *iv.criterion->inverse_dynamics()->instruments();
+  EXPECT_EQ(z.window, 4 * (ls.criterion->inverse_dynamics()->reach() + 1));
   EXPECT_EQ(z.restarts, 0);
 
   const LibraryEffect viscous = find_candidate(base.model, "joint_viscous_damping:shoulder");

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 
 namespace gpilqg::diagnosis {
@@ -33,7 +34,9 @@ Matrix weighted_force_regressor(const ModelSpec& model, const std::vector<const 
   const DynamicsPtr system = model.build();
   const Dynamics& owner = force_map_system(*system);
   const auto workspace = owner.make_workspace();
-  const Matrix u = force_controls(model, c);
+  const InverseDynamicsCriterion* criterion = c.criterion->inverse_dynamics();
+  if (criterion == nullptr) throw std::invalid_argument("weighted_force_regressor: the context is not inverse dynamics");
+  const Matrix u = criterion->force_controls(model, *c.data);
   const Vector sqrt_w = c.weights.cwiseSqrt();
   const Eigen::Index k = sqrt_w.size();
   Eigen::Index p = 0;

@@ -183,9 +183,26 @@ std::vector<Vector> state_segments(const MeasurementSet& data, int state) {
   return segments;
 }
 
+/// The model's state derivative f(x_t, u_t) at every sample of every episode, as measured (T x n each).
+std::vector<Matrix> model_derivatives(const Dynamics& model, const MeasurementSet& data) {
+  const auto workspace = model.make_workspace();
+  Vector xdot(model.state_dim());
+  std::vector<Matrix> out;
+  for (const Episode& e : data.episodes) {
+    Matrix f(e.length(), model.state_dim());
+    for (Eigen::Index r = 0; r < e.length(); ++r) {
+      model.evaluate(e.x.row(r).transpose(), e.u.row(r).transpose(), xdot, nullptr, *workspace);
+      f.row(r) = xdot.transpose();
+    }
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
 /// rho of velocity state `state` with the acceleration estimate of window `window` (the one window of
-/// every coordinate, accelerations.hpp).
-StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, int state, double dt, int window) {
+/// every coordinate, accelerations.hpp); `own` the model's derivatives at the samples (model_derivatives).
+StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own, int state,
+                       double dt, int window) {
   const std::vector<Vector> segments = state_segments(data, state);
   StateRatio out;
   if (segments.empty()) return out;
@@ -218,14 +235,9 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, int st
   const auto workspace = model.make_workspace();
   double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0;
   long count = 0, position = 0;
-  for (const Episode& e : data.episodes) {
+  for (std::size_t episode = 0; episode < data.episodes.size(); ++episode) {
+    const Episode& e = data.episodes[episode];
     if (e.length() < window) continue;
-    // The model's acceleration of the state at every sample of the episode, as measured.
-    Vector own(e.length());
-    for (Eigen::Index r = 0; r < e.length(); ++r) {
-      model.evaluate(e.x.row(r).transpose(), e.u.row(r).transpose(), xdot, nullptr, *workspace);
-      own(r) = xdot(state);
-    }
     // Every sample at its place p in its window: centred, or off-centre at the episode's ends, where
     // the estimate is noisier and no longer zero-phase (on short episodes most samples are there).
     for (Eigen::Index t = 0; t < e.length(); ++t, ++position) {
@@ -239,7 +251,7 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, int st
       // acceleration at x_t under the window's mean control (0 when nothing but the control changes).
       const Vector filtered_u = u * continuous[p];
       model.evaluate(e.x.row(t).transpose(), filtered_u, xdot, &jac, *workspace);
-      smear += std::pow(own.segment(start, window).dot(continuous[p]) - xdot(state), 2);
+      smear += std::pow(own[episode].col(state).segment(start, window).dot(continuous[p]) - xdot(state), 2);
       hold += std::pow(jac.fu.row(state).dot(du), 2);
       const double noise = jac.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
       shared += noise;
@@ -393,9 +405,10 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
     if (!segments.empty()) window = std::max(window, choose_derivative_window(segments, facts.dt, 2).window);
   }
   facts.ratio = std::numeric_limits<double>::infinity();
+  const std::vector<Matrix> own = window > 0 ? model_derivatives(*dynamics, data) : std::vector<Matrix>();
   for (const GeneralisedCoordinate& c : coordinates) {
     if (window == 0) break;
-    const StateRatio r = state_ratio(*dynamics, data, c.velocity, facts.dt, window);
+    const StateRatio r = state_ratio(*dynamics, data, own, c.velocity, facts.dt, window);
     if (r.ratio < facts.ratio || facts.ratio_state.empty()) {
       facts.ratio = r.ratio;
       facts.ratio_state = data.system.states[static_cast<std::size_t>(c.velocity)].name;

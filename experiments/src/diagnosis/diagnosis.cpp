@@ -9,6 +9,8 @@
 
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/input_delay.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/criterion_context.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
 #include "gpilqg/experiments/diagnosis/criterion_choice.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
@@ -69,16 +71,6 @@ Vector floor_weights(const Transitions& data, const Matrix& residual, const Resi
   return noise_floor(data, residual, gp).cwiseAbs2().cwiseInverse();
 }
 
-double weighted_heldout_explained(const Transitions& data, const Matrix& residual, const Matrix& correction,
-                                  const Vector& weights) {
-  double before = 0.0, after = 0.0;
-  for (int r : data.rows(true)) {
-    before += residual.row(r).cwiseAbs2().dot(weights);
-    after += (residual.row(r) - correction.row(r)).cwiseAbs2().dot(weights);
-  }
-  return before > 0.0 ? 1.0 - after / before : 0.0;
-}
-
 /// Rows normalised to sum 1 (rows of zeros stay zero).
 Matrix shares(Matrix sensitivity) {
   for (Eigen::Index i = 0; i < sensitivity.rows(); ++i) {
@@ -116,13 +108,10 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   v.reason = fmt::format("the best candidate '{}' removes {:.1f}% of the held-out residual (z = {:.1f}); the GP removes {:.1f}%",
                          f.effect, 100.0 * f.explained, f.z_score, 100.0 * r.gp_explained_total);
   // The GP's share is of the one-step residual: comparable with the effects' under the one-step criterion only.
-  const bool one_step = o.criterion == FitCriterion::OneStep;
-  if (o.criterion == FitCriterion::Simulation)
-    v.reason += fmt::format(" of the one-step residual; the effects are scored on the simulation error over windows of {} "
-                            "samples, so the GP's share is not required", o.window);
-  if (o.criterion == FitCriterion::InverseDynamics)
-    v.reason += " of the one-step residual; the effects are scored on the generalised-force (inverse-dynamics) residual, "
-                "so the GP's share is not required";
+  const bool one_step = r.criterion->scored_like_the_gp();
+  if (!one_step)
+    v.reason += " of the one-step residual; the effects are scored on " + r.criterion->scored_on() +
+                ", so the GP's share is not required";
   if (!finding.accepted) {
     v.status = "unexplained";
     v.reason += "; not a finding: " + finding.reason;
@@ -174,11 +163,12 @@ void judge_remainder(Verdict& v, double remainder, const DiagnosisOptions& o) {
 
 /// The verdict once --auto has chosen its set: what the whole set leaves (each step's share is of
 /// what the step before left, so the shares multiply).
-void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0, const DiagnosisOptions& o) {
+void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0, const Criterion& criterion,
+                     const DiagnosisOptions& o) {
   if (!v.effect) return;
   if (selection.steps.empty()) {
     // Nothing chosen: the single best effect meets the rule decide() left to the set.
-    if (o.criterion == FitCriterion::OneStep && v.effect->explained < o.relative_to_gp * (1.0 - v.gp_left)) {
+    if (criterion.scored_like_the_gp() && v.effect->explained < o.relative_to_gp * (1.0 - v.gp_left)) {
       v.status = "unexplained";
       v.reason += ", so the residual's structure is mostly something else";
       v.effect.reset();
@@ -209,9 +199,9 @@ void judge_selection(Verdict& v, const Selection& selection, const ModelSpec& m0
   if (!(v.effects.size() == 1 && last.refitted.empty() && v.effects.front() == last.effect)) v.rivals.clear();
   v.reason = fmt::format("the {} effect(s) chosen by --auto ({}) remove {:.1f}% of the held-out residual; the GP removes {:.1f}%",
                          v.effects.size(), fmt::join(v.effects, ", "), 100.0 * (1.0 - left), 100.0 * (1.0 - v.gp_left));
-  if (o.criterion != FitCriterion::OneStep)
-    v.reason += fmt::format(" of the one-step residual (the effects are scored on the {} error)", fit_criterion_name(o.criterion));
-  if (o.criterion == FitCriterion::OneStep && 1.0 - left < o.relative_to_gp * (1.0 - v.gp_left)) {
+  if (!criterion.scored_like_the_gp())
+    v.reason += " of the one-step residual (the effects are scored on " + criterion.scored_on() + ")";
+  if (criterion.scored_like_the_gp() && 1.0 - left < o.relative_to_gp * (1.0 - v.gp_left)) {
     v.status = "partly_explained";
     v.reason += fmt::format(", less than {:g} of what the GP removes, so the residual's structure is mostly something else",
                             o.relative_to_gp);
@@ -262,7 +252,8 @@ struct ModelAsGiven {
 /// inverse-dynamics criterion's IV form when it is asked for (instrumental_variables.hpp).
 FitContext options_context(const DiagnosisOptions& o, const FitContext& base, int* restarts = nullptr) {
   FitContext context = criterion_context(base, o.criterion, o.window, restarts);
-  if (o.instruments && o.criterion == FitCriterion::InverseDynamics) context.instruments = simulated_instruments(context);
+  if (const InverseDynamicsCriterion* inverse = context.criterion->inverse_dynamics(); inverse && o.instruments)
+    context.criterion = inverse->with_instruments(context);
   return context;
 }
 
@@ -402,34 +393,19 @@ void where(const DiagnosisOptions& o, const MeasurementSet& set, DiagnosisReport
 /// model diverges), the verdict (decide), and with --auto the forward selection of several, judged
 /// as a set (judge_selection).
 void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidates, DiagnosisReport& R) {
-  R.criterion = o.criterion;
-  R.window = o.window;
   FitContext context = options_context(o, {&R.data, R.model, o.integrator, R.dt, o.substeps, R.weights, R.residual},
                                        &R.window_restarts);
-  R.instruments = context.instruments;
+  R.criterion = context.criterion;
   context.excluded = o.exclude;
   R.excluded = o.exclude;
-  // On the force residual M qdd - h(q, qdot, k u) the inertias and the actuators' gains can all shrink
-  // together to zero, where the residual vanishes whatever the data: the equation is homogeneous in
-  // them (the scale ambiguity of inverse-dynamics identification, which a measured torque fixes by
-  // its own calibration). So the gains are not candidates there.
-  if (o.criterion == FitCriterion::InverseDynamics)
-    for (const LibraryEffect& effect : candidates) {
-      const bool gain = effect.kind == EffectKind::ActuatorGain ||
-                        (effect.kind == EffectKind::Recalibration &&
-                         (effect.recalibrated.ends_with(".gain") || effect.recalibrated.ends_with(".gear")));
-      if (gain && std::find(context.excluded.begin(), context.excluded.end(), effect.name) == context.excluded.end()) {
-        context.excluded.push_back(effect.name);
-        R.criterion_excluded.push_back(effect.name);
-      }
+  // Candidates the criterion cannot identify on any data (under inverse dynamics the actuators' gains).
+  for (const std::string& name : R.criterion->unidentifiable(candidates))
+    if (std::find(context.excluded.begin(), context.excluded.end(), name) == context.excluded.end()) {
+      context.excluded.push_back(name);
+      R.criterion_excluded.push_back(name);
     }
   R.criterion_weights = context.weights;
-  R.accelerations = context.accelerations;
-  R.acceleration_window = context.acceleration_window;
-  R.filtered_controls = context.filtered_controls;
-  R.filtered_delay = context.filtered_delay;
-  R.initial_state = context.initial_state;
-  if (o.criterion == FitCriterion::InverseDynamics) {
+  if (R.criterion->inverse_dynamics()) {
     for (const Quantity& q : force_components(*R.model.build()).forces) {
       R.channel_names.push_back(q.name);
       R.channel_units.push_back(q.unit);
@@ -458,7 +434,7 @@ void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidat
   // Step 1 is the verdict: its ranking is the first step's, and without an explained verdict nothing is added.
   if (R.verdict.effect) {
     R.selection = select_effects(context, so, R.ranking);
-    judge_selection(R.verdict, *R.selection, R.model, o);
+    judge_selection(R.verdict, *R.selection, R.model, *R.criterion, o);
   } else {
     R.selection = Selection{};
     R.selection->method = o.search;
@@ -517,41 +493,13 @@ bool add(const DiagnosisOptions& o, const ModelAsGiven& given, const std::vector
   return true;
 }
 
-/// What a flexible model removes of what `model` leaves on the held-out rows, under the criterion:
-/// the flexible model is `model` plus the mean of `gp`, the GP of its one-step residual `residual`
-/// (gp.model). One-step: 1 - sum_w (r - mu)^2 / sum_w r^2. Simulation: the same with the simulation
-/// errors of both models over the criterion's windows from measured states. Weighted with R.weights.
-double flexible_share(const ModelSpec& model, const Matrix& residual, const ResidualGp& gp, const DiagnosisOptions& o,
-                      const DiagnosisReport& R) {
-  if (o.criterion == FitCriterion::OneStep) return weighted_heldout_explained(R.data, residual, gp.mean, R.weights);
-  if (o.criterion == FitCriterion::InverseDynamics) {
-    // A GP of each component of the model's generalised-force residual, on (x, u).
-    FitContext c{&R.data, model, o.integrator, R.dt, o.substeps, R.criterion_weights, Matrix()};
-    c.criterion = FitCriterion::InverseDynamics;
-    c.accelerations = R.accelerations;
-    c.acceleration_window = R.acceleration_window;
-    c.filtered_controls = R.filtered_controls;
-    c.filtered_delay = R.filtered_delay;
-    const Matrix force = criterion_residual(model, c);
-    return weighted_heldout_explained(R.data, force, gp_column_means(R.data, force, o.gp), R.criterion_weights);
-  }
-  const std::vector<int> rows = R.data.rows(true);
-  const Matrix u = applied_controls(R.data, model.input_delay);
-  const Matrix plain = simulated_predictions(*make_step_model(model, o.integrator, R.dt, o.substeps), R.data, u, rows, o.window);
-  const Matrix flexible = simulated_predictions(*gp.model, R.data, u, rows, o.window);
-  Matrix measured(static_cast<Eigen::Index>(rows.size()), R.data.x_next.cols());
-  for (std::size_t k = 0; k < rows.size(); ++k) measured.row(static_cast<Eigen::Index>(k)) = R.data.x_next.row(rows[k]);
-  Matrix plain_errors = measured - plain, flexible_errors = measured - flexible;
-  if (R.initial_state) {
-    plain_errors = without_start_error(*R.initial_state, rows, plain_errors, R.criterion_weights);
-    flexible_errors = without_start_error(*R.initial_state, rows, flexible_errors, R.criterion_weights);
-  }
-  double before = 0.0, after = 0.0;
-  for (Eigen::Index k = 0; k < measured.rows(); ++k) {
-    before += plain_errors.row(k).cwiseAbs2().dot(R.weights);
-    after += flexible_errors.row(k).cwiseAbs2().dot(R.weights);
-  }
-  return before > 0.0 ? 1.0 - after / before : 0.0;
+/// What a flexible model removes of what `model` leaves on the held-out rows under the report's
+/// criterion (Criterion::flexible_share); `gp` the GP of `model`'s one-step residual when the
+/// criterion needs it.
+double flexible_share(const ModelSpec& model, const OneStepGp* gp, const DiagnosisOptions& o, const DiagnosisReport& R) {
+  FitContext c{&R.data, model, o.integrator, R.dt, o.substeps, R.criterion_weights, Matrix()};
+  c.criterion = R.criterion;
+  return R.criterion->flexible_share(model, gp, c, o.gp);
 }
 
 /// The remainder test of the verdict (judge_remainder) on the model it proposes: model_next with the
@@ -560,20 +508,23 @@ double flexible_share(const ModelSpec& model, const Matrix& residual, const Resi
 void judge_proposal(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidates, const FitContext& settings,
                     bool compared, const ResidualGp& gp_after, DiagnosisReport& R) {
   if (!R.verdict.effect || R.verdict.status != "explained") return;
-  if (o.add.empty() && compared && o.criterion != FitCriterion::InverseDynamics) {
-    judge_remainder(R.verdict, flexible_share(R.model_next, R.residual_after, gp_after, o, R), o);
+  const Criterion& criterion = *R.criterion;
+  if (o.add.empty() && compared && criterion.needs_one_step_gp()) {
+    const OneStepGp gp{R.residual_after, gp_after};
+    judge_remainder(R.verdict, flexible_share(R.model_next, &gp, o, R), o);
     return;
   }
   const ModelSpec proposed = o.add.empty() && compared
                                 ? R.model_next
                                 : R.model.with(named(candidates, R.verdict.effect->effect), R.verdict.effect->estimate);
-  if (o.criterion == FitCriterion::InverseDynamics) {  // its flexible model is a GP of the force residual
-    judge_remainder(R.verdict, flexible_share(proposed, Matrix(), ResidualGp(), o, R), o);
+  if (!criterion.needs_one_step_gp()) {
+    judge_remainder(R.verdict, flexible_share(proposed, nullptr, o, R), o);
     return;
   }
   const Matrix residual = residual_of_model(proposed, settings);
   const ResidualGp gp = fit_residual_gp(make_step_model(proposed, o.integrator, R.dt, o.substeps), R.data, residual, o.gp);
-  judge_remainder(R.verdict, flexible_share(proposed, residual, gp, o, R), o);
+  const OneStepGp one_step{residual, gp};
+  judge_remainder(R.verdict, flexible_share(proposed, &one_step, o, R), o);
 }
 
 /// The measured inputs as `model` applies them (its input delay).

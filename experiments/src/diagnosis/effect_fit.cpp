@@ -19,11 +19,9 @@
 #include "gpilqg/core/generalised_forces.hpp"
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/affine_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
-#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
-#include "gpilqg/experiments/diagnosis/accelerations.hpp"
-#include "gpilqg/experiments/diagnosis/initial_state.hpp"
 #include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
@@ -36,80 +34,18 @@ std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integra
 }
 
 Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int* diverged) {
-  if (settings.window > 1)
-    return simulated_predictions(*make_step_model(model, settings.integrator, settings.dt, settings.substeps),
-                                 *settings.data, applied_controls(*settings.data, model.input_delay),
-                                 all_rows(*settings.data), settings.window, diverged);
-  return one_step_predictions(*make_step_model(model, settings.integrator, settings.dt, settings.substeps), *settings.data,
-                              diverged, model.input_delay);
+  return settings.criterion->predictions(model, settings, diverged);
 }
-
-namespace {
-
-/// Whether the simulation errors of `c` leave out the start error: sensitivities of c's own windows.
-bool estimates_starts(const FitContext& c) {
-  return c.initial_state && c.window > 1 && c.initial_state->window == c.window;
-}
-
-}  // namespace
 
 Matrix criterion_residual(const ModelSpec& model, const FitContext& settings, int* diverged) {
-  if (settings.criterion == FitCriterion::InverseDynamics) {
-    if (diverged != nullptr) *diverged = 0;
-    return generalised_force_residual(model, *settings.data, force_controls(model, settings), *settings.accelerations,
-                                      all_rows(*settings.data));
-  }
-  const Matrix errors = settings.data->x_next - model_predictions(model, settings, diverged);
-  if (!estimates_starts(settings)) return errors;
-  return without_start_error(*settings.initial_state, all_rows(*settings.data), errors, settings.weights);
+  return settings.criterion->residual(model, settings, diverged);
+}
+
+Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows) {
+  return settings.criterion->weighted_residual(model, settings, rows);
 }
 
 namespace {
-
-/// Inverse dynamics: sqrt(w_i) r_{t,i} of the generalised-force residual stacked over `rows` (index
-/// k c + i). A model that does not accept the data (a singular map, a force that is not finite) is an
-/// std::invalid_argument, which the objective turns into +inf.
-Vector weighted_force_residual(const ModelSpec& model, const FitContext& c, const std::vector<int>& rows) {
-  const Matrix r = generalised_force_residual(model, *c.data, force_controls(model, c), *c.accelerations, rows);
-  const Vector sqrt_w = c.weights.cwiseSqrt();
-  const auto k = static_cast<Eigen::Index>(sqrt_w.size());
-  Vector out(static_cast<Eigen::Index>(rows.size()) * k);
-  for (Eigen::Index i = 0; i < r.rows(); ++i) out.segment(i * k, k) = sqrt_w.cwiseProduct(r.row(i).transpose());
-  return out;
-}
-
-/// sqrt(w_i) (x_{t+1,i} - phi_i(x_t, u_t)) stacked row by row over `rows` (index r * n + i); `finite`
-/// turns false when a prediction diverged (prediction_diverged: not finite or beyond 1e12). Such a
-/// prediction is replaced by x_t, as in one_step_predictions, so every entry stays finite and its
-/// square cannot overflow.
-Vector weighted_residual(const StepModel& model, const Matrix& u, const FitContext& c, const std::vector<int>& rows,
-                         bool* finite) {
-  const auto n = static_cast<Eigen::Index>(c.weights.size());
-  const Vector sqrt_w = c.weights.cwiseSqrt();
-  Vector out(static_cast<Eigen::Index>(rows.size()) * n);
-  Vector next(n);
-  if (c.window > 1) {  // simulation over windows (simulation_error.hpp)
-    int restarts = 0;
-    const Matrix predicted = simulated_predictions(model, *c.data, u, rows, c.window, &restarts);
-    if (restarts > 0 && finite != nullptr) *finite = false;
-    for (std::size_t k = 0; k < rows.size(); ++k)
-      out.segment(static_cast<Eigen::Index>(k) * n, n) = sqrt_w.cwiseProduct(
-          (c.data->x_next.row(rows[k]) - predicted.row(static_cast<Eigen::Index>(k))).transpose());
-    if (estimates_starts(c)) remove_start_error(*c.initial_state, rows, out);
-    return out;
-  }
-  const auto workspace = model.make_workspace();
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    const int r = rows[k];
-    model.step(c.data->x.row(r).transpose(), u.row(r).transpose(), next, nullptr, *workspace);
-    if (prediction_diverged(next)) {
-      if (finite != nullptr) *finite = false;
-      next = c.data->x.row(r).transpose();
-    }
-    out.segment(static_cast<Eigen::Index>(k) * n, n) = sqrt_w.cwiseProduct(c.data->x_next.row(r).transpose() - next);
-  }
-  return out;
-}
 
 /// The effects of one fit with their parameters stacked, theta = [theta_1; ...; theta_E]; the
 /// candidate is effects[0], so column 0 of the regressor is its first parameter.
@@ -156,7 +92,7 @@ class SetResidual {
   /// `probe`: under inverse dynamics, try the closed form for sets with parameters of the model too
   /// (probed_affine_residual); the fit checks it again at its estimate (matches_at).
   SetResidual(const EffectSet& set, const Vector& theta0, const FitContext& c, bool probe = true) : set_(set), c_(c) {
-    if (c.criterion != FitCriterion::InverseDynamics) return;
+    if (!c.criterion->inverse_dynamics()) return;
     if (linear_forces(set.effects)) {
       affine_.emplace(set.model_at(c.model, theta0), set.effects, theta0, c);
     } else if (probe && c.probe_affine) {
@@ -174,7 +110,7 @@ class SetResidual {
     if (!probed_) return true;
     const std::vector<int> rows = all_rows(*c_.data);
     try {
-      return affine_to_rounding(weighted_force_residual(set_.model_at(c_.model, theta), c_, rows),
+      return affine_to_rounding(c_.criterion->weighted_residual(set_.model_at(c_.model, theta), c_, rows),
                                 affine_->weighted(theta, rows), affine_->weighted(theta0_, rows));
     } catch (const std::invalid_argument&) {
       return false;
@@ -193,12 +129,7 @@ class SetResidual {
       }
     const ModelSpec spec = set_.model_at(c_.model, theta);
     Evaluation e{theta, rows, {}, true};
-    if (c_.criterion == FitCriterion::InverseDynamics) {
-      e.value = weighted_force_residual(spec, c_, rows);
-    } else {
-      const auto model = make_step_model(spec, c_.integrator, c_.dt, c_.substeps);
-      e.value = weighted_residual(*model, applied_controls(*c_.data, spec.input_delay), c_, rows, &e.finite);
-    }
+    e.value = c_.criterion->weighted_residual(spec, c_, rows, &e.finite);
     if (finite != nullptr && !e.finite) *finite = false;
     return remember(residuals_, std::move(e)).value;
   }
@@ -215,7 +146,7 @@ class SetResidual {
     std::vector<const LibraryEffect*> forces;
     std::vector<Eigen::Index> force_columns;
     for (std::size_t e = 0; e < set_.effects.size(); ++e) {
-      if (c_.criterion == FitCriterion::InverseDynamics && linear_forces({set_.effects[e]})) {
+      if (c_.criterion->inverse_dynamics() && linear_forces({set_.effects[e]})) {
         forces.push_back(set_.effects[e]);
         for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) force_columns.push_back(j);
         continue;
@@ -262,7 +193,7 @@ class SetResidual {
     for (Eigen::Index j = 0; j < p; ++j) step(j) = set_.parameter(j).scale;
     if (!step.allFinite() || !(step.minCoeff() > 0.0)) return std::nullopt;
     try {
-      const Vector r0 = weighted_force_residual(set_.model_at(c_.model, theta0), c_, rows);
+      const Vector r0 = c_.criterion->weighted_residual(set_.model_at(c_.model, theta0), c_, rows);
       Matrix G(r0.size(), p);
       std::vector<const LibraryEffect*> forces;
       std::vector<Eigen::Index> force_columns;
@@ -275,13 +206,13 @@ class SetResidual {
         for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) {
           Vector theta = theta0;
           theta(j) += step(j);
-          G.col(j) = (r0 - weighted_force_residual(set_.model_at(c_.model, theta), c_, rows)) / step(j);
+          G.col(j) = (r0 - c_.criterion->weighted_residual(set_.model_at(c_.model, theta), c_, rows)) / step(j);
         }
       }
       if (!forces.empty())
         G(Eigen::all, force_columns) = weighted_force_regressor(set_.model_at(c_.model, theta0), forces, c_, rows);
       const Vector far = theta0 + 2.0 * step;
-      if (!affine_to_rounding(weighted_force_residual(set_.model_at(c_.model, far), c_, rows), r0 - G * (far - theta0), r0))
+      if (!affine_to_rounding(c_.criterion->weighted_residual(set_.model_at(c_.model, far), c_, rows), r0 - G * (far - theta0), r0))
         return std::nullopt;
       return AffineForceResidual(theta0, c_.weights.size(), r0, std::move(G));
     } catch (const std::invalid_argument&) {  // a probe outside the physical range, or a singular model
@@ -324,7 +255,7 @@ Vector clamp_to(const Vector& theta, const Vector& lo, const Vector& hi) { retur
 int heldout_batch_length(const FitContext& c, int rows) {
   const int batch = c.batch > 0 ? c.batch : std::max(10, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(rows)))));
   // Whole windows under the simulation criterion: the errors within a window are strongly correlated.
-  const int window = std::max(1, c.window);
+  const int window = c.criterion->window();
   return (batch + window - 1) / window * window;
 }
 
@@ -470,21 +401,6 @@ EffectValues own_values(const EffectFit& fit) {
   return {fit.effect, fit.parameters, fit.initial, fit.estimate, fit.ci_low, fit.ci_high, fit.smoothing, fit.null_value};
 }
 
-Matrix force_controls(const ModelSpec& model, const FitContext& settings) {
-  if (settings.acceleration_window == 0) return applied_controls(*settings.data, model.input_delay);
-  if (settings.filtered_controls && settings.filtered_delay == model.input_delay &&
-      settings.filtered_controls->rows() == settings.data->size())
-    return *settings.filtered_controls;
-  return filtered_controls(*settings.data, applied_controls(*settings.data, model.input_delay),
-                           settings.acceleration_window);
-}
-
-Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows) {
-  if (settings.criterion == FitCriterion::InverseDynamics) return weighted_force_residual(model, settings, rows);
-  const auto step = make_step_model(model, settings.integrator, settings.dt, settings.substeps);
-  return weighted_residual(*step, applied_controls(*settings.data, model.input_delay), settings, rows, nullptr);
-}
-
 namespace {
 
 EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& null, const Vector& theta_ls,
@@ -514,10 +430,11 @@ Vector least_squares_step(const Matrix& J, const Vector& r, const Matrix& Q) {
 /// Q, the instruments' basis of a set of effects at theta on `rows` (instrumental_variables.hpp): their
 /// regressor evaluated at the simulated states. Empty without instruments.
 Matrix instruments_of(const EffectSet& set, const Vector& theta, const FitContext& c, const std::vector<int>& rows) {
-  if (!c.instruments) return {};
-  const FitContext at_simulation = instrument_context(c, *c.instruments);
+  const InverseDynamicsCriterion* criterion = c.criterion->inverse_dynamics();
+  if (criterion == nullptr || criterion->instruments() == nullptr) return {};
+  const FitContext at_simulation = instrument_context(c);
   const SetResidual residual(set, theta, at_simulation);
-  return instrument_basis(residual.regressor(theta, rows), *c.instruments, rows);
+  return instrument_basis(residual.regressor(theta, rows), *criterion->instruments(), rows);
 }
 
 /// Gauss-Newton from `theta` (updated in place), at most `iterations` steps, each clamped to the
@@ -561,35 +478,13 @@ double refine_gauss_newton(const SetResidual& residual, Vector& theta, const Vec
 constexpr int kLinearRefinements = 2;
 constexpr int kNonlinearRefinements = 12;
 
-/// The state indices of the generalised velocities of `system` (generalised_coordinates), or every
-/// state when it has no generalised-force map. Built once per system.
-const std::vector<int>& velocity_states(const ModelSpec& model) {
-  static std::mutex guard;
-  static std::map<std::string, std::vector<int>> known;
-  const std::lock_guard<std::mutex> lock(guard);
-  auto it = known.find(model.system);
-  if (it != known.end()) return it->second;
-  const DynamicsPtr dynamics = model.build();
-  std::vector<int> states;
-  for (const GeneralisedCoordinate& q : generalised_coordinates(*dynamics)) states.push_back(q.velocity);
-  if (states.empty())
-    for (int i = 0; i < dynamics->state_dim(); ++i) states.push_back(i);
-  return known.emplace(model.system, std::move(states)).first->second;
-}
-
 /// Each parameter's scale on the data (EffectFit::scale): max(|null_j|, |m| / |J_j|) over the
 /// velocity rows of the weighted training rows, m = sqrt(w) (x_hat_{r+1} - x_r) the model's own
 /// predicted change (x_hat = x_next - residual under the criterion). Infinite where J_j is zero on
 /// them (nothing to compare with).
 Vector data_scales(const Matrix& J, const FitContext& c, const std::vector<int>& rows, const Vector& null) {
-  const bool forces = c.criterion == FitCriterion::InverseDynamics && c.own_force;
   const auto n = static_cast<Eigen::Index>(c.weights.size());
-  std::vector<int> channels;
-  if (forces) {
-    for (int i = 0; i < n; ++i) channels.push_back(i);
-  } else {
-    channels = velocity_states(c.model);
-  }
+  const std::vector<int> channels = c.criterion->scale_channels(c);
   double motion = 0.0;
   Vector column = Vector::Zero(J.cols());
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -597,8 +492,7 @@ Vector data_scales(const Matrix& J, const FitContext& c, const std::vector<int>&
     for (int i : channels) {
       if (i >= n) continue;
       const double w = c.weights(i);
-      // The model's own change under the criterion: its predicted state change, or its generalised force.
-      const double change = forces ? (*c.own_force)(r, i) : c.data->x_next(r, i) - c.residual(r, i) - c.data->x(r, i);
+      const double change = c.criterion->own_change(c, r, i);
       motion += w * change * change;
       column += J.row(static_cast<Eigen::Index>(k) * n + i).transpose().cwiseAbs2();
     }
@@ -657,7 +551,7 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
     fit.identifiable = false;
     fit.not_identifiable = "it does not change the predictions";
     fit.training_objective_after = residual.at(initial, training).squaredNorm();
-  } else if (c.instruments && Q.size() == 0) {
+  } else if (c.criterion->inverse_dynamics() && c.criterion->inverse_dynamics()->instruments() && Q.size() == 0) {
     fit.identifiable = false;
     fit.not_identifiable = "it has no instrument: its regressor at the simulated states is zero or collinear";
     fit.training_objective_after = residual.at(initial, training).squaredNorm();
@@ -670,7 +564,7 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
     theta_hat = initial;
     fit.training_objective_after =
         refine_gauss_newton(residual, theta_hat, lower, upper, training,
-                            set.linear() && c.window == 1 ? kLinearRefinements : kNonlinearRefinements,
+                            set.linear() && c.criterion->window() == 1 ? kLinearRefinements : kNonlinearRefinements,
                             fit.evaluations, Q);
     // The IV fit minimised the projected objective; the fit's objective is the residual's own.
     if (Q.size() > 0) fit.training_objective_after = objective_at(residual, theta_hat, training);

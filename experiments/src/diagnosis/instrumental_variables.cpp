@@ -5,6 +5,7 @@
 #include <Eigen/QR>
 
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 
 namespace gpilqg::diagnosis {
@@ -58,12 +59,13 @@ WindowGrid simulate_grid(const StepModel& model, const Transitions& data, const 
 }  // namespace
 
 std::shared_ptr<const Instruments> simulated_instruments(const FitContext& c) {
-  if (c.criterion != FitCriterion::InverseDynamics || !c.accelerations)
+  const InverseDynamicsCriterion* criterion = c.criterion->inverse_dynamics();
+  if (criterion == nullptr)
     throw std::invalid_argument("instruments: the context is not an inverse-dynamics context (criterion_context)");
   if (c.data == nullptr) throw std::invalid_argument("instruments: the context has no data");
   const Transitions& data = *c.data;
   auto out = std::make_shared<Instruments>();
-  out->reach = c.acceleration_reach;
+  out->reach = criterion->reach();
   out->window = 4 * (out->reach + 1);
   out->data = data;
   out->instrumented.assign(static_cast<std::size_t>(data.size()), false);
@@ -90,15 +92,13 @@ std::shared_ptr<const Instruments> simulated_instruments(const FitContext& c) {
   return out;
 }
 
-FitContext instrument_context(const FitContext& context, const Instruments& instruments) {
+FitContext instrument_context(const FitContext& context) {
+  const InverseDynamicsCriterion* criterion = context.criterion->inverse_dynamics();
+  if (criterion == nullptr || criterion->instruments() == nullptr)
+    throw std::invalid_argument("instrument_context: the context's criterion has no instruments");
   FitContext c = context;
-  c.data = &instruments.data;
-  c.accelerations = instruments.accelerations;
-  c.instruments = nullptr;
-  // The simulated accelerations are the model's own at each state, not a window's mean: the
-  // instruments take the controls as applied.
-  c.acceleration_window = 0;
-  c.filtered_controls = nullptr;
+  c.data = &criterion->instruments()->data;
+  c.criterion = criterion->at_instruments();
   return c;
 }
 

@@ -31,7 +31,7 @@ std::pair<Matrix, Matrix> columns(const ModelSpec& base, const Split& r0, const 
                                   const std::vector<int>& heldout) {
   // Inverse dynamics with a force linear in its parameters: secant and tangent are both the force's
   // own regressor (affine_force_residual.hpp), without evaluating the model.
-  if (c.criterion == FitCriterion::InverseDynamics && linear_forces({&effect}))
+  if (c.criterion->inverse_dynamics() && linear_forces({&effect}))
     return {weighted_force_regressor(base, {&effect}, c, train), weighted_force_regressor(base, {&effect}, c, heldout)};
   const auto p = static_cast<Eigen::Index>(effect.parameters.size());
   Matrix JT(r0.train.size(), p), JH(r0.heldout.size(), p);

@@ -186,8 +186,8 @@ void write_where(Hdf5Writer& h5, const DiagnosisReport& r) {
 void write_ranking(Hdf5Writer& h5, const DiagnosisReport& r) {
   const int state = worst_channel(r);
   h5.attribute("/ranking", "heldout_state", r.channel_names.empty() ? std::string() : r.channel_names[static_cast<std::size_t>(state)]);
-  h5.attribute("/ranking", "criterion", fit_criterion_name(r.criterion));
-  h5.attribute("/ranking", "window", static_cast<std::int64_t>(r.window));
+  h5.attribute("/ranking", "criterion", r.criterion->name());
+  h5.attribute("/ranking", "window", static_cast<std::int64_t>(r.criterion->window()));
   h5.attribute("/ranking", "window_restarts", static_cast<std::int64_t>(r.window_restarts));
   if (r.ranking.empty()) return;
   std::vector<std::string> effect, parameter, unit, aliases;

@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gpilqg/control/rollout.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
@@ -22,7 +23,7 @@ int worst_state(const DiagnosisReport& r) {
 }
 
 int worst_channel(const DiagnosisReport& r) {
-  if (r.criterion != FitCriterion::InverseDynamics) return worst_state(r);
+  if (!r.criterion->inverse_dynamics()) return worst_state(r);
   if (r.ranking.empty() || r.criterion_weights.size() != r.ranking.front().fit.heldout_rmse_before.size()) return 0;
   Eigen::Index worst = 0;
   (r.ranking.front().fit.heldout_rmse_before.array() * r.criterion_weights.array().sqrt()).maxCoeff(&worst);
@@ -130,12 +131,14 @@ json where_json(const DiagnosisReport& r) {
 
 /// The instruments of the IV form of inverse dynamics (instrumental_variables.hpp), or null.
 json instruments_json(const DiagnosisReport& r) {
-  if (!r.instruments) return nullptr;
-  return {{"window", r.instruments->window},
-          {"reach", r.instruments->reach},
-          {"instrumented_rows", r.instruments->instrumented_rows()},
-          {"rows", r.instruments->instrumented.size()},
-          {"restarts", r.instruments->restarts}};
+  const InverseDynamicsCriterion* criterion = r.criterion->inverse_dynamics();
+  const Instruments* instruments = criterion != nullptr ? criterion->instruments() : nullptr;
+  if (instruments == nullptr) return nullptr;
+  return {{"window", instruments->window},
+          {"reach", instruments->reach},
+          {"instrumented_rows", instruments->instrumented_rows()},
+          {"rows", instruments->instrumented.size()},
+          {"restarts", instruments->restarts}};
 }
 
 json whiteness_json(const DiagnosisReport& r) {
@@ -291,12 +294,11 @@ nlohmann::json report_json(const DiagnosisReport& r) {
           {"where", where_json(r)},
           {"gp_explained", r.gp_explained_total},
           {"criterion",
-           {{"name", fit_criterion_name(r.criterion) + (r.instruments ? "-iv" : "")},
-            {"window", r.window},
+           {{"name", r.criterion->name()},
+            {"window", r.criterion->window()},
             {"instruments", instruments_json(r)},
             {"restarts", r.window_restarts},
-            {"starts", r.criterion == FitCriterion::InverseDynamics ? json(nullptr)
-                       : json(r.initial_state ? "estimated" : "measured")},
+            {"starts", r.criterion->starts().empty() ? json(nullptr) : json(r.criterion->starts())},
             {"chosen_by", r.criterion_reason.empty() ? "user" : "data"},
             {"excluded", r.criterion_excluded},
             {"reason", r.criterion_reason.empty() ? json(nullptr) : json(r.criterion_reason)}}},

@@ -212,24 +212,11 @@ void which_section(const DiagnosisReport& r, std::string& out) {
   if (!r.excluded.empty())
     out += fmt::format("   excluded by --exclude (never ranked, searched or proposed): {}\n", fmt::join(r.excluded, ", "));
   if (!r.criterion_reason.empty()) out += "   criterion chosen by the data (--criterion auto): " + r.criterion_reason + "\n";
-  if (r.criterion == FitCriterion::InverseDynamics)
-    out += "   criterion: inverse dynamics, the generalised-force residual M(q) qdd - h(q, qdot, u) with qdd a zero-phase "
-           "derivative of the measured velocities\n";
-  if (r.instruments) {
-    out += fmt::format("   instrumental variables (IDIM-IV): instruments from the model simulated over windows of {} samples "
-                       "from measured states, {} of {} rows instrumented{}\n",
-                       r.instruments->window, r.instruments->instrumented_rows(), r.instruments->instrumented.size(),
-                       r.instruments->restarts > 0 ? fmt::format(", {} restarts after a diverged state", r.instruments->restarts)
-                                                   : "");
-  }
+  if (const std::string line = r.criterion->description(r.dt, r.window_restarts); !line.empty())
+    out += "   " + line + "\n";
   if (!r.criterion_excluded.empty())
-    out += fmt::format("   not candidates on this criterion (the force residual and the inertias scale with them): {}\n",
+    out += fmt::format("   not candidates on this criterion ({}): {}\n", r.criterion->unidentifiable_reason(),
                        fmt::join(r.criterion_excluded, ", "));
-  if (r.criterion == FitCriterion::Simulation)
-    out += fmt::format("   criterion: simulation error over windows of {} samples ({:g} s), each window's start "
-                       "estimated{}\n",
-                       r.window, r.window * r.dt,
-                       r.window_restarts > 0 ? fmt::format(", {} restarts after a diverged state", r.window_restarts) : "");
   // Columns as wide as the longest name and parameter text (a MuJoCo model's effects have long names).
   std::size_t name_width = 24, parameter_width = 40;
   for (const RankedEffect& g : r.ranking) {

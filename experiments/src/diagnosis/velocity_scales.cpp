@@ -31,7 +31,7 @@ double profiled_objective(const FitContext& c, const LibraryEffect& coulomb, dou
                           const std::vector<int>& rows) {
   const LibraryEffect effect = with_smoothing(coulomb, v0);
   Vector J;
-  if (c.criterion == FitCriterion::InverseDynamics && linear_forces({&effect})) {
+  if (c.criterion->inverse_dynamics() && linear_forces({&effect})) {
     J = weighted_force_regressor(c.model, {&effect}, c, rows).col(0);  // the force's own regressor
   } else {
     const double h = effect.parameters[0].scale;

@@ -215,10 +215,10 @@ struct DiagnosisReport {
   bool consistent = false;
   double gp_explained_total = 0.0;       ///< weighted, held-out
   Vector weights;                        ///< n, 1 / noise floor^2
-  /// The criterion of the fits below (ranking, verdict, added, selection): one-step or simulation
-  /// over windows of `window` samples (simulation_error.hpp).
-  FitCriterion criterion = FitCriterion::OneStep;
-  int window = 1;
+  /// The criterion of the fits below (ranking, verdict, added, selection, the remainder test), made
+  /// for these data and the diagnosed model (criteria/criterion.hpp): its name, window, accelerations
+  /// (inverse dynamics), windows' starts (simulation) and instruments (IDIM-IV).
+  std::shared_ptr<const Criterion> criterion = one_step_criterion();
   /// `--criterion auto`: the sentence saying which criterion the data chose and why (empty when the
   /// user chose it).
   std::string criterion_reason;
@@ -227,23 +227,10 @@ struct DiagnosisReport {
   /// the weights 1 / sigma_i^2 the fits use in them.
   std::vector<std::string> channel_names, channel_units;
   Vector criterion_weights;
-  /// Inverse dynamics: the measured accelerations (N x k) the residuals are computed with.
-  std::shared_ptr<const Matrix> accelerations;
-  /// Inverse dynamics: the window of their estimate and the controls seen through it (FitContext's
-  /// acceleration_window, filtered_controls and filtered_delay: parallel filtering, accelerations.hpp).
-  int acceleration_window = 0;
-  std::shared_ptr<const Matrix> filtered_controls;
-  double filtered_delay = 0.0;
-  /// Simulation: the sensitivities of the windows to their starts, whose first-order effect every
-  /// simulation error of the diagnosis leaves out (initial_state.hpp).
-  std::shared_ptr<const InitialStateSensitivity> initial_state;
   /// Simulation criterion: simulated states of the diagnosed model that diverged, each followed by a
   /// restart from the measurement (0 for the one-step criterion, whose divergences are counted in
   /// non_finite_predictions).
   int window_restarts = 0;
-  /// Inverse dynamics in its IV form: the simulated data of the instruments (instrumental_variables.hpp);
-  /// null for least squares and the other criteria.
-  std::shared_ptr<const Instruments> instruments;
   std::vector<RankedEffect> ranking;
   std::vector<std::string> excluded;     ///< candidates left out by the user (DiagnosisOptions::exclude)
   /// Candidates the criterion cannot identify and leaves out: under inverse dynamics the actuators'

@@ -1,9 +1,9 @@
 #pragma once
 /// @file effect_fit.hpp
 /// Which physical effect is missing: fit every effect of the library to the one-step residuals of the
-/// training episodes and score it on the held-out episodes. Under the simulation criterion
-/// (FitContext::window > 1, simulation_error.hpp) phi(x_t, u_t; theta) below stands for the model
-/// simulated from the measured state at the start of t's window, and every step is otherwise the same.
+/// training episodes and score it on the held-out episodes, under the context's criterion
+/// (criteria/criterion.hpp). Under the simulation criterion phi(x_t, u_t; theta) below stands for the
+/// model simulated from the start of t's window, and every step is otherwise the same.
 ///
 /// For an effect with parameters theta (current value theta_0 in the model) the predicted next state
 /// is phi(x_t, u_t; theta) (the model with the effect, integrated like the model). With per-state
@@ -54,13 +54,10 @@
 
 #include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/integrator.hpp"
-#include "gpilqg/experiments/diagnosis/fit_criterion.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/criterion.hpp"
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
 
 namespace gpilqg::diagnosis {
-
-struct Instruments;              // instrumental_variables.hpp
-struct InitialStateSensitivity;  // initial_state.hpp
 
 /// The data and model a fit works on. The criterion's channels are the states (one-step, simulation)
 /// or the generalised-force components (inverse dynamics): c of them below.
@@ -75,33 +72,10 @@ struct FitContext {
   /// Batch length of the held-out significance test; 0: ceil(sqrt(N)) of the N held-out rows, at
   /// least 10 (24 on 600 held-out rows, 87 on 7,500). criterion_context makes it at least a window.
   int batch = 0;
-  /// The criterion (simulation_error.hpp): 1 for the one-step error; W > 1 for the simulation error
-  /// over windows of W rows started from measured states. criterion_context sets it with the
-  /// residual and the batch.
-  int window = 1;
-  /// The criterion (fit_criterion.hpp); Simulation exactly when window > 1. criterion_context sets it.
-  FitCriterion criterion = FitCriterion::OneStep;
-  /// Inverse dynamics: the measured accelerations of the force components' velocity states at every
-  /// row (N x k, accelerations.hpp), and the model's own generalised force W_v^-1 f_v at every row
-  /// (N x k, the scale of EffectFit::scale). Null for the other criteria.
-  std::shared_ptr<const Matrix> accelerations = {};
-  std::shared_ptr<const Matrix> own_force = {};
-  /// Inverse dynamics: h, the half-width of the widest window of the acceleration estimate (the rows
-  /// a measured sample's noise reaches); 0 for the other criteria.
-  int acceleration_reach = 0;
-  /// Inverse dynamics: the one window of the acceleration estimate (accelerations.hpp), whose weights
-  /// the controls are seen through (parallel filtering, force_controls); 0: the controls as applied.
-  int acceleration_window = 0;
-  /// Inverse dynamics: force_controls for the delay `filtered_delay`, made once by criterion_context.
-  std::shared_ptr<const Matrix> filtered_controls = {};
-  double filtered_delay = 0.0;
-  /// Inverse dynamics in its instrumental-variable form (instrumental_variables.hpp): the simulated
-  /// data the instruments are evaluated at; null for least squares.
-  std::shared_ptr<const Instruments> instruments = {};
-  /// Simulation: the sensitivities of the base model's windows to their starts, whose first-order
-  /// effect is removed from every window's errors (initial_state.hpp); null: the measured starts.
-  std::shared_ptr<const InitialStateSensitivity> initial_state = {};
-  /// Simulation: whether criterion_context estimates the windows' starts (sets initial_state); false:
+  /// The criterion the residual, the fits and the scores are under (criteria/criterion.hpp): made
+  /// for these data and this model by criterion_context; one-step by default.
+  std::shared_ptr<const Criterion> criterion = one_step_criterion();
+  /// Simulation: whether criterion_context estimates the windows' starts; false:
   /// every window from its measured start, as simulated_predictions runs it.
   bool estimate_starts = true;
   /// Candidates left out of every ranking and search (`--exclude`): effects the user declares
@@ -114,30 +88,16 @@ struct FitContext {
   bool probe_affine = true;
 };
 
-/// The controls of the inverse-dynamics residual of `model` on settings.data: applied_controls with
-/// model.input_delay, seen through the acceleration estimate's weights (filtered_controls,
-/// accelerations.hpp: parallel filtering) when settings.acceleration_window > 0; settings'
-/// filtered_controls when they were made for that delay.
-Matrix force_controls(const ModelSpec& model, const FitContext& settings);
-
 /// The model integrated as configured.
 std::shared_ptr<const StepModel> make_step_model(const ModelSpec& model, Integrator integrator, double dt, int substeps);
 
-/// One-step predictions of `model` on settings.data (one_step_predictions), integrated as
-/// `settings` says and driven by the measured inputs delayed by model.input_delay; with
-/// settings.window > 1 the simulated predictions over windows (simulated_predictions,
-/// simulation_error.hpp), `diverged` then counting the restarts. Only the data, integrator, dt,
-/// substeps and window of `settings` are used.
+/// settings.criterion->predictions: the next state predicted at every row of settings.data (N x n).
 Matrix model_predictions(const ModelSpec& model, const FitContext& settings, int* diverged = nullptr);
 
-/// sqrt(w_i) (x_{t+1,i} - phi_i(x_t, u_t)) of `model` stacked over `rows` (index k n + i), integrated
-/// and weighted as `settings` says; a diverged prediction counts as x_t (see one_step_predictions).
-/// Under the inverse-dynamics criterion the weighted generalised-force residual (index k c + i).
+/// settings.criterion->weighted_residual: sqrt(w_i) r_{t,i} of `model` stacked over `rows`.
 Vector weighted_residual_of(const ModelSpec& model, const FitContext& settings, const std::vector<int>& rows);
 
-/// The residual of `model` at every row of settings.data under settings' criterion (N x c): x_next
-/// minus model_predictions for one-step and simulation, the generalised-force residual
-/// (generalised_force_residual.hpp) for inverse dynamics.
+/// settings.criterion->residual: the residual of `model` at every row of settings.data (N x c).
 Matrix criterion_residual(const ModelSpec& model, const FitContext& settings, int* diverged = nullptr);
 
 /// The values of one effect inside a joint fit: where it started, where it ended, its 95% interval.

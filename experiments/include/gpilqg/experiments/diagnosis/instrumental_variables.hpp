@@ -62,14 +62,16 @@ struct Instruments {
 };
 
 /// The instruments of an inverse-dynamics context (criterion_context with FitCriterion::InverseDynamics):
-/// its model simulated over two staggered grids of windows of 4 (context.acceleration_reach + 1) rows. Throws
+/// its model simulated over two staggered grids of windows of 4 (h + 1) rows, h the criterion's
+/// reach (InverseDynamicsCriterion::reach). Throws
 /// std::invalid_argument when the context is not inverse dynamics or has no data.
 std::shared_ptr<const Instruments> simulated_instruments(const FitContext& context);
 
-/// `context` with the data and accelerations of `instruments`: the context in which the regressor of
-/// a set of effects is its instrument matrix Z (rows without an instrument still to be zeroed,
-/// instrument_basis).
-FitContext instrument_context(const FitContext& context, const Instruments& instruments);
+/// `context` at the data and accelerations of its criterion's instruments
+/// (InverseDynamicsCriterion::at_instruments): the context in which the regressor of a set of effects
+/// is its instrument matrix Z (rows without an instrument still to be zeroed, instrument_basis).
+/// Throws std::invalid_argument when the context's criterion has no instruments.
+FitContext instrument_context(const FitContext& context);
 
 /// Q, an orthonormal basis of the columns of Z (Z's rows stacked like the weighted regressor over
 /// `rows`, index t k + i), after zeroing the rows without an instrument. Empty when Z has a column of

@@ -74,19 +74,4 @@ Matrix simulated_predictions(const StepModel& model, const Transitions& data, co
 /// All rows of `data` (0, ..., N - 1).
 std::vector<int> all_rows(const Transitions& data);
 
-/// `context` set to the criterion. One-step: window = 1, the rest as given (its residual is the
-/// one-step residual). Simulation: window = `window`, the held-out batch rounded up to a multiple of
-/// the window, initial_state the sensitivities of context.model's windows to their starts, and
-/// `residual` recomputed as the simulation error of context.model with the starts estimated
-/// (criterion_residual, initial_state.hpp);
-/// `restarts` (when not null) receives the restarts of that simulation. Inverse dynamics
-/// (generalised_force_residual.hpp): the accelerations of the force components' velocity states
-/// (accelerations.hpp), `residual` the generalised-force residual of context.model (N x k), `weights`
-/// 1 / sigma_i^2 with sigma_i the white noise of component i's residual estimated from its repeated
-/// differences within each record (difference_noise_std: what a smooth missing force does not
-/// raise), and own_force the model's own generalised force. Throws std::invalid_argument for
-/// window < 1, and for inverse dynamics on a system without a generalised-force map or on records too
-/// short for the acceleration estimate.
-FitContext criterion_context(FitContext context, FitCriterion criterion, int window, int* restarts = nullptr);
-
 }  // namespace gpilqg::diagnosis

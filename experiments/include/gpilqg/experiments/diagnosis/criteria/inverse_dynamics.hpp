@@ -1,0 +1,90 @@
+#pragma once
+/// @file inverse_dynamics.hpp
+/// The inverse-dynamics criterion (IDIM-LS, Gautier; in its instrumental-variable form IDIM-IV,
+/// instrumental_variables.hpp): the generalised force the model is missing,
+///
+///   r_t = W_v(x_t)^-1 (qdd_t - f_v(x_t, u_t)),
+///
+/// with qdd_t a zero-phase Savitzky-Golay derivative of the measured velocities, one window for every
+/// coordinate (accelerations.hpp), and the controls seen through the same weights (parallel
+/// filtering). Friction and offsets are linear and directly visible there, and an error in a torque
+/// is not divided by the joint's inertia; it needs measured velocities and controls that are
+/// generalised forces (generalised_force_residual.hpp).
+///
+/// The force residual M qdd - h(q, qdot, k u) is homogeneous in the inertias and the actuators'
+/// gains together (the scale ambiguity that a measured torque fixes by its own calibration), so the
+/// gains and gears are not candidates here.
+
+#include <memory>
+
+#include "gpilqg/experiments/diagnosis/criteria/criterion.hpp"
+
+namespace gpilqg::diagnosis {
+
+struct Instruments;  // instrumental_variables.hpp
+
+class InverseDynamicsCriterion final : public Criterion {
+ public:
+  /// Estimates the accelerations on c.data and sets c.residual (N x k) to the force residual of
+  /// c.model and c.weights to 1 / sigma_i^2, sigma_i the white noise of component i's residual (its
+  /// repeated differences within each record, with the controls as applied: what a smooth missing
+  /// force does not raise). Throws std::invalid_argument on a system without a generalised-force map
+  /// or records too short for the estimate.
+  static std::shared_ptr<const InverseDynamicsCriterion> make(FitContext& c);
+
+  /// The criterion with the same accelerations and instruments simulated from c.model
+  /// (instrumental_variables.hpp): the IV form.
+  std::shared_ptr<const InverseDynamicsCriterion> with_instruments(const FitContext& c) const;
+  /// The criterion at the instruments' simulated data: their accelerations, the controls as applied
+  /// (the simulated accelerations are the model's own at each state, not a window's mean), no
+  /// instruments. Its regressor of a set of effects is the instrument matrix Z.
+  std::shared_ptr<const InverseDynamicsCriterion> at_instruments() const;
+
+  FitCriterion kind() const override { return FitCriterion::InverseDynamics; }
+  std::string name() const override;
+
+  /// The measured accelerations of the force components' velocity states (N x k).
+  const Matrix& accelerations() const { return *accelerations_; }
+  /// h, the half-width of the acceleration estimate's window (the rows one sample's noise reaches).
+  int reach() const { return reach_; }
+  /// The one window of the acceleration estimate; 0 at the instruments (controls as applied).
+  int acceleration_window() const { return window_; }
+  /// The instruments of the IV form, or null for least squares.
+  const Instruments* instruments() const { return instruments_.get(); }
+
+  /// The controls of `model`'s force residual on `data`: applied with model.input_delay, seen through
+  /// the acceleration estimate's weights (filtered_controls, accelerations.hpp); the cached matrix
+  /// for the base model's delay.
+  Matrix force_controls(const ModelSpec& model, const Transitions& data) const;
+
+  std::string scored_on() const override { return "the generalised-force (inverse-dynamics) residual"; }
+  Matrix residual(const ModelSpec& model, const FitContext& c, int* diverged = nullptr) const override;
+  Vector weighted_residual(const ModelSpec& model, const FitContext& c, const std::vector<int>& rows,
+                           bool* finite = nullptr) const override;
+  /// Every force component, against the model's own generalised force W_v^-1 f_v.
+  std::vector<int> scale_channels(const FitContext& c) const override;
+  double own_change(const FitContext& c, int row, int channel) const override;
+  /// The actuators' gains and gears.
+  std::vector<std::string> unidentifiable(const std::vector<LibraryEffect>& candidates) const override;
+  std::string unidentifiable_reason() const override;
+  bool needs_one_step_gp() const override { return false; }
+  /// A GP of each component of `model`'s force residual on (x, u) is the flexible model.
+  double flexible_share(const ModelSpec& model, const OneStepGp* gp, const FitContext& c,
+                        const GpSettings& settings) const override;
+  std::string starts() const override { return {}; }
+  std::string description(double dt, int restarts) const override;
+  const InverseDynamicsCriterion* inverse_dynamics() const override { return this; }
+
+ private:
+  InverseDynamicsCriterion() = default;
+
+  std::shared_ptr<const Matrix> accelerations_;
+  std::shared_ptr<const Matrix> own_force_;  ///< N x k, W_v^-1 f_v of the base model
+  int reach_ = 0;
+  int window_ = 0;
+  std::shared_ptr<const Matrix> filtered_controls_;  ///< force_controls for the delay filtered_delay_
+  double filtered_delay_ = 0.0;
+  std::shared_ptr<const Instruments> instruments_;
+};
+
+}  // namespace gpilqg::diagnosis

@@ -1,0 +1,145 @@
+#include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gpilqg/experiments/diagnosis/accelerations.hpp"
+#include "gpilqg/experiments/diagnosis/derivative_window.hpp"
+#include "gpilqg/experiments/diagnosis/effect_fit.hpp"
+#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
+#include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
+#include "gpilqg/experiments/diagnosis/simulation_error.hpp"
+
+namespace gpilqg::diagnosis {
+
+std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(FitContext& c) {
+  std::shared_ptr<InverseDynamicsCriterion> out(new InverseDynamicsCriterion());
+  if (c.data == nullptr) return out;
+  const Transitions& data = *c.data;
+  const ForceComponents components = force_components(*c.model.build());
+  const auto k = static_cast<Eigen::Index>(components.forces.size());
+  const AccelerationEstimate estimate = estimate_accelerations(data, components.velocity_states(), c.dt);
+  out->accelerations_ = std::make_shared<const Matrix>(estimate.qdd);
+  out->reach_ = estimate.window / 2;
+  // Parallel filtering: the controls seen through the acceleration estimate's weights (accelerations.hpp).
+  out->window_ = estimate.window;
+  out->filtered_delay_ = c.model.input_delay;
+  out->filtered_controls_ = std::make_shared<const Matrix>(out->force_controls(c.model, data));
+  const std::vector<int> rows = all_rows(data);
+  c.residual = generalised_force_residual(c.model, data, *out->filtered_controls_, *out->accelerations_, rows);
+  // The model's own force: the residual at zero acceleration is -W_v^-1 f_v.
+  out->own_force_ = std::make_shared<const Matrix>(
+      -generalised_force_residual(c.model, data, *out->filtered_controls_, Matrix::Zero(data.size(), k), rows));
+  // w_i = 1 / sigma_i^2 with sigma_i the white noise of component i's residual, from its repeated
+  // differences within each record (difference_noise_std): the noise of the torque and of the
+  // acceleration estimate, which a smooth missing force does not raise. Taken from the residual with
+  // the controls as measured: the filter turns their white noise into a smooth one that differences
+  // no longer see, and it scales every component's noise variance by the same |m|^2, so the weights'
+  // ratios, which are all a fit uses, are those of the unfiltered noise.
+  const Matrix unfiltered = generalised_force_residual(c.model, data, applied_controls(data, c.model.input_delay),
+                                                       *out->accelerations_, rows);
+  const std::vector<RowSegment> segments = row_segments(data);
+  c.weights.resize(k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    std::vector<Vector> pieces;
+    for (const RowSegment& s : segments) pieces.push_back(unfiltered.col(i).segment(s.first, s.end - s.first));
+    const double rms = std::sqrt(unfiltered.col(i).squaredNorm() / std::max<double>(1.0, data.size()));
+    const double sigma = std::max(difference_noise_std(pieces), 1e-12 * (1.0 + rms));
+    c.weights(i) = 1.0 / (sigma * sigma);
+  }
+  return out;
+}
+
+std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::with_instruments(const FitContext& c) const {
+  std::shared_ptr<InverseDynamicsCriterion> out(new InverseDynamicsCriterion(*this));
+  out->instruments_ = simulated_instruments(c);
+  return out;
+}
+
+std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::at_instruments() const {
+  std::shared_ptr<InverseDynamicsCriterion> out(new InverseDynamicsCriterion(*this));
+  if (instruments_) out->accelerations_ = instruments_->accelerations;
+  out->window_ = 0;
+  out->filtered_controls_ = nullptr;
+  out->instruments_ = nullptr;
+  return out;
+}
+
+std::string InverseDynamicsCriterion::name() const {
+  return fit_criterion_name(kind()) + (instruments_ ? "-iv" : "");
+}
+
+Matrix InverseDynamicsCriterion::force_controls(const ModelSpec& model, const Transitions& data) const {
+  if (window_ == 0) return applied_controls(data, model.input_delay);
+  if (filtered_controls_ && filtered_delay_ == model.input_delay && filtered_controls_->rows() == data.size())
+    return *filtered_controls_;
+  return filtered_controls(data, applied_controls(data, model.input_delay), window_);
+}
+
+Matrix InverseDynamicsCriterion::residual(const ModelSpec& model, const FitContext& c, int* diverged) const {
+  if (diverged != nullptr) *diverged = 0;
+  return generalised_force_residual(model, *c.data, force_controls(model, *c.data), *accelerations_, all_rows(*c.data));
+}
+
+Vector InverseDynamicsCriterion::weighted_residual(const ModelSpec& model, const FitContext& c,
+                                                   const std::vector<int>& rows, bool*) const {
+  const Matrix r = generalised_force_residual(model, *c.data, force_controls(model, *c.data), *accelerations_, rows);
+  const Vector sqrt_w = c.weights.cwiseSqrt();
+  const auto k = static_cast<Eigen::Index>(sqrt_w.size());
+  Vector out(static_cast<Eigen::Index>(rows.size()) * k);
+  for (Eigen::Index i = 0; i < r.rows(); ++i) out.segment(i * k, k) = sqrt_w.cwiseProduct(r.row(i).transpose());
+  return out;
+}
+
+std::vector<int> InverseDynamicsCriterion::scale_channels(const FitContext& c) const {
+  if (!own_force_) return Criterion::scale_channels(c);
+  std::vector<int> channels(static_cast<std::size_t>(c.weights.size()));
+  for (std::size_t i = 0; i < channels.size(); ++i) channels[i] = static_cast<int>(i);
+  return channels;
+}
+
+double InverseDynamicsCriterion::own_change(const FitContext& c, int row, int channel) const {
+  if (!own_force_) return Criterion::own_change(c, row, channel);
+  return (*own_force_)(row, channel);
+}
+
+std::vector<std::string> InverseDynamicsCriterion::unidentifiable(const std::vector<LibraryEffect>& candidates) const {
+  std::vector<std::string> out;
+  for (const LibraryEffect& effect : candidates) {
+    const bool gain = effect.kind == EffectKind::ActuatorGain ||
+                      (effect.kind == EffectKind::Recalibration &&
+                       (effect.recalibrated.ends_with(".gain") || effect.recalibrated.ends_with(".gear")));
+    if (gain) out.push_back(effect.name);
+  }
+  return out;
+}
+
+std::string InverseDynamicsCriterion::unidentifiable_reason() const {
+  return "the force residual and the inertias scale with them";
+}
+
+double InverseDynamicsCriterion::flexible_share(const ModelSpec& model, const OneStepGp*, const FitContext& c,
+                                                const GpSettings& settings) const {
+  const Matrix force = residual(model, c);
+  return weighted_heldout_explained(*c.data, force, gp_column_means(*c.data, force, settings), c.weights);
+}
+
+std::string InverseDynamicsCriterion::description(double, int) const {
+  std::string out =
+      "criterion: inverse dynamics, the generalised-force residual M(q) qdd - h(q, qdot, u) with qdd a zero-phase "
+      "derivative of the measured velocities";
+  if (window_ > 0)
+    out += fmt::format(" (Savitzky-Golay window of {} samples, the controls seen through the same weights)", window_);
+  if (instruments_)
+    out += fmt::format("\n   instrumental variables (IDIM-IV): instruments from the model simulated over windows of {} "
+                       "samples from measured states, {} of {} rows instrumented{}",
+                       instruments_->window, instruments_->instrumented_rows(), instruments_->instrumented.size(),
+                       instruments_->restarts > 0 ? fmt::format(", {} restarts after a diverged state", instruments_->restarts)
+                                                  : "");
+  return out;
+}
+
+}  // namespace gpilqg::diagnosis
