@@ -68,21 +68,21 @@ void diagnose(benchmark::State& state, bool auto_select) {
 void BM_DiagnoseOneEffect(benchmark::State& state) { diagnose(state, false); }
 void BM_DiagnoseAutoThreeEffects(benchmark::State& state) { diagnose(state, true); }
 
-/// The drive's log of `seconds`, imported as `gpilqg data import` does.
-MeasurementSet drive_record(double seconds) {
+/// The rig's model and its log of `seconds`, imported as `gpilqg data import` does.
+std::pair<std::filesystem::path, MeasurementSet> drive_record(const test::DriveRig& rig, double seconds) {
   const auto dir = std::filesystem::temp_directory_path() / "gpilqg_diagnosis_bench";
   std::filesystem::create_directories(dir);
-  const auto model = test::drive_model(GPILQG_BENCH_SOURCE_DIR);
-  const auto log = test::drive_log(test::drive_world(model, dir, {}), dir, seconds, 3);
-  return import_log(read_raw_log(log), read_import_map(test::drive_map(dir)),
-                    system_signature(model.string()))
-      .set;
+  const auto model = test::drive_model(GPILQG_BENCH_SOURCE_DIR, dir, rig);
+  const auto log = test::drive_log(test::drive_world(model, dir, rig), dir, rig, seconds, 3);
+  return {model, import_log(read_raw_log(log), read_import_map(test::drive_map(dir)), system_signature(model.string())).set};
 }
 
+/// Range 0: samples at 1 kHz; range 1: 0 for the light rig, 1 for the heavy one.
 void BM_DiagnoseAutoDrive(benchmark::State& state) {
-  const MeasurementSet data = drive_record(static_cast<double>(state.range(0)) / 1000.0);
+  const auto rig = state.range(1) == 0 ? test::DriveRig::light() : test::DriveRig::heavy();
+  const auto [model, data] = drive_record(rig, static_cast<double>(state.range(0)) / 1000.0);
   diagnosis::DiagnoseRequest request;
-  request.system = test::drive_model(GPILQG_BENCH_SOURCE_DIR).string();
+  request.system = model.string();
   request.auto_select = true;
   const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(request);
   std::size_t found = 0;
@@ -143,7 +143,7 @@ void BM_DiagnoseAutoArm7InverseDynamics(benchmark::State& state) { diagnose_arm7
 
 BENCHMARK(BM_DiagnoseOneEffect)->Unit(benchmark::kSecond)->Iterations(3);
 BENCHMARK(BM_DiagnoseAutoThreeEffects)->Unit(benchmark::kSecond)->Iterations(3);
-BENCHMARK(BM_DiagnoseAutoDrive)->Arg(25000)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_DiagnoseAutoDrive)->Args({25000, 0})->Args({25000, 1})->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_RankArm7InverseDynamics)->Arg(5000)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_DiagnoseAutoArm7InverseDynamics)->Arg(5000)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
 

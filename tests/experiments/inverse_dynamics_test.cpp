@@ -12,6 +12,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <memory>
 #include <random>
 #include <set>
 
@@ -26,6 +27,7 @@
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
+#include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 #include "gpilqg/experiments/diagnosis/student_t.hpp"
 #include "test_support.hpp"
@@ -868,6 +870,34 @@ TEST(InverseDynamicsFit, RecalibrationWithALinearForceEndsAtTheRebuiltModelsMini
 
 // --- IDIM-IV: instruments from the simulated model --------------------------------------------------
 
+/// One noisy record of the hidden-friction world (velocity noise `velocity_noise`, episode 2 held out)
+/// with its least-squares and instrumental-variable inverse-dynamics contexts.
+struct NoisyRecord {
+  std::shared_ptr<Transitions> data;
+  FitContext base, ls, iv;
+};
+
+NoisyRecord noisy_record(double velocity_noise, unsigned seed) {
+  const HiddenFrictionWorld& w = hidden_friction_world();
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<Matrix> noisy = w.states;
+  for (Matrix& x : noisy)
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      for (Eigen::Index j = 0; j < 4; ++j) x(i, j) += (j < 2 ? 1e-4 : velocity_noise) * gauss(rng);
+  NoisyRecord record;
+  record.data = std::make_shared<Transitions>(transitions_of(noisy, w.controls, w.dt));
+  Transitions& data = *record.data;
+  for (std::size_t t = 0; t < data.episode.size(); ++t) data.heldout[t] = data.episode[t] == 2;
+  record.base.data = &data;
+  record.base.model.system = arm_2ms_path();  // the instruments simulate the model at the records' step
+  record.base.dt = w.dt;
+  record.ls = criterion_context(record.base, FitCriterion::InverseDynamics, 1);
+  record.iv = record.ls;
+  record.iv.criterion = record.ls.criterion->inverse_dynamics()->with_instruments(record.ls);
+  return record;
+}
+
 /// The least-squares and the instrumental-variable fit of the shoulder's viscous damping on one noisy
 /// record of the hidden-friction world, and the IV estimate in closed form from its instruments.
 struct DampingFits {
@@ -877,22 +907,9 @@ struct DampingFits {
 };
 
 DampingFits fit_damping_both_ways(double velocity_noise, unsigned seed) {
-  const HiddenFrictionWorld& w = hidden_friction_world();
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  std::vector<Matrix> noisy = w.states;
-  for (Matrix& x : noisy)
-    for (Eigen::Index i = 0; i < x.rows(); ++i)
-      for (Eigen::Index j = 0; j < 4; ++j) x(i, j) += (j < 2 ? 1e-4 : velocity_noise) * gauss(rng);
-  Transitions data = transitions_of(noisy, w.controls, w.dt);
-  for (std::size_t t = 0; t < data.episode.size(); ++t) data.heldout[t] = data.episode[t] == 2;
-  FitContext base;
-  base.data = &data;
-  base.model.system = arm_2ms_path();  // the instruments simulate the model at the records' step
-  base.dt = w.dt;
-  const FitContext ls = criterion_context(base, FitCriterion::InverseDynamics, 1);
-  FitContext iv = ls;
-  iv.criterion = ls.criterion->inverse_dynamics()->with_instruments(ls);
+  const NoisyRecord record = noisy_record(velocity_noise, seed);
+  const Transitions& data = *record.data;
+  const FitContext &base = record.base, &ls = record.ls, &iv = record.iv;
   const Instruments& z = *iv.criterion->inverse_dynamics()->instruments();
   EXPECT_EQ(z.window, 4 * (ls.criterion->inverse_dynamics()->reach() + 1));
   EXPECT_EQ(z.restarts, 0);
@@ -950,6 +967,23 @@ TEST(InverseDynamicsFit, InstrumentsFromTheSimulatedModelRemoveTheNoiseBiasOfLea
   EXPECT_LT(ls_mean, 0.95 * kShoulderDamping);
   EXPECT_GE(iv_holds, 3);
   EXPECT_LE(ls_holds, 1);
+}
+
+// The subset search screens with the estimator it then fits with (linearised_fits.hpp): in a context
+// with instruments, what the linearised fit of a force linear in its parameters leaves on the training
+// rows is what the exact IV fit leaves (fit_effect: its training objective), not what least squares
+// leaves, which is less (least squares minimises it; the IV estimate does not).
+TEST(InverseDynamicsFit, TheSubsetScreeningFitsWithTheInstruments) {
+  const NoisyRecord record = noisy_record(0.5, 1);
+  const LibraryEffect viscous = find_candidate(record.base.model, "joint_viscous_damping:shoulder");
+  const EffectFit ls = fit_effect(viscous, record.ls), iv = fit_effect(viscous, record.iv);
+  const LinearisedFits screened_ls(record.ls, {ls}, {}), screened_iv(record.iv, {iv}, {});
+  std::printf("training residual left: IV %.8g (exact %.8g), least squares %.8g (exact %.8g)\n",
+              screened_iv.training_left({0}), iv.training_objective_after, screened_ls.training_left({0}),
+              ls.training_objective_after);
+  EXPECT_NEAR(screened_iv.training_left({0}), iv.training_objective_after, 1e-9 * iv.training_objective_after);
+  EXPECT_NEAR(screened_ls.training_left({0}), ls.training_objective_after, 1e-9 * ls.training_objective_after);
+  EXPECT_GT(iv.training_objective_after, ls.training_objective_after * (1.0 + 1e-6));
 }
 
 // Parameters of the model whose residual is affine in them (a mass with its inertia, an armature, a

@@ -146,6 +146,9 @@ struct StateRatio {
   int window = 0;
   double control_error = 0.0;  ///< sqrt(mean a_h^2) / E_ID
   double smear_error = 0.0;    ///< sqrt(mean a_s^2) / E_ID
+  /// sqrt((mean a_s^2 + mean a_h^2) / mean |b_v u|^2): the filter's misfit on the model against the
+  /// force the controls apply (infinite when they apply none)
+  double misfit = 0.0;
 };
 
 /// The white-noise level of a sampled signal robust to isolated corners and steps: for each order
@@ -233,7 +236,7 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
   DynamicsJacobians jac;
   Vector xdot(model.state_dim());
   const auto workspace = model.make_workspace();
-  double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0;
+  double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0, applied = 0.0;
   long count = 0, position = 0;
   for (std::size_t episode = 0; episode < data.episodes.size(); ++episode) {
     const Episode& e = data.episodes[episode];
@@ -253,6 +256,7 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
       model.evaluate(e.x.row(t).transpose(), filtered_u, xdot, &jac, *workspace);
       smear += std::pow(own[episode].col(state).segment(start, window).dot(continuous[p]) - xdot(state), 2);
       hold += std::pow(jac.fu.row(state).dot(du), 2);
+      applied += std::pow(jac.fu.row(state).dot(e.u.row(t)), 2);
       const double noise = jac.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
       shared += noise;
       filtered_noise += noise * continuous[p].squaredNorm();
@@ -269,6 +273,7 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
                                 : (e1_squared > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
   out.control_error = eid_squared > 0.0 ? std::sqrt(hold_mse / eid_squared) : 0.0;
   out.smear_error = eid_squared > 0.0 ? std::sqrt(smear_mse / eid_squared) : 0.0;
+  out.misfit = applied > 0.0 ? std::sqrt((smear + hold) / applied) : std::numeric_limits<double>::infinity();
   return out;
 }
 
@@ -331,6 +336,26 @@ std::pair<int, std::string> simulation_window(const MeasurementSet& data, const 
   return {static_cast<int>(std::lround(periods)), two_periods};
 }
 
+/// Rules 1 and 3: the simulation criterion, its window, and the reason `why`; one-step when no window fits.
+CriterionChoice simulation_choice(const MeasurementSet& data, const std::vector<int>& states, CriterionFacts& facts,
+                                  const std::string& why) {
+  CriterionChoice choice;
+  const auto [window, how] = simulation_window(data, states, facts);
+  choice.facts = facts;
+  if (window < 2) {
+    choice.reason = fmt::format(
+        "one-step: the simulation criterion is called for ({}), but no window of 2 samples or more fits the "
+        "episodes ({})",
+        why, how);
+    return choice;
+  }
+  choice.criterion = FitCriterion::Simulation;
+  choice.window = window;
+  choice.reason =
+      fmt::format("simulation over windows of {} samples ({}, {}): {}", window, seconds(window * facts.dt), how, why);
+  return choice;
+}
+
 }  // namespace
 
 int simulation_window_cap(const MeasurementSet& data) {
@@ -363,36 +388,27 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
   const std::vector<int> states = velocity_states(coordinates, data.system);
   for (int s : states) facts.velocity_states.push_back(data.system.states[static_cast<std::size_t>(s)].name);
 
-  // 1. Passive, or estimated states: simulation.
-  if (facts.passive || !facts.estimated_states.empty()) {
-    std::string why;
-    if (!facts.estimated_states.empty())
-      why = fmt::format("{} {} estimated from other states (e.g. by the import), and a one-step fit regresses on them: "
-                        "biased, as errors in the variables are",
-                        names(facts.estimated_states), facts.estimated_states.size() == 1 ? "was" : "were");
-    if (facts.passive)
-      why += std::string(why.empty() ? "" : "; and ") +
-             "the system has no controls, so the data are a free response whose decay accumulates over periods "
-             "but is below the noise of one step when it is light";
-    const auto [window, how] = simulation_window(data, states, facts);
-    if (window < 2) {
-      choice.reason = fmt::format(
-          "one-step: the simulation criterion is called for ({}), but no window of 2 samples or more fits the "
-          "episodes ({})",
-          why, how);
-      return choice;
-    }
-    choice.criterion = FitCriterion::Simulation;
-    choice.window = window;
-    choice.reason = fmt::format("simulation over windows of {} samples ({}, {}): {}", window,
-                                seconds(window * facts.dt), how, why);
-    return choice;
-  }
+  // 1. Passive: simulation.
+  if (facts.passive)
+    return simulation_choice(data, states, facts,
+                             "the system has no controls, so the data are a free response whose decay accumulates over "
+                             "periods but is below the noise of one step when it is light");
 
-  // 2. Generalised forces, and the inverse-dynamics residual clearly less noisy per sample.
+  // 2. Generalised forces, and accelerations the filter estimates well: inverse dynamics.
+  const bool estimated = !facts.estimated_states.empty();
+  const std::string estimated_why =
+      estimated ? fmt::format("{} {} estimated from other states (e.g. by the import)", names(facts.estimated_states),
+                              facts.estimated_states.size() == 1 ? "was" : "were")
+                : std::string();
+  const std::string one_step_bias = "a one-step fit regresses on them: biased, as errors in the variables are";
   facts.forces_checked = true;
   facts.not_forces = why_not_forces(*dynamics, coordinates, data);
   if (!facts.not_forces.empty()) {
+    if (estimated)
+      return simulation_choice(data, states, facts,
+                               fmt::format("{}, and {}; {}, so the inverse-dynamics residual is not the generalised "
+                                           "force the model misses",
+                                           estimated_why, one_step_bias, facts.not_forces));
     choice.reason = fmt::format("one-step: the velocities are measured and the system is driven, but {}, so the "
                                 "inverse-dynamics residual is not the generalised force the model misses",
                                 facts.not_forces);
@@ -409,18 +425,28 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
   for (const GeneralisedCoordinate& c : coordinates) {
     if (window == 0) break;
     const StateRatio r = state_ratio(*dynamics, data, own, c.velocity, facts.dt, window);
+    const std::string name = data.system.states[static_cast<std::size_t>(c.velocity)].name;
     if (r.ratio < facts.ratio || facts.ratio_state.empty()) {
       facts.ratio = r.ratio;
-      facts.ratio_state = data.system.states[static_cast<std::size_t>(c.velocity)].name;
+      facts.ratio_state = name;
       facts.acceleration_window = r.window;
       facts.control_error = r.control_error;
       facts.smear_error = r.smear_error;
     }
+    if (r.misfit > facts.misfit || facts.misfit_state.empty()) {
+      facts.misfit = r.misfit;
+      facts.misfit_state = name;
+    }
   }
   if (facts.acceleration_window == 0) {
     facts.ratio = 0.0;
-    choice.reason = fmt::format("one-step: every episode is shorter than the {} samples an acceleration estimate needs",
-                                shortest_differentiable_segment(2));
+    facts.misfit = 0.0;
+    const std::string too_short = fmt::format(
+        "every episode is shorter than the {} samples an acceleration estimate needs", shortest_differentiable_segment(2));
+    if (estimated)
+      return simulation_choice(data, states, facts,
+                               fmt::format("{}, and {}; {}", estimated_why, one_step_bias, too_short));
+    choice.reason = "one-step: " + too_short;
     return choice;
   }
   const std::string measured = fmt::format(
@@ -428,6 +454,25 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
       "the window, {:.0f}% from not knowing how the controls are held",
       facts.ratio_state, facts.acceleration_window, 1.0 / facts.dt, 100.0 * facts.smear_error * facts.smear_error,
       100.0 * facts.control_error * facts.control_error);
+  const std::string misfit = fmt::format(
+      "the filter's misfit on the model (the motion within the acceleration window of {} samples and the controls' "
+      "hold) is {:.2g}% of the force the controls apply on {} (at most {:g}%)",
+      facts.acceleration_window, 100.0 * facts.misfit, facts.misfit_state, 100.0 * kFilterMisfit);
+  if (estimated) {
+    if (facts.misfit <= kFilterMisfit) {
+      choice.criterion = FitCriterion::InverseDynamics;
+      choice.instruments = true;
+      choice.reason = fmt::format(
+          "inverse-dynamics in its instrumental-variable form (IDIM-IV): the controls are generalised forces, {}, "
+          "and {}; the estimates' noise is filtered, so the bias it gives least squares cannot be bounded from the "
+          "data, and the instruments, the model simulated with the measured controls, do not share it",
+          estimated_why, misfit);
+      return choice;
+    }
+    return simulation_choice(data, states, facts,
+                             fmt::format("{}, and {}; the controls are generalised forces, but {}", estimated_why,
+                                         one_step_bias, misfit));
+  }
   if (facts.ratio >= kInverseDynamicsRatio) {
     choice.criterion = FitCriterion::InverseDynamics;
     for (const GeneralisedCoordinate& c : coordinates) {

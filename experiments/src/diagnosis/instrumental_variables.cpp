@@ -102,12 +102,17 @@ FitContext instrument_context(const FitContext& context) {
   return c;
 }
 
-Matrix instrument_basis(Matrix Z, const Instruments& instruments, const std::vector<int>& rows) {
-  if (rows.empty() || Z.cols() == 0) return {};
+void zero_uninstrumented(Matrix& Z, const Instruments& instruments, const std::vector<int>& rows) {
+  if (rows.empty()) return;
   const Eigen::Index k = Z.rows() / static_cast<Eigen::Index>(rows.size());
   for (std::size_t t = 0; t < rows.size(); ++t)
     if (!instruments.instrumented[static_cast<std::size_t>(rows[t])])
       Z.middleRows(static_cast<Eigen::Index>(t) * k, k).setZero();
+}
+
+Matrix instrument_basis(Matrix Z, const Instruments& instruments, const std::vector<int>& rows) {
+  if (rows.empty() || Z.cols() == 0) return {};
+  zero_uninstrumented(Z, instruments, rows);
   if (!Z.allFinite()) return {};
   const Eigen::ColPivHouseholderQR<Matrix> qr(Z);
   if (qr.rank() < Z.cols()) return {};

@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include <Eigen/Dense>
 
 #include "gpilqg/core/fork_join.hpp"
 #include "gpilqg/experiments/diagnosis/affine_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
+#include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -61,6 +64,11 @@ LinearisedFits::LinearisedFits(const FitContext& c, const std::vector<EffectFit>
   ModelSpec base = c.model;
   for (const RefitEffect& r : refit) base = base.with(*r.effect, r.start);
   const Split r0 = residual_split(base, c, train, heldout);
+  const InverseDynamicsCriterion* criterion = c.criterion->inverse_dynamics();
+  instrumented_ = criterion != nullptr && criterion->instruments() != nullptr;
+  const std::optional<FitContext> at_instruments =
+      instrumented_ ? std::optional<FitContext>(instrument_context(c)) : std::nullopt;
+  const Vector r_instruments = instrumented_ ? weighted_residual_of(base, *at_instruments, train) : Vector();
 
   // Candidates first, then the refitted effects; each block of columns computed on its own.
   for (const EffectFit& f : fits) {
@@ -76,16 +84,13 @@ LinearisedFits::LinearisedFits(const FitContext& c, const std::vector<EffectFit>
   }
   const Eigen::Index P = offset_.back() + refit_columns_;
   Matrix JT = Matrix::Zero(r0.train.size(), P), JH = Matrix::Zero(r0.heldout.size(), P);
+  if (instrumented_) ZT_ = Matrix::Zero(r0.train.size(), P);
   std::atomic<std::size_t> next{0};
   ForkJoin workers;
   workers.run(std::max(1, std::min<int>(threads, static_cast<int>(blocks_.size()))), [&](int, int) {
-    for (std::size_t b = next++; b < blocks_.size(); b = next++) {
-      if (!blocks_[b].usable) continue;
-      auto [T, H] = columns(base, r0, blocks_[b].effect, blocks_[b].theta0, &blocks_[b].fitted, c, train, heldout);
-      if (!T.allFinite() || !H.allFinite()) continue;
-      JT.middleCols(first_column(b), T.cols()) = T;
-      JH.middleCols(first_column(b), H.cols()) = H;
-    }
+    for (std::size_t b = next++; b < blocks_.size(); b = next++)
+      compute_block(b, base, c, train, heldout, r0.train, r0.heldout, at_instruments ? &*at_instruments : nullptr,
+                    r_instruments, JT, JH);
   });
   accumulate(c, train, JT, JH, r0.train, r0.heldout);
   if (keep_columns_) {
@@ -93,7 +98,36 @@ LinearisedFits::LinearisedFits(const FitContext& c, const std::vector<EffectFit>
     JH_ = std::move(JH);
     r0_train_ = r0.train;
     r0_heldout_ = r0.heldout;
+    r0_instruments_ = r_instruments;
   }
+}
+
+void LinearisedFits::compute_block(std::size_t b, const ModelSpec& base, const FitContext& c,
+                                   const std::vector<int>& train, const std::vector<int>& heldout, const Vector& r_train,
+                                   const Vector& r_heldout, const FitContext* at_instruments,
+                                   const Vector& r_instruments, Matrix& JT, Matrix& JH) {
+  const Block& block = blocks_[b];
+  const Eigen::Index first = first_column(b), p = static_cast<Eigen::Index>(block.effect.parameters.size());
+  const auto clear = [&] {
+    JT.middleCols(first, p).setZero();
+    JH.middleCols(first, p).setZero();
+    if (instrumented_) ZT_.middleCols(first, p).setZero();
+  };
+  clear();
+  if (!block.usable) return;
+  auto [T, H] = columns(base, {r_train, r_heldout}, block.effect, block.theta0, &block.fitted, c, train, heldout);
+  if (!T.allFinite() || !H.allFinite()) return;
+  if (at_instruments != nullptr) {
+    // The same column at the simulated states, on the training rows only (the fits use no other).
+    Matrix Z = columns(base, {r_instruments, Vector()}, block.effect, block.theta0, &block.fitted, *at_instruments,
+                       train, {})
+                   .first;
+    zero_uninstrumented(Z, *c.criterion->inverse_dynamics()->instruments(), train);
+    if (!Z.allFinite()) return;
+    ZT_.middleCols(first, p) = Z;
+  }
+  JT.middleCols(first, p) = T;
+  JH.middleCols(first, p) = H;
 }
 
 Eigen::Index LinearisedFits::first_column(std::size_t block) const {
@@ -111,6 +145,8 @@ void LinearisedFits::accumulate(const FitContext& c, const std::vector<int>& tra
   cross_heldout_ = JH.transpose() * r_heldout;
   base_heldout_ = r_heldout.squaredNorm();
   base_train_ = r_train.squaredNorm();
+  fit_gram_train_ = instrumented_ ? Matrix(ZT_.transpose() * JT) : gram_train_;
+  fit_cross_train_ = instrumented_ ? Vector(ZT_.transpose() * r_train) : cross_train_;
 
   // The screening folds: the training episodes dealt in turn into K = min(5, episodes) folds.
   fold_gram_.clear();
@@ -118,6 +154,8 @@ void LinearisedFits::accumulate(const FitContext& c, const std::vector<int>& tra
   fold_base_.clear();
   rest_gram_.clear();
   rest_cross_.clear();
+  rest_fit_gram_.clear();
+  rest_fit_cross_.clear();
   std::vector<int> episodes;
   for (int r : train) {
     const int e = c.data->episode[static_cast<std::size_t>(r)];
@@ -129,6 +167,8 @@ void LinearisedFits::accumulate(const FitContext& c, const std::vector<int>& tra
   fold_gram_.assign(static_cast<std::size_t>(K), Matrix::Zero(P, P));
   fold_cross_.assign(static_cast<std::size_t>(K), Vector::Zero(P));
   fold_base_.assign(static_cast<std::size_t>(K), 0.0);
+  std::vector<Matrix> fold_fit_gram(instrumented_ ? static_cast<std::size_t>(K) : 0, Matrix::Zero(P, P));
+  std::vector<Vector> fold_fit_cross(instrumented_ ? static_cast<std::size_t>(K) : 0, Vector::Zero(P));
   for (std::size_t k = 0; k < train.size(); ++k) {
     const int e = c.data->episode[static_cast<std::size_t>(train[k])];
     const auto f = static_cast<std::size_t>((std::find(episodes.begin(), episodes.end(), e) - episodes.begin()) % K);
@@ -137,10 +177,17 @@ void LinearisedFits::accumulate(const FitContext& c, const std::vector<int>& tra
     fold_gram_[f].noalias() += rows.transpose() * rows;
     fold_cross_[f].noalias() += rows.transpose() * r;
     fold_base_[f] += r.squaredNorm();
+    if (instrumented_) {
+      const auto z = ZT_.middleRows(static_cast<Eigen::Index>(k) * n, n);
+      fold_fit_gram[f].noalias() += z.transpose() * rows;
+      fold_fit_cross[f].noalias() += z.transpose() * r;
+    }
   }
   for (std::size_t f = 0; f < fold_gram_.size(); ++f) {
     rest_gram_.push_back(gram_train_ - fold_gram_[f]);
     rest_cross_.push_back(cross_train_ - fold_cross_[f]);
+    rest_fit_gram_.push_back(instrumented_ ? Matrix(fit_gram_train_ - fold_fit_gram[f]) : rest_gram_.back());
+    rest_fit_cross_.push_back(instrumented_ ? Vector(fit_cross_train_ - fold_fit_cross[f]) : rest_cross_.back());
   }
 }
 
@@ -155,13 +202,10 @@ void LinearisedFits::relinearise(int candidate, const FitContext& c) {
   for (std::size_t r = static_cast<std::size_t>(size()); r < blocks_.size(); ++r)
     base = base.with(blocks_[r].effect, blocks_[r].theta0);
   block.effect = find_candidate(c.model, names_[b]);
-  auto [T, H] = columns(base, {r0_train_, r0_heldout_}, block.effect, block.theta0, &block.fitted, c, train, heldout);
-  if (!T.allFinite() || !H.allFinite()) {
-    T.setZero();
-    H.setZero();
-  }
-  JT_.middleCols(first_column(b), T.cols()) = T;
-  JH_.middleCols(first_column(b), H.cols()) = H;
+  const std::optional<FitContext> at_instruments =
+      instrumented_ ? std::optional<FitContext>(instrument_context(c)) : std::nullopt;
+  compute_block(b, base, c, train, heldout, r0_train_, r0_heldout_, at_instruments ? &*at_instruments : nullptr,
+                r0_instruments_, JT_, JH_);
   accumulate(c, train, JT_, JH_, r0_train_, r0_heldout_);
 }
 
@@ -221,7 +265,7 @@ double LinearisedFits::left_of(const std::vector<Eigen::Index>& cols, const Matr
 }
 
 double LinearisedFits::left(const std::vector<int>& subset, const Matrix& gram, const Vector& cross, double base) const {
-  return left_of(columns_of(subset), gram_train_, cross_train_, gram, cross, base);
+  return left_of(columns_of(subset), fit_gram_train_, fit_cross_train_, gram, cross, base);
 }
 
 double LinearisedFits::screening_left(const std::vector<int>& subset) const {
@@ -235,7 +279,7 @@ std::vector<double> LinearisedFits::screening_folds(const std::vector<int>& subs
   const std::vector<Eigen::Index> cols = columns_of(subset);
   std::vector<double> out;
   for (std::size_t f = 0; f < fold_gram_.size(); ++f)
-    out.push_back(left_of(cols, rest_gram_[f], rest_cross_[f], fold_gram_[f], fold_cross_[f], fold_base_[f]));
+    out.push_back(left_of(cols, rest_fit_gram_[f], rest_fit_cross_[f], fold_gram_[f], fold_cross_[f], fold_base_[f]));
   return out;
 }
 

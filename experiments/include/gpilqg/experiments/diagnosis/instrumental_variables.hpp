@@ -73,6 +73,10 @@ std::shared_ptr<const Instruments> simulated_instruments(const FitContext& conte
 /// Throws std::invalid_argument when the context's criterion has no instruments.
 FitContext instrument_context(const FitContext& context);
 
+/// Z (stacked like the weighted regressor over `rows`, index t k + i) with the rows of the samples
+/// without an instrument set to zero.
+void zero_uninstrumented(Matrix& Z, const Instruments& instruments, const std::vector<int>& rows);
+
 /// Q, an orthonormal basis of the columns of Z (Z's rows stacked like the weighted regressor over
 /// `rows`, index t k + i), after zeroing the rows without an instrument. Empty when Z has a column of
 /// zeros or is rank-deficient (no instrument for a parameter): the caller falls back to least squares.

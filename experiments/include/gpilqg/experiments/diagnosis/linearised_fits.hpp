@@ -30,6 +30,18 @@
 ///
 /// what the fit on the other folds leaves on fold f, from the folds' Gram matrices (K small solves per
 /// subset). The held-out rows then judge only the few subsets refitted exactly.
+///
+/// With instruments (the inverse-dynamics criterion in its IV form, instrumental_variables.hpp) every
+/// fit above is the IV fit the exact refit makes: each column also has its instrument z_e, the same
+/// secant or tangent in the instrument context (the regressor at the simulated states, zero on rows
+/// without an instrument), and the fits solve Z' J theta = Z' r instead of J' J theta = J' r,
+///
+///   theta_S = (Z_T' J_T)^+ Z_T' r_T,   theta_{-f} = (Z_T' J_T - Z_f' J_f)^+ (Z_T' r_T - Z_f' r_f),
+///
+/// while what a fit leaves is still measured on the residual, with G and b as above. Least squares
+/// would screen on the bias the instruments remove: a regressor that holds the noise of the
+/// residual's own rows (an armature's acceleration, a delay's control) predicts that noise on any
+/// fold, so cross-validation alone cannot reject it.
 
 #include <string>
 #include <vector>
@@ -110,14 +122,29 @@ class LinearisedFits {
   std::vector<Matrix> rest_gram_;  ///< G_T - G_f: the other folds'
   std::vector<Vector> rest_cross_;
   std::vector<double> fold_base_;
+  /// The normal equations the fits solve (file comment): J' J and J' r (gram_train_, cross_train_, the
+  /// same objects) for least squares, Z' J and Z' r with instruments; over the training rows and over
+  /// the other folds of each fold.
+  Matrix fit_gram_train_;
+  Vector fit_cross_train_;
+  std::vector<Matrix> rest_fit_gram_;
+  std::vector<Vector> rest_fit_cross_;
+  bool instrumented_ = false;  ///< the criterion has instruments: ZT_ holds them
+  Matrix ZT_;                  ///< with instruments: the instrument columns on the training rows
+  Vector r0_instruments_;      ///< with instruments and keep_columns: the base residual at the instruments
   /// The first column of block `block`.
   Eigen::Index first_column(std::size_t block) const;
   /// Every Gram matrix, cross product and fold from the columns and the base residual.
   void accumulate(const FitContext& c, const std::vector<int>& train, const Matrix& JT, const Matrix& JH,
                   const Vector& r_train, const Vector& r_heldout);
+  /// Block `block`'s columns (on both row sets) and, with instruments, its instrument columns.
+  void compute_block(std::size_t block, const ModelSpec& base, const FitContext& c, const std::vector<int>& train,
+                     const std::vector<int>& heldout, const Vector& r_train, const Vector& r_heldout,
+                     const FitContext* at_instruments, const Vector& r_instruments, Matrix& JT, Matrix& JH);
   /// The columns of `subset` with the refitted effects'.
   std::vector<Eigen::Index> columns_of(const std::vector<int>& subset) const;
-  /// What the least-squares solution of (gram_fit, cross_fit) over `cols` leaves of (gram, cross, base).
+  /// What the solution theta of gram_fit theta = cross_fit over `cols` (minimum norm) leaves of
+  /// (gram, cross, base): base - 2 theta' cross + theta' gram theta.
   static double left_of(const std::vector<Eigen::Index>& cols, const Matrix& gram_fit, const Vector& cross_fit,
                         const Matrix& gram, const Vector& cross, double base);
   /// What the least-squares fit of `subset` (with the refitted effects) leaves of r'r, with the fit on
