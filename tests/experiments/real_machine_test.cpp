@@ -171,11 +171,10 @@ TEST(RealMachineCli, ClosedLoopDriveAtOneKilohertzFindsItsThreeFrictionTerms) {
 // constant of 35 N/V, viscous friction 200 N s/m, Coulomb 20 N, a constant -3 N, one record of 25 s.
 // The velocity is estimated by the import and the commands are generalised forces sampled fast
 // against the motion, so the defaults take the inverse-dynamics criterion in its instrumental-variable
-// form, as drives are identified (IDIM-IV); the simulation error, the choice before, gave a Coulomb
-// friction of 14 N [2.5, 26] and no constant here (partly explained). With the defaults the diagnosis
-// must name the three effects (viscous within 5%, Coulomb within 10%, the constant within 35%: it is
-// 1.5% of the force the loop applies), add no proxy, and its written model must leave on a second
-// record (a new trajectory) a held-out force residual within 2% of the world's own.
+// form, as drives are identified (IDIM-IV). With the defaults the diagnosis must name the three effects
+// (viscous within 5%, Coulomb within 10%, the constant within 35%: it is 1.5% of the force the loop
+// applies), add no proxy, and its written model must leave on a second record (a new trajectory) a
+// held-out force residual within 2% of the world's own.
 TEST(RealMachineCli, HeavyDriveWithEstimatedVelocitiesTakesInverseDynamicsAndPredictsASecondRecord) {
   const auto rig = test::DriveRig::heavy();
   const auto dir = test::temporary_dir("heavy_drive");
