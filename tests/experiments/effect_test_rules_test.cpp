@@ -97,6 +97,23 @@ TEST(EffectTest, AFitThatIsNotIdentifiableIsNotAFinding) {
   const auto result = test_effect(f, {});
   EXPECT_FALSE(result.accepted);
   EXPECT_NE(result.reason.find("not identifiable"), std::string::npos) << result.reason;
+  EXPECT_EQ(result.reason.find("the set of"), std::string::npos) << result.reason;
+}
+
+// A joint fit is identifiable as a whole or not at all, and the parameter at fault need not be the
+// lead's: the reason names the whole set, beside the fit's own text that names the parameter.
+TEST(EffectTest, ASetThatIsNotIdentifiableIsNamedAsTheSet) {
+  EffectFit set = passing_fit("param:slide.damping");
+  set.refitted.push_back({"external_force_y:carriage", {{"F", "N", 1.0}}, Vector::Zero(1), Vector::Zero(1),
+                          Vector::Zero(1), Vector::Zero(1), 0.0, Vector::Zero(1)});
+  set.identifiable = false;
+  set.not_identifiable = "the covariance of F = 0 N is not finite: the data do not see it there";
+  const auto result = test_effect(set, {});
+  EXPECT_FALSE(result.accepted);
+  EXPECT_NE(result.reason.find("the set of 'param:slide.damping', 'external_force_y:carriage' is not identifiable on "
+                               "these data: the covariance of F"),
+            std::string::npos)
+      << result.reason;
 }
 
 TEST(EffectTest, EveryNewMemberOfASetMustExcludeItsValueWithoutIt) {

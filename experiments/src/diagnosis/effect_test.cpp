@@ -36,7 +36,14 @@ EffectTestResult test_effect(const EffectFit& fit, const EffectTestThresholds& t
                              const std::vector<std::string>& already_in_model) {
   EffectTestResult result;
   if (!fit.identifiable) {
-    result.reason = fmt::format("'{}' is not identifiable on these data{}", fit.effect,
+    // A joint fit is identifiable as a whole or not at all: name the set, whose not_identifiable text
+    // names the parameter at fault (not necessarily the lead's).
+    std::string who = fmt::format("'{}'", fit.effect);
+    if (!fit.refitted.empty()) {
+      who = "the set of '" + fit.effect + "'";
+      for (const EffectValues& v : fit.refitted) who += ", '" + v.effect + "'";
+    }
+    result.reason = fmt::format("{} is not identifiable on these data{}", who,
                                 fit.not_identifiable.empty() ? std::string() : ": " + fit.not_identifiable);
     return result;
   }

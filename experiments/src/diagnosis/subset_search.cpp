@@ -56,7 +56,7 @@ std::vector<std::vector<int>> grown_subsets(const LinearisedFits& fits, const st
   std::vector<std::pair<double, std::vector<int>>> best;
   for (int c = 0; c < fits.size(); ++c) {
     if (std::find(base.begin(), base.end(), c) != base.end()) continue;
-    bool allowed = true;
+    bool allowed = !forbidden[static_cast<std::size_t>(c)][static_cast<std::size_t>(c)];
     for (int b : base) allowed = allowed && !forbidden[static_cast<std::size_t>(b)][static_cast<std::size_t>(c)];
     if (!allowed) continue;
     std::vector<int> grown = base;
@@ -89,7 +89,7 @@ std::vector<std::vector<int>> best_subsets(const LinearisedFits& fits, int k, in
   while (k <= n) {
     bool allowed = true;
     for (int a = 0; a < k && allowed; ++a)
-      for (int b = a + 1; b < k && allowed; ++b)
+      for (int b = a; b < k && allowed; ++b)
         allowed = !forbidden[static_cast<std::size_t>(subset[static_cast<std::size_t>(a)])]
                             [static_cast<std::size_t>(subset[static_cast<std::size_t>(b)])];
     if (allowed) {
@@ -132,8 +132,12 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
   const LinearisedFits fits(context, singles, present, o.threads);
   const auto n = static_cast<std::size_t>(fits.size());
   std::vector<std::vector<bool>> forbidden(n, std::vector<bool>(n, false));
+  // forbidden[a][b]: a and b never in one set (declared the same physics); forbidden[a][a]: a in no set
+  // (its fit alone is not identifiable: LinearisedFits gives it no columns, so a set holding it would
+  // screen as the set without it and carry a member the data do not see).
   for (std::size_t a = 0; a < n; ++a)
-    for (std::size_t b = 0; b < n; ++b) forbidden[a][b] = a != b && declared_same(*system, singles[a].effect, singles[b].effect);
+    for (std::size_t b = 0; b < n; ++b)
+      forbidden[a][b] = a == b ? !singles[a].identifiable : declared_same(*system, singles[a].effect, singles[b].effect);
 
   Selection S;
   S.method = SearchMethod::Subsets;
