@@ -62,6 +62,7 @@ echo "== building and running the test suite under ASan + UBSan (build-sanitize/
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGPILQG_SANITIZE=ON -DGPILQG_BUILD_TESTS=ON \
   -DGPILQG_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
   -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=8
-cmake --build build-sanitize -j"$jobs"
+# Only the test programs (target gpilqg_test_programs): the label unit runs nothing else.
+cmake --build build-sanitize -j"$jobs" --target gpilqg_test_programs
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j"$jobs" --timeout 900 -L unit
