@@ -19,6 +19,7 @@
 #include "free_decay_pendulum.hpp"
 #include "gpilqg/core/log_import.hpp"
 #include "gpilqg/core/raw_log.hpp"
+#include "gpilqg/core/savitzky_golay.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/data_info.hpp"
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
@@ -112,6 +113,35 @@ TEST(MotionPeriod, ASinusoidWithNoiseAndADriftingPositionAreMeasuredByTheirVeloc
   EXPECT_FALSE(p.still);
   EXPECT_NEAR(p.period, 0.37, 0.01 * 0.37);
   EXPECT_TRUE(motion_period(set, 3).still);
+}
+
+TEST(CriterionChoice, AVelocityTheImportEstimatedIsTimedOnItsPosition) {
+  // A free swing logged by a 4096-count encoder at 1 kHz, the velocity differentiated by the
+  // import's Savitzky-Golay filter (window 9, order 4): its noise is correlated over 9 samples, which
+  // the differences of the column do not see, so the velocity's own hysteresis band is too narrow.
+  // The period comes from the position: within 2% of the signal's P = 0.93 s (closed form).
+  const fs::path dir = test::temporary_dir("criterion_choice_encoder");
+  test::write_pendulum(dir / "pendulum.xml", 0.0);
+  const double period = 0.93, dt = 0.001, count = 2.0 * M_PI / 4096.0;
+  MeasurementSet set;
+  set.system = system_signature((dir / "pendulum.xml").string());
+  set.estimated_states = {"hinge_dot"};
+  Episode e;
+  e.t = Vector::LinSpaced(20001, 0.0, 20.0);
+  e.x = Matrix::Zero(e.t.size(), 2);
+  e.u = Matrix::Zero(e.t.size(), 0);
+  for (Eigen::Index i = 0; i < e.t.size(); ++i)
+    e.x(i, 0) = count * std::round(0.12 * std::exp(-0.02 * e.t(i)) * std::cos(2.0 * M_PI * e.t(i) / period) / count);
+  e.x.col(1) = SavitzkyGolayDerivative(9, 4).differentiate(e.x.col(0), dt);
+  set.episodes.push_back(e);
+  const MotionPeriod of_velocity = motion_period(set, 1);
+  EXPECT_LT(of_velocity.period, 0.5 * period) << "the case must trip the velocity's own band";
+  const CriterionChoice c = choose_criterion(set, preset((dir / "pendulum.xml").string()));
+  ASSERT_EQ(c.criterion, FitCriterion::Simulation) << c.reason;
+  EXPECT_EQ(c.facts.slowest_state, "hinge");
+  EXPECT_NEAR(c.facts.slowest_period, period, 0.02 * period);
+  std::printf("encoder pendulum: velocity's own period %.3f s, position's %.3f s (P = %.3f s)\n", of_velocity.period,
+              c.facts.slowest_period, period);
 }
 
 TEST(CriterionChoice, WindowCapsFollowTheEpisodesAndTheHeldOutBlocks) {

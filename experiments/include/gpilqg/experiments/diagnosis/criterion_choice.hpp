@@ -136,7 +136,12 @@
 ///    gap of W samples at the held-out blocks (heldout_blocks.hpp), at most (L - 2) / 4 for blocks of
 ///    L samples, so a training block between two held-out blocks keeps at least two windows;
 ///  - a velocity state that never leaves its noise band does not count; one that moves but is slower
-///    than every episode sets W to the cap.
+///    than every episode sets W to the cap;
+///  - a velocity `<q>_dot` estimated from its position (MeasurementSet::estimated_states) is timed on
+///    `<q>`: the derivative filter's noise is correlated over its window, which the hysteresis band
+///    (from the column's differences) does not see, while the position carries the sensor's white
+///    noise and the same oscillation. A position that drifts (no period within the episodes) leaves
+///    the velocity's own period.
 ///  When the cap is below 2 samples no window fits: one-step, with the reason saying so.
 ///
 /// Velocity states: those of the model's generalised coordinates, else the states named `<q>_dot`
