@@ -13,6 +13,7 @@
 
 #include "test_support.hpp"
 #include "diagnosis_support.hpp"
+#include "free_decay_pendulum.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
@@ -169,6 +170,17 @@ TEST(EffectTest, AnArmatureThatRunsAwayIsNotIdentifiable) {
       << armature->not_identifiable;
   EXPECT_GT(armature->estimate(0), diagnosis::kRunawayFactor * 2.0);  // beyond 100 carriage masses
   EXPECT_NEAR(armature->scale(0), 2.0, 1.0);                          // the carriage's 2 kg
+  // The carriage's mass, which the forces weigh, has a scale of its own 2 kg: the data can weigh it
+  // (here it runs away instead, 200 times heavier, as the alias of the weak motor).
+  const EffectFit* mass = nullptr;
+  for (const diagnosis::RankedEffect& g : r.ranking) {
+    if (g.fit.effect == "param:carriage.mass") mass = &g.fit;
+    for (const EffectFit& a : g.aliases)
+      if (a.effect == "param:carriage.mass") mass = &a;
+  }
+  ASSERT_NE(mass, nullptr);
+  EXPECT_EQ(mass->not_identifiable.find("cannot weigh"), std::string::npos) << mass->not_identifiable;
+  EXPECT_NEAR(mass->scale(0), 2.0, 1.0);
   // Never ahead of an identifiable fit, and never the verdict.
   bool seen_unidentifiable = false;
   for (const diagnosis::RankedEffect& g : r.ranking) {
@@ -180,6 +192,29 @@ TEST(EffectTest, AnArmatureThatRunsAwayIsNotIdentifiable) {
   const std::string& found = r.verdict.effect->effect;
   EXPECT_TRUE(found == "actuator_gain:drive" || found == "param:drive.gear") << r.verdict.reason;
   EXPECT_NEAR(r.verdict.effect->estimate(0), 0.005, 0.002) << found;
+}
+
+// A body's mass in a free swing: MuJoCo scales the body's inertia with its mass, so the motion does not
+// change at all and only rounding is left in the regressor. Its fit goes anywhere (the fit's own
+// interval is some 1e8 kg wide on a 1 kg bob) and would be ranked; a mass is also measured against its
+// own value, and one that the data cannot weigh is not identifiable.
+TEST(EffectTest, AMassTheDataCannotWeighIsNotIdentifiable) {
+  const std::filesystem::path dir = test::temporary_dir("mass_free_swing");
+  test::write_pendulum(dir / "damped.xml", test::kPendulumDamping);
+  test::write_pendulum(dir / "pendulum.xml", 0.0);
+  const MeasurementSet data = test::free_decay(dir / "damped.xml", 4, 11);
+  diagnosis::DiagnosisOptions o = test::fast_options((dir / "pendulum.xml").string());
+  const diagnosis::DiagnosisReport r = diagnosis::diagnose(data, o);
+  const EffectFit* mass = nullptr;
+  for (const diagnosis::RankedEffect& g : r.ranking)
+    if (g.fit.effect == "param:bob.mass") mass = &g.fit;
+  ASSERT_NE(mass, nullptr);
+  EXPECT_FALSE(mass->identifiable) << mass->estimate(0);
+  EXPECT_NE(mass->not_identifiable.find("cannot weigh"), std::string::npos) << mass->not_identifiable;
+  EXPECT_GT(mass->scale(0), diagnosis::kRunawayFactor * 1.0) << "the bob's 1 kg";
+  if (r.verdict.effect.has_value()) {
+    EXPECT_NE(r.verdict.effect->effect, "param:bob.mass");
+  }
 }
 
 // The scale of an effect on the data is what moves the predictions as much as the model does: for a

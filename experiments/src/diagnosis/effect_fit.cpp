@@ -504,8 +504,10 @@ Vector data_scales(const Matrix& J, const FitContext& c, const std::vector<int>&
   return scale;
 }
 
-/// Test 1 of effect_test.hpp on a finished fit: a covariance that is not finite, or a parameter
-/// further than kRunawayFactor times its scale from its value without the effect.
+/// Test 1 of effect_test.hpp on a finished fit: a covariance that is not finite, a quantity that must
+/// stay positive (a mass: lower bound above 0) whose scale on the data exceeds kRunawayFactor times its
+/// own value, or a parameter further than kRunawayFactor times its scale from its value without the
+/// effect.
 void check_identifiable(const EffectSet& set, const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high,
                         const Vector& null, EffectFit& fit) {
   for (Eigen::Index j = 0; j < theta_hat.size() && fit.identifiable; ++j) {
@@ -514,6 +516,12 @@ void check_identifiable(const EffectSet& set, const Vector& theta_hat, const Vec
       fit.identifiable = false;
       fit.not_identifiable = fmt::format("the covariance of {} = {:.4g} {} is not finite: the data do not see it there",
                                          spec.name, theta_hat(j), spec.unit);
+    } else if (spec.lower > 0.0 && null(j) > 0.0 && fit.scale(j) > kRunawayFactor * null(j)) {
+      fit.identifiable = false;
+      fit.not_identifiable = fmt::format(
+          "the data barely see {}: only a change of {:.3g} {}, {:.3g} times its value of {:.4g} {}, moves the predictions "
+          "as much as the model itself moves them; more than {:g} times is a quantity these data cannot weigh",
+          spec.name, fit.scale(j), spec.unit, fit.scale(j) / null(j), null(j), spec.unit, kRunawayFactor);
     } else if (std::abs(theta_hat(j) - null(j)) > kRunawayFactor * fit.scale(j)) {
       fit.identifiable = false;
       fit.not_identifiable =

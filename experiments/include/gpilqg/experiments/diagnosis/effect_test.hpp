@@ -12,7 +12,11 @@
 ///     effect than kRunawayFactor (100) times its scale on these data (EffectFit::scale). An
 ///     armature of 2.7e21 kg m^2 on a wrist, or a link of 318 kg on an arm of 3 kg links, is a fit
 ///     that ran away along a direction the data barely see; its z score and zero-width interval say
-///     nothing. Such fits are reported as not identifiable and never ranked.
+///     nothing. A quantity that must stay positive (a mass: its lower bound is above 0) is measured
+///     against its own value too: when only a change of more than kRunawayFactor times that value
+///     moves the predictions as much as the model does, the data cannot weigh it (a body's mass in a
+///     free swing, where MuJoCo scales the inertia with it and the motion does not change at all).
+///     Such fits are reported as not identifiable and never ranked.
 ///  2. **Its interval excludes the value without it.** The null hypothesis of an effect is the value
 ///     it has in the model it is added to (EffectFit::null_value: a force of 0, a gain of 1, the
 ///     model's own parameter, no delay). An effect whose 95% interval contains that value in every
