@@ -194,6 +194,27 @@ TEST(EffectTest, AnArmatureThatRunsAwayIsNotIdentifiable) {
   EXPECT_NEAR(r.verdict.effect->estimate(0), 0.005, 0.002) << found;
 }
 
+// The finite-difference probes of a fit stay within the parameter's physical range: an input delay
+// fitted to its largest value (50 steps) was probed at 50.005, which the library refuses, and the
+// whole diagnosis of a real 6-axis arm stopped there. At a bound the step is one-sided, inside it
+// central, and the width is the distance between the two points.
+TEST(EffectFit, TheDifferenceProbesStayWithinTheParametersRange) {
+  EffectParameter delay{"d", "steps", 1.0, 0.0, 50.0};
+  for (const double value : {50.0, 0.0, 20.0, 49.9999}) {
+    const Vector theta = Vector::Constant(1, value);
+    const diagnosis::DifferenceStep d = diagnosis::difference_step(delay, theta, 0);
+    EXPECT_GE(d.minus(0), delay.lower) << value;
+    EXPECT_LE(d.plus(0), delay.upper) << value;
+    EXPECT_GT(d.width, 0.0) << value;
+    EXPECT_DOUBLE_EQ(d.width, d.plus(0) - d.minus(0)) << value;
+  }
+  const diagnosis::DifferenceStep top = diagnosis::difference_step(delay, Vector::Constant(1, 50.0), 0);
+  EXPECT_EQ(top.plus(0), 50.0);
+  EXPECT_DOUBLE_EQ(top.minus(0), 50.0 - 1e-4 * 50.0);
+  const diagnosis::DifferenceStep inside = diagnosis::difference_step(delay, Vector::Constant(1, 20.0), 0);
+  EXPECT_DOUBLE_EQ(inside.plus(0) - 20.0, 20.0 - inside.minus(0));  // central
+}
+
 // A body's mass in a free swing: MuJoCo scales the body's inertia with its mass, so the motion does not
 // change at all and only rounding is left in the regressor. Its fit goes anywhere (the fit's own
 // interval is some 1e8 kg wide on a 1 kg bob) and would be ranked; a mass is also measured against its

@@ -375,13 +375,10 @@ std::pair<Vector, Vector> confidence_interval(const SetResidual& residual, const
 
 DifferenceStep difference_step(const EffectParameter& spec, const Vector& theta, Eigen::Index j) {
   const double h = 1e-4 * std::max(std::abs(theta(j)), spec.scale);
-  DifferenceStep d{theta, theta, 2.0 * h};
-  d.plus(j) += h;
-  d.minus(j) -= h;
-  if (d.minus(j) < spec.lower) {
-    d.minus(j) = theta(j);
-    d.width = h;
-  }
+  DifferenceStep d{theta, theta, 0.0};
+  d.plus(j) = std::min(theta(j) + h, std::max(spec.upper, theta(j)));
+  d.minus(j) = std::max(theta(j) - h, std::min(spec.lower, theta(j)));
+  d.width = d.plus(j) - d.minus(j);
   return d;
 }
 

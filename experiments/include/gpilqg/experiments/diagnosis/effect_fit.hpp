@@ -161,8 +161,9 @@ EffectFit led_by(EffectFit fit, const EffectValues& values);
 EffectValues own_values(const EffectFit& fit);
 
 /// The central-difference step of parameter j of theta (spec its parameter): theta -+ h e_j with
-/// h = 1e-4 max(|theta_j|, spec.scale), one-sided (theta itself as `minus`) when the lower point would
-/// leave the physical range. The derivative is (f(plus) - f(minus)) / width.
+/// h = 1e-4 max(|theta_j|, spec.scale), each point kept within the physical range [lower, upper]
+/// (one-sided, theta itself, when theta sits on a bound: an input delay fitted to its largest value
+/// is probed below it, never beyond). The derivative is (f(plus) - f(minus)) / width.
 struct DifferenceStep {
   Vector minus, plus;
   double width = 0.0;
