@@ -95,20 +95,21 @@ double chosen(const std::map<std::string, double>& values, std::initializer_list
   return std::nan("");
 }
 
-/// A rig's files as a user has them: its model, the world (the model with the rig's truth), and two
-/// records imported by `gpilqg data import` (the second a new trajectory of the same machine).
+/// A rig's files as a user has them: its model, the world (the model with the rig's truth), and
+/// `records` (1 or 2) records imported by `gpilqg data import` (the second a new trajectory of the same
+/// machine).
 struct DriveFiles {
   std::string model, world, first, second;
 };
 
-DriveFiles drive_files(const test::DriveRig& rig, const std::filesystem::path& dir, double seconds) {
+DriveFiles drive_files(const test::DriveRig& rig, const std::filesystem::path& dir, double seconds, int records) {
   DriveFiles files;
   const auto model = test::drive_model(test::source_dir(), dir, rig);
   const auto world = test::drive_world(model, dir, rig);
   const auto map = test::drive_map(dir);
   files.model = "'" + model.string() + "'";
   files.world = "'" + world.string() + "'";
-  for (int record = 0; record < 2; ++record) {
+  for (int record = 0; record < records; ++record) {
     const auto log = test::drive_log(world, dir, rig, seconds, 3 + static_cast<std::uint64_t>(record), record);
     const auto out = dir / fmt::format("drive_{}.h5", record);
     const auto r = test::run_cli("data import '" + log.string() + "' --system " + files.model + " --map '" + map.string() +
@@ -157,7 +158,7 @@ void expect_no_proxy(const std::map<std::string, double>& values, const test::Dr
 // the rig's).
 TEST(RealMachineCli, ClosedLoopDriveAtOneKilohertzFindsItsThreeFrictionTerms) {
   const auto rig = test::DriveRig::light();
-  const auto files = drive_files(rig, test::temporary_dir("ball_drive"), 12.0);
+  const auto files = drive_files(rig, test::temporary_dir("ball_drive"), 12.0, 1);
   const nlohmann::json report = diagnose_json("--system " + files.model + " --data " + files.first + " --auto");
   ASSERT_FALSE(report["heldout_blocks"].is_null());  // one record: held-out blocks
   const auto values = chosen_values(report);
@@ -179,7 +180,7 @@ TEST(RealMachineCli, ClosedLoopDriveAtOneKilohertzFindsItsThreeFrictionTerms) {
 TEST(RealMachineCli, HeavyDriveWithEstimatedVelocitiesTakesInverseDynamicsAndPredictsASecondRecord) {
   const auto rig = test::DriveRig::heavy();
   const auto dir = test::temporary_dir("heavy_drive");
-  const auto files = drive_files(rig, dir, 25.0);
+  const auto files = drive_files(rig, dir, 25.0, 2);
   const std::string written = "'" + (dir / "diagnosed.toml").string() + "'";
   const nlohmann::json report =
       diagnose_json("--system " + files.model + " --data " + files.first + " --auto --write-model " + written);

@@ -422,15 +422,19 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
       estimated ? fmt::format("{} {} estimated from other states (e.g. by the import)", names(facts.estimated_states),
                               facts.estimated_states.size() == 1 ? "was" : "were")
                 : std::string();
-  const std::string one_step_bias = "a one-step fit regresses on them: biased, as errors in the variables are";
+  // Rule 3: estimated velocities and no inverse dynamics, `because` says why not.
+  const auto estimated_simulation = [&](const std::string& because) {
+    return simulation_choice(data, states, facts,
+                             fmt::format("{}, and a one-step fit regresses on them: biased, as errors in the variables "
+                                         "are; {}",
+                                         estimated_why, because));
+  };
   facts.forces_checked = true;
   facts.not_forces = why_not_forces(*dynamics, coordinates, data);
   if (!facts.not_forces.empty()) {
     if (estimated)
-      return simulation_choice(data, states, facts,
-                               fmt::format("{}, and {}; {}, so the inverse-dynamics residual is not the generalised "
-                                           "force the model misses",
-                                           estimated_why, one_step_bias, facts.not_forces));
+      return estimated_simulation(fmt::format(
+          "{}, so the inverse-dynamics residual is not the generalised force the model misses", facts.not_forces));
     choice.reason = fmt::format("one-step: the velocities are measured and the system is driven, but {}, so the "
                                 "inverse-dynamics residual is not the generalised force the model misses",
                                 facts.not_forces);
@@ -465,9 +469,7 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
     facts.misfit = 0.0;
     const std::string too_short = fmt::format(
         "every episode is shorter than the {} samples an acceleration estimate needs", shortest_differentiable_segment(2));
-    if (estimated)
-      return simulation_choice(data, states, facts,
-                               fmt::format("{}, and {}; {}", estimated_why, one_step_bias, too_short));
+    if (estimated) return estimated_simulation(too_short);
     choice.reason = "one-step: " + too_short;
     return choice;
   }
@@ -491,9 +493,7 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
           estimated_why, misfit);
       return choice;
     }
-    return simulation_choice(data, states, facts,
-                             fmt::format("{}, and {}; the controls are generalised forces, but {}", estimated_why,
-                                         one_step_bias, misfit));
+    return estimated_simulation("the controls are generalised forces, but " + misfit);
   }
   if (facts.ratio >= kInverseDynamicsRatio) {
     choice.criterion = FitCriterion::InverseDynamics;
