@@ -16,20 +16,29 @@
 
 namespace gpilqg::test {
 
-/// A point-like bob of 1 kg on a 0.25 m rod about a hinge: I = 0.0626 kg m^2, omega_0 = 6.26 rad/s
-/// (period 1.0 s); damping b gives zeta = b / (2 I omega_0), 0.005 for b = 0.0039 N m s/rad.
-inline void write_pendulum(const std::filesystem::path& file, double damping) {
-  std::ofstream(file) << R"(<mujoco model="pendulum">
+/// One body on a hinge about y, integrated by RK4 without contacts: the MuJoCo file of both pendulums
+/// below. `body` is the body's name and `inertial` its <inertial> attributes.
+inline void write_hinge_model(const std::filesystem::path& file, const std::string& model, double timestep,
+                              const std::string& body, const std::string& joint, double damping,
+                              const std::string& inertial) {
+  std::ofstream(file) << "<mujoco model=\"" << model << R"(">
   <compiler angle="radian" inertiafromgeom="false"/>
-  <option timestep="0.01" gravity="0 0 -9.81" integrator="RK4"><flag contact="disable"/></option>
+  <option timestep=")" << timestep << R"(" gravity="0 0 -9.81" integrator="RK4"><flag contact="disable"/></option>
   <worldbody>
-    <body name="bob">
-      <joint name="hinge" type="hinge" axis="0 1 0" damping=")" << damping << R"("/>
-      <inertial pos="0 0 -0.25" mass="1" diaginertia="0.0001 0.0001 0.0001"/>
+    <body name=")" << body << R"(">
+      <joint name=")" << joint << R"(" type="hinge" axis="0 1 0" damping=")" << damping << R"("/>
+      <inertial )" << inertial << R"(/>
     </body>
   </worldbody>
 </mujoco>
 )";
+}
+
+/// A point-like bob of 1 kg on a 0.25 m rod about a hinge: I = 0.0626 kg m^2, omega_0 = 6.26 rad/s
+/// (period 1.0 s); damping b gives zeta = b / (2 I omega_0), 0.005 for b = 0.0039 N m s/rad.
+inline void write_pendulum(const std::filesystem::path& file, double damping) {
+  write_hinge_model(file, "pendulum", 0.01, "bob", "hinge", damping,
+                    R"(pos="0 0 -0.25" mass="1" diaginertia="0.0001 0.0001 0.0001")");
 }
 
 /// The pendulum's moment of inertia about the hinge [kg m^2] and its weight's lever: m g l [N m].
@@ -80,17 +89,8 @@ inline MeasurementSet free_decay(const std::filesystem::path& world_file, int ep
 /// b = 2.24e-4 N m s/rad of kRodDamping, an amplitude that falls by a third in 20 s. `damping` 0 is the
 /// user's model: the rod without its bearing's losses.
 inline void write_rod_pendulum(const std::filesystem::path& file, double damping) {
-  std::ofstream(file) << R"(<mujoco model="rod_pendulum">
-  <compiler angle="radian" inertiafromgeom="false"/>
-  <option timestep="0.001" gravity="0 0 -9.81" integrator="RK4"><flag contact="disable"/></option>
-  <worldbody>
-    <body name="rod">
-      <joint name="swing" type="hinge" axis="0 1 0" damping=")" << damping << R"("/>
-      <inertial pos="0 0 -0.15" mass="0.2" diaginertia="0.0015 0.0015 0.00001"/>
-    </body>
-  </worldbody>
-</mujoco>
-)";
+  write_hinge_model(file, "rod_pendulum", 0.001, "rod", "swing", damping,
+                    R"(pos="0 0 -0.15" mass="0.2" diaginertia="0.0015 0.0015 0.00001")");
 }
 
 inline constexpr double kRodDamping = 2.24e-4;  // N m s/rad
