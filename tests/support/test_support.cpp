@@ -132,6 +132,9 @@ std::string program_path() {
       ADD_FAILURE() << suite << "." << test->name() << " runs the gpilqg program, so its test suite's name must "
                     << "end in Cli (the ctest label cli, tests/CMakeLists.txt)";
   }
+  if (!std::filesystem::exists(GPILQG_CLI_PATH))
+    ADD_FAILURE() << GPILQG_CLI_PATH << " does not exist: the tests labelled cli run the gpilqg program, which the "
+                  << "default target builds (cmake --build <build folder>)";
   return GPILQG_CLI_PATH;
 }
 
