@@ -126,7 +126,7 @@ LibraryEffect recalibration_entry(std::string effect_name, const Parameter& para
   e.recalibrated = parameter.name;
   const double magnitude = std::abs(parameter.value);
   e.parameters = {{parameter.name, parameter.unit, std::max(magnitude, 1e-3), non_negative ? 0.0 : 1e-6 * magnitude,
-                   std::numeric_limits<double>::infinity()}};
+                   std::numeric_limits<double>::infinity(), !non_negative}};
   e.formula = "recalibrate " + parameter.name + " [" + parameter.unit + "]";
   e.linear = linear;
   return e;

@@ -185,6 +185,11 @@ TEST(Arm7StandIn, InverseDynamicsDiagnosisFitsEachFrictionAsTheProjectionOfItsJo
     ASSERT_NE(coulomb, fits.end()) << joint;
     const EffectFit& b = *viscous->second;
     const EffectFit& c = *coulomb->second;
+    // Under inverse dynamics a joint's friction enters its own joint's torque only: it is judged there
+    // (effect_test.hpp, test 3), and its share there is at least its share of all seven joints.
+    EXPECT_EQ(b.acts_on, std::vector<int>{j}) << joint;
+    EXPECT_EQ(c.acts_on, std::vector<int>{j}) << joint;
+    EXPECT_GE(diagnosis::heldout_share(c, c.acts_on).explained, c.explained) << joint;
     // The projections of the joint's true friction on each effect's regressor (the measured velocity,
     // as the fit uses it; the Coulomb term at the v0 the fit chose).
     const Vector qd = measured_qd.col(j);

@@ -2,7 +2,8 @@
 // to trip it: an interval that holds the value without the effect despite a large z score, a fit that
 // runs away along a direction the data barely see, a set with a member that is not needed, a negative
 // share printed as a number, the screening of the subset search against a refit on each fold, and a
-// single effect that explains much of a residual of two effects (partly explained).
+// single effect that explains much of a residual of two effects (partly explained), and a joint's
+// friction judged on the residual of the joint it acts on.
 
 #include <gtest/gtest.h>
 
@@ -213,6 +214,13 @@ TEST(EffectFit, TheDifferenceProbesStayWithinTheParametersRange) {
   EXPECT_DOUBLE_EQ(top.minus(0), 50.0 - 1e-4 * 50.0);
   const diagnosis::DifferenceStep inside = diagnosis::difference_step(delay, Vector::Constant(1, 20.0), 0);
   EXPECT_DOUBLE_EQ(inside.plus(0) - 20.0, 20.0 - inside.minus(0));  // central
+  // A range of one point (a parameter pinned by its bounds): no probe moves, and the derivative is 0,
+  // not 0/0.
+  const EffectParameter pinned{"d", "steps", 1.0, 3.0, 3.0};
+  const diagnosis::DifferenceStep fixed = diagnosis::difference_step(pinned, Vector::Constant(1, 3.0), 0);
+  EXPECT_EQ(fixed.plus(0), 3.0);
+  EXPECT_EQ(fixed.minus(0), 3.0);
+  EXPECT_EQ(fixed.inverse_width(), 0.0);
 }
 
 // A body's mass in a free swing: MuJoCo scales the body's inertia with its mass, so the motion does not
@@ -354,6 +362,54 @@ TEST(EffectTest, TwoFitsAreComparedBatchByBatchOnTheSameHeldOutRows) {
   // Fits of other rows (other batches) are not compared.
   b.heldout_batch_before(0) = 2.0;
   EXPECT_FALSE(compare_heldout(a, b).comparable);
+}
+
+// Inverse dynamics on a real arm: a joint whose torque sensor is quiet (weight 1 / sigma^2) carries a
+// large error of its own, and a friction on another joint removes most of that joint's torque residual
+// but under 1% of the whole. Closed form: two channels, eight batches; channel 0 has 100 per batch and
+// nothing removed, channel 1 has 1 per batch with 0.6 and 0.5 removed in turn. On channel 1 the share is
+// 0.55, the batch residuals d - R b are +-0.05, so the variance of the ratio is 8/7 * 8 * 0.0025 / 8^2
+// and the half-width t_{0.975, 7} times its root. The friction acts on channel 1 only: it is judged
+// there and accepted; an effect acting on both channels is judged on the whole and is not.
+TEST(EffectTest, AJointsFrictionIsJudgedOnTheResidualOfTheJointItActsOn) {
+  EffectFit f = passing_fit("joint_viscous_friction:joint_2");
+  constexpr int K = 8;
+  f.heldout_channel_before.resize(K, 2);
+  f.heldout_channel_reduction.resize(K, 2);
+  for (int b = 0; b < K; ++b) {
+    f.heldout_channel_before.row(b) << 100.0, 1.0;
+    f.heldout_channel_reduction.row(b) << 0.0, b % 2 == 0 ? 0.6 : 0.5;
+  }
+  const diagnosis::HeldoutShare whole = diagnosis::heldout_share(f, {});
+  EXPECT_NEAR(whole.explained, 4.4 / 808.0, 1e-15);
+  f.explained = whole.explained;
+  f.explained_ci = whole.explained_ci;
+  f.z_score = whole.z_score;
+  const diagnosis::HeldoutShare own = diagnosis::heldout_share(f, {1});
+  EXPECT_NEAR(own.explained, 0.55, 1e-15);
+  EXPECT_NEAR(own.explained_ci, 2.3646242510103 * std::sqrt(8.0 / 7.0 * 8.0 * 0.0025) / 8.0, 1e-4);  // t_{0.975, 7}
+  EXPECT_GT(own.z_score, 3.0);
+  EXPECT_THROW(diagnosis::heldout_share(f, {2}), std::invalid_argument);
+
+  f.acts_on = {1};
+  const diagnosis::EffectTestResult judged = test_effect(f, {});
+  EXPECT_TRUE(judged.accepted) << judged.reason;
+  f.acts_on = {0, 1};
+  const diagnosis::EffectTestResult diluted = test_effect(f, {});
+  EXPECT_FALSE(diluted.accepted);
+  EXPECT_NE(diluted.reason.find("removes 0.5%"), std::string::npos) << diluted.reason;
+
+  // In a set, what it adds: a member the model had, or one accepted before, does not count.
+  f.acts_on = {1};
+  EffectValues before = diagnosis::own_values(passing_fit("joint_viscous_friction:joint_1"));
+  before.acts_on = {0};
+  f.refitted = {before};
+  EXPECT_FALSE(test_effect(f, {}).accepted);
+  EXPECT_TRUE(test_effect(f, {}, {"joint_viscous_friction:joint_1"}).accepted);
+  const diagnosis::EffectTestResult step = test_effect(f, {}, {}, {"joint_viscous_friction:joint_1"});
+  EXPECT_TRUE(step.accepted) << step.reason;
+  const diagnosis::JudgedShare text = diagnosis::judged_share(f, {"joint_viscous_friction:joint_1"}, "the residual");
+  EXPECT_EQ(text.what, "the residual on the 1 of 2 channels the new members act on");
 }
 
 }  // namespace

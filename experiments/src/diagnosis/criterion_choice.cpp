@@ -55,16 +55,20 @@ std::vector<GeneralisedCoordinate> force_coordinates(const Dynamics& model) {
   return coordinates;
 }
 
+/// The state `<q>` whose velocity the state `<q>_dot` at `velocity` is by its name, -1 when there is none.
+int position_by_name(const SystemSignature& system, int velocity) {
+  const std::string& name = system.states[static_cast<std::size_t>(velocity)].name;
+  if (name.size() <= 4 || !name.ends_with("_dot")) return -1;
+  return index_of(system.states, name.substr(0, name.size() - 4));
+}
+
 /// The velocity states (file comment of the header): the coordinates', else `<q>_dot`, else all.
 std::vector<int> velocity_states(const std::vector<GeneralisedCoordinate>& coordinates, const SystemSignature& system) {
   std::vector<int> out;
   for (const GeneralisedCoordinate& c : coordinates) out.push_back(c.velocity);
   if (!out.empty()) return out;
-  for (int i = 0; i < static_cast<int>(system.states.size()); ++i) {
-    const std::string& name = system.states[static_cast<std::size_t>(i)].name;
-    if (name.size() > 4 && name.ends_with("_dot") && index_of(system.states, name.substr(0, name.size() - 4)) >= 0)
-      out.push_back(i);
-  }
+  for (int i = 0; i < static_cast<int>(system.states.size()); ++i)
+    if (position_by_name(system, i) >= 0) out.push_back(i);
   if (!out.empty()) return out;
   for (int i = 0; i < static_cast<int>(system.states.size()); ++i) out.push_back(i);
   return out;
@@ -308,18 +312,16 @@ std::string names(const std::vector<std::string>& list) { return fmt::format("{}
 /// position that drifts (no finite period) says nothing of the oscillation, and the velocity's own is
 /// kept.
 MotionPeriod velocity_period(const MeasurementSet& data, int velocity) {
-  const MotionPeriod own = motion_period(data, velocity);
-  const std::string& name = data.system.states[static_cast<std::size_t>(velocity)].name;
-  const bool estimated = std::find(data.estimated_states.begin(), data.estimated_states.end(), name) !=
-                         data.estimated_states.end();
-  if (!estimated || !name.ends_with("_dot")) return own;
-  const std::string position_name = name.substr(0, name.size() - 4);
-  const int position = index_of(data.system.states, position_name);
-  if (position < 0 || std::find(data.estimated_states.begin(), data.estimated_states.end(), position_name) !=
-                          data.estimated_states.end())
-    return own;
-  const MotionPeriod of_position = motion_period(data, position);
-  return !of_position.still && std::isfinite(of_position.period) ? of_position : own;
+  const auto estimated = [&](int state) {
+    const std::string& name = data.system.states[static_cast<std::size_t>(state)].name;
+    return std::find(data.estimated_states.begin(), data.estimated_states.end(), name) != data.estimated_states.end();
+  };
+  const int position = position_by_name(data.system, velocity);
+  if (position >= 0 && estimated(velocity) && !estimated(position)) {
+    const MotionPeriod of_position = motion_period(data, position);
+    if (!of_position.still && std::isfinite(of_position.period)) return of_position;
+  }
+  return motion_period(data, velocity);
 }
 
 /// W and the phrase that says how it was chosen (header: the window).

@@ -154,7 +154,7 @@ class SetResidual {
       for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) {
         const DifferenceStep d = difference_step(set_.parameter(j), theta, j);
         // The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
-        J.col(j) = (at(d.minus, rows) - at(d.plus, rows)) / d.width;
+        J.col(j) = (at(d.minus, rows) - at(d.plus, rows)) * d.inverse_width();
       }
     }
     if (!forces.empty())
@@ -268,9 +268,9 @@ void score_heldout(const SetResidual& residual, const Vector& theta, const FitCo
   const Vector sqrt_w = c.weights.cwiseSqrt();
   fit.heldout_rmse_before = Vector::Zero(n);
   fit.heldout_rmse_after = Vector::Zero(n);
-  // Batches of consecutive samples of one episode: sums of the reduction d and of the "before" term.
-  std::vector<double> d_batches, b_batches;
-  double d_total = 0.0, b_total = 0.0;
+  // Batches of consecutive samples of one episode: per channel, sums of the reduction d and of the
+  // "before" term.
+  std::vector<Vector> d_batches, b_batches;
   int previous_episode = -1, in_batch = 0;
   const int batch = heldout_batch_length(c, static_cast<int>(rows.size()));
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -278,40 +278,54 @@ void score_heldout(const SetResidual& residual, const Vector& theta, const FitCo
     const Vector rb = before.segment(seg, n), ra = after.segment(seg, n);
     fit.heldout_rmse_before += rb.cwiseQuotient(sqrt_w).cwiseAbs2();
     fit.heldout_rmse_after += ra.cwiseQuotient(sqrt_w).cwiseAbs2();
-    const double b = rb.squaredNorm(), d = b - ra.squaredNorm();
     const int episode = c.data->episode[static_cast<std::size_t>(rows[k])];
     if (episode != previous_episode || in_batch == batch) {
-      d_batches.push_back(0.0);
-      b_batches.push_back(0.0);
+      d_batches.push_back(Vector::Zero(n));
+      b_batches.push_back(Vector::Zero(n));
       in_batch = 0;
       previous_episode = episode;
     }
-    d_batches.back() += d;
-    b_batches.back() += b;
+    b_batches.back() += rb.cwiseAbs2();
+    d_batches.back() += rb.cwiseAbs2() - ra.cwiseAbs2();
     ++in_batch;
-    d_total += d;
-    b_total += b;
   }
   const double count = std::max<double>(1.0, static_cast<double>(rows.size()));
   fit.heldout_rmse_before = (fit.heldout_rmse_before / count).cwiseSqrt();
   fit.heldout_rmse_after = (fit.heldout_rmse_after / count).cwiseSqrt();
-  if (b_total <= 0.0) return;
-  fit.explained = d_total / b_total;
-  // Ratio estimator R = D / B: Var(R) ~ K / (K - 1) sum_b (d_b - R b_b)^2 / B^2.
-  const auto K = static_cast<double>(d_batches.size());
-  if (K < 2.0) return;
-  double spread = 0.0;
-  for (std::size_t b = 0; b < d_batches.size(); ++b) {
-    const double e = d_batches[b] - fit.explained * b_batches[b];
-    spread += e * e;
+  const auto K = static_cast<Eigen::Index>(b_batches.size());
+  fit.heldout_channel_before.resize(K, n);
+  fit.heldout_channel_reduction.resize(K, n);
+  for (Eigen::Index b = 0; b < K; ++b) {
+    fit.heldout_channel_before.row(b) = b_batches[static_cast<std::size_t>(b)].transpose();
+    fit.heldout_channel_reduction.row(b) = d_batches[static_cast<std::size_t>(b)].transpose();
   }
-  const double se = std::sqrt(K / (K - 1.0) * spread) / b_total;
-  fit.heldout_batch_before = Eigen::Map<const Vector>(b_batches.data(), static_cast<Eigen::Index>(b_batches.size()));
-  fit.heldout_batch_reduction = Eigen::Map<const Vector>(d_batches.data(), static_cast<Eigen::Index>(d_batches.size()));
-  // K batches: Student's t with K - 1 degrees of freedom, z its normal equivalent (student_t.hpp).
-  const int batches = static_cast<int>(d_batches.size());
-  fit.explained_ci = batch_half_width(se, batches);
-  fit.z_score = se > 0.0 ? normal_equivalent(fit.explained / se, batches) : (fit.explained > 0.0 ? 1e6 : 0.0);
+  if (K >= 2) {
+    fit.heldout_batch_before = fit.heldout_channel_before.rowwise().sum();
+    fit.heldout_batch_reduction = fit.heldout_channel_reduction.rowwise().sum();
+  }
+  // On every channel: the ratio estimator R = D / B (heldout_share).
+  const HeldoutShare share = heldout_share(fit, {});
+  fit.explained = share.explained;
+  fit.explained_ci = share.explained_ci;
+  fit.z_score = share.z_score;
+}
+
+/// EffectFit::acts_on of each effect of `set`, from the weighted regressor J over `rows` (c channels per
+/// row, one column per stacked parameter).
+std::vector<std::vector<int>> acting_channels(const EffectSet& set, const Matrix& J, Eigen::Index c) {
+  std::vector<std::vector<int>> out(set.effects.size());
+  if (c == 0 || J.rows() % c != 0) return out;
+  const Eigen::Index rows = J.rows() / c;
+  for (std::size_t e = 0; e < set.effects.size(); ++e) {
+    Vector energy = Vector::Zero(c);
+    for (Eigen::Index k = 0; k < rows; ++k)
+      for (Eigen::Index i = 0; i < c; ++i)
+        energy(i) += J.row(k * c + i).segment(set.offset[e], set.length(e)).squaredNorm();
+    const double largest = energy.allFinite() ? energy.maxCoeff() : 0.0;
+    for (Eigen::Index i = 0; i < c && largest > 0.0; ++i)
+      if (energy(i) > 1e-12 * largest) out[e].push_back(static_cast<int>(i));
+  }
+  return out;
 }
 
 /// The 95% interval at theta_hat (step 3): [low, high]. With instruments (Q, an orthonormal basis of
@@ -391,17 +405,47 @@ EffectFit led_by(EffectFit fit, const EffectValues& values) {
   fit.ci_high = values.ci_high;
   fit.smoothing = values.smoothing;
   fit.null_value = values.null_value;
+  fit.acts_on = values.acts_on;
   return fit;
 }
 
 EffectValues own_values(const EffectFit& fit) {
-  return {fit.effect, fit.parameters, fit.initial, fit.estimate, fit.ci_low, fit.ci_high, fit.smoothing, fit.null_value};
+  return {fit.effect,   fit.parameters, fit.initial,    fit.estimate, fit.ci_low,
+          fit.ci_high,  fit.smoothing,  fit.null_value, fit.acts_on};
+}
+
+HeldoutShare heldout_share(const EffectFit& fit, const std::vector<int>& channels) {
+  HeldoutShare share;
+  const Matrix& B = fit.heldout_channel_before;
+  const Matrix& D = fit.heldout_channel_reduction;
+  Vector b = Vector::Zero(B.rows()), d = Vector::Zero(B.rows());
+  if (channels.empty()) {
+    b = B.rowwise().sum();
+    d = D.rowwise().sum();
+  }
+  for (int i : channels) {
+    if (i < 0 || i >= B.cols()) throw std::invalid_argument("heldout_share: channel " + std::to_string(i) + " out of range");
+    b += B.col(i);
+    d += D.col(i);
+  }
+  const double before = b.sum();
+  if (!(before > 0.0)) return share;
+  share.explained = d.sum() / before;
+  const auto K = static_cast<double>(b.size());
+  if (K < 2.0) return share;
+  const double se = std::sqrt(K / (K - 1.0) * (d - share.explained * b).squaredNorm()) / before;
+  // K batches: Student's t with K - 1 degrees of freedom, z its normal equivalent (student_t.hpp).
+  const int batches = static_cast<int>(b.size());
+  share.explained_ci = batch_half_width(se, batches);
+  share.z_score = se > 0.0 ? normal_equivalent(share.explained / se, batches) : (share.explained > 0.0 ? 1e6 : 0.0);
+  return share;
 }
 
 namespace {
 
 EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& null, const Vector& theta_ls,
-                     const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high, EffectFit fit);
+                     const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high,
+                     const std::vector<std::vector<int>>& acts_on, EffectFit fit);
 
 /// S(theta), or +inf where the model diverges or does not accept theta (a mass of 0, say). With
 /// instruments (Q not empty, instrumental_variables.hpp) the IV objective |Q' r(theta)|^2.
@@ -502,7 +546,7 @@ Vector data_scales(const Matrix& J, const FitContext& c, const std::vector<int>&
 }
 
 /// Test 1 of effect_test.hpp on a finished fit: a covariance that is not finite, a quantity that must
-/// stay positive (a mass: lower bound above 0) whose scale on the data exceeds kRunawayFactor times its
+/// stay positive (a mass: EffectParameter::strictly_positive) whose scale on the data exceeds kRunawayFactor times its
 /// own value, or a parameter further than kRunawayFactor times its scale from its value without the
 /// effect.
 void check_identifiable(const EffectSet& set, const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high,
@@ -513,7 +557,7 @@ void check_identifiable(const EffectSet& set, const Vector& theta_hat, const Vec
       fit.identifiable = false;
       fit.not_identifiable = fmt::format("the covariance of {} = {:.4g} {} is not finite: the data do not see it there",
                                          spec.name, theta_hat(j), spec.unit);
-    } else if (spec.lower > 0.0 && null(j) > 0.0 && fit.scale(j) > kRunawayFactor * null(j)) {
+    } else if (spec.strictly_positive && null(j) > 0.0 && fit.scale(j) > kRunawayFactor * null(j)) {
       fit.identifiable = false;
       fit.not_identifiable = fmt::format(
           "the data barely see {}: only a change of {:.3g} {}, {:.3g} times its value of {:.4g} {}, moves the predictions "
@@ -550,6 +594,7 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
   const Matrix J = residual.regressor(initial, training);
   fit.regressor = J.col(0);
   fit.scale = data_scales(J, c, training, null);
+  const std::vector<std::vector<int>> acts_on = acting_channels(set, J, c.weights.size());
   // IDIM-IV: the instruments of the set, fixed at theta_0 (instrumental_variables.hpp).
   const Matrix Q = J.allFinite() ? instruments_of(set, initial, c, training) : Matrix();
   if (!(J.col(0).norm() > 0.0) || !J.allFinite()) {
@@ -583,19 +628,21 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
   if (residual.probed() && !residual.matches_at(theta_hat)) return fit_set(set, initial, c, false);
   // 4. Held-out scores; then each effect's slice.
   score_heldout(residual, theta_hat, c, fit);
-  return finish_fit(set, initial, null, theta_ls, theta_hat, ci_low, ci_high, std::move(fit));
+  return finish_fit(set, initial, null, theta_ls, theta_hat, ci_low, ci_high, acts_on, std::move(fit));
 }
 
 /// Each effect's slice of the stacked estimates into `fit` (the candidate) and fit.refitted (the others).
 EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& null, const Vector& theta_ls,
-                     const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high, EffectFit fit) {
+                     const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high,
+                     const std::vector<std::vector<int>>& acts_on, EffectFit fit) {
   const Vector scale = fit.scale;
   for (std::size_t e = 0; e < set.effects.size(); ++e) {
     const Eigen::Index at = set.offset[e], length = set.length(e);
     const auto& smoothing = set.effects[e]->smoothing;
     EffectValues values{set.effects[e]->name,          set.effects[e]->parameters,   initial.segment(at, length),
                         theta_hat.segment(at, length), ci_low.segment(at, length), ci_high.segment(at, length),
-                        smoothing ? smoothing->width : 0.0,                          null.segment(at, length)};
+                        smoothing ? smoothing->width : 0.0,                          null.segment(at, length),
+                        acts_on[e]};
     if (e == 0) {
       fit.effect = values.effect;
       fit.parameters = values.parameters;
@@ -606,6 +653,7 @@ EffectFit finish_fit(const EffectSet& set, const Vector& initial, const Vector& 
       fit.ci_high = values.ci_high;
       fit.smoothing = values.smoothing;
       fit.null_value = values.null_value;
+      fit.acts_on = values.acts_on;
       if (scale.size() == theta_hat.size()) fit.scale = scale.segment(at, length);
     } else {
       fit.refitted.push_back(std::move(values));
@@ -655,6 +703,7 @@ EffectFit score_effect(const LibraryEffect& effect, const VectorCRef& values, co
   fit.training_objective_before = weighted_model_residual(c, training).squaredNorm();
   const SetResidual residual(set, values, c, false);
   fit.training_objective_after = residual.at(values, training).squaredNorm();
+  fit.acts_on = acting_channels(set, residual.regressor(values, training), c.weights.size()).front();
   score_heldout(residual, values, c, fit);
   return fit;
 }

@@ -32,8 +32,30 @@ std::string interval_reason(const EffectValues& v) {
 
 }  // namespace
 
+JudgedShare judged_share(const EffectFit& fit, const std::vector<std::string>& known, const std::string& residual) {
+  std::vector<int> channels;
+  const auto add = [&](const std::string& name, const std::vector<int>& acts_on) {
+    if (!listed(known, name)) channels.insert(channels.end(), acts_on.begin(), acts_on.end());
+  };
+  add(fit.effect, fit.acts_on);
+  for (const EffectValues& v : fit.refitted) add(v.effect, v.acts_on);
+  std::sort(channels.begin(), channels.end());
+  channels.erase(std::unique(channels.begin(), channels.end()), channels.end());
+  const auto all = fit.heldout_channel_before.cols();
+  if (static_cast<Eigen::Index>(channels.size()) == all) channels.clear();
+  // On every channel the share is the fit's own (heldout_share of all channels, step 4).
+  JudgedShare out{channels.empty() ? HeldoutShare{fit.explained, fit.explained_ci, fit.z_score}
+                                   : heldout_share(fit, channels),
+                  residual};
+  if (!channels.empty())
+    out.what = fmt::format("{} on the {} of {} channels {} act{} on", residual, channels.size(), all,
+                           fit.refitted.empty() ? "it" : "the new members", fit.refitted.empty() ? "s" : "");
+  return out;
+}
+
 EffectTestResult test_effect(const EffectFit& fit, const EffectTestThresholds& t,
-                             const std::vector<std::string>& already_in_model) {
+                             const std::vector<std::string>& already_in_model,
+                             const std::vector<std::string>& accepted_before) {
   EffectTestResult result;
   if (!fit.identifiable) {
     // A joint fit is identifiable as a whole or not at all: name the set, whose not_identifiable text
@@ -54,10 +76,14 @@ EffectTestResult test_effect(const EffectFit& fit, const EffectTestThresholds& t
     result.reason = interval_reason(v);
     return result;
   }
-  if (fit.explained < t.min_explained || fit.z_score < t.min_z) {
+  std::vector<std::string> known = already_in_model;
+  known.insert(known.end(), accepted_before.begin(), accepted_before.end());
+  const JudgedShare judged = judged_share(fit, known, "the held-out residual");
+  const HeldoutShare& s = judged.share;
+  if (s.explained < t.min_explained || s.z_score < t.min_z) {
     result.reason = fmt::format("{}; a finding needs at least {:.0f}% and z >= {:g}",
-                                share_text(fit.explained, fit.explained_ci, fit.z_score, "the held-out residual"),
-                                100.0 * t.min_explained, t.min_z);
+                                share_text(s.explained, s.explained_ci, s.z_score, judged.what), 100.0 * t.min_explained,
+                                t.min_z);
     return result;
   }
   result.accepted = true;

@@ -49,8 +49,8 @@ std::pair<Matrix, Matrix> columns(const ModelSpec& base, const Split& r0, const 
     const DifferenceStep d = difference_step(effect.parameters[static_cast<std::size_t>(j)], theta0, j);
     const Split a = residual_split(base.with(effect, d.minus), c, train, heldout);
     const Split b = residual_split(base.with(effect, d.plus), c, train, heldout);
-    JT.col(j) = (a.train - b.train) / d.width;
-    JH.col(j) = (a.heldout - b.heldout) / d.width;
+    JT.col(j) = (a.train - b.train) * d.inverse_width();
+    JH.col(j) = (a.heldout - b.heldout) * d.inverse_width();
   }
   return {JT, JH};
 }

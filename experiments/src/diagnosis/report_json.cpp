@@ -73,6 +73,10 @@ json values_json(const EffectValues& v) {
 }
 
 json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
+  json acts_on = json::array();
+  for (int channel : f.acts_on)
+    if (channel >= 0 && channel < static_cast<int>(r.channel_names.size()))
+      acts_on.push_back(r.channel_names[static_cast<std::size_t>(channel)]);
   json ci = json::object();
   for (std::size_t i = 0; i < f.parameters.size(); ++i)
     ci[f.parameters[i].name] = {bound_json(f.ci_low(static_cast<Eigen::Index>(i))),
@@ -95,6 +99,7 @@ json fit_json(const EffectFit& f, const DiagnosisReport& r, int state) {
           {"null_value", f.null_value.size() == f.estimate.size() ? parameters_json(f, f.null_value) : json::object()},
           {"interval_holds_null", interval_contains_null(own_values(f))},
           {"scale", scale},
+          {"acts_on", acts_on},
           {"evaluations", f.evaluations},
           {"heldout_state", r.channel_names[static_cast<std::size_t>(state)]},
           {"heldout_rmse_before", f.heldout_rmse_before(state)},

@@ -264,6 +264,8 @@ void selection_section(const DiagnosisReport& r, std::string& out) {
   for (const RefitEffect& e : model_effects(r.model, candidates)) before.push_back(e.effect->name);
   for (const SelectionStep& step : r.selection->steps) {
     const EffectFit& f = step.fit;
+    // Judged on the channels of what the step adds (effect_test.hpp, test 3).
+    const JudgedShare judged = judged_share(f, before, "the held-out residual left");
     out += fmt::format("   step {}: + {}: {}\n", k++, f.effect, parameter_text(f, true));
     for (const EffectValues& v : f.refitted) {
       const bool had = std::find(before.begin(), before.end(), v.effect) != before.end();
@@ -274,7 +276,7 @@ void selection_section(const DiagnosisReport& r, std::string& out) {
     for (const std::string& name : step.removed)
       out += fmt::format("           removed {}\n", name);
     out += fmt::format("           {}; held-out rmse:",
-                       share_text(f.explained, f.explained_ci, f.z_score, "the held-out residual left"));
+                       share_text(judged.share.explained, judged.share.explained_ci, judged.share.z_score, judged.what));
     for (std::size_t i = 0; i < r.channel_names.size() && i < static_cast<std::size_t>(f.heldout_rmse_before.size()); ++i) {
       const auto ii = static_cast<Eigen::Index>(i);
       if (f.heldout_rmse_before(ii) > 1.05 * f.heldout_rmse_after(ii))

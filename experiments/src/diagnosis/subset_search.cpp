@@ -194,19 +194,24 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     std::vector<std::string> members{best.effect};
     for (const EffectValues& v : best.refitted) members.push_back(v.effect);
     const std::string names = fmt::format("{}", fmt::join(members, ", "));
-    const std::string left_text = "the held-out residual left";
+    // The share of what the accepted model leaves, on the channels the members it adds act on
+    // (effect_test.hpp, test 3).
+    const std::vector<std::string> in_m0 = names_of_effects(present);
+    std::vector<std::string> known = in_m0;
+    known.insert(known.end(), accepted.begin(), accepted.end());
+    const JudgedShare judged = judged_share(best, known, "the held-out residual left");
+    const HeldoutShare& share = judged.share;
     if (o.progress)
       o.progress(fmt::format("best subset of {}: {} {}", k, names,
-                             share_text(best.explained, best.explained_ci, best.z_score, left_text)));
+                             share_text(share.explained, share.explained_ci, share.z_score, judged.what)));
     // 3. Accepted when it is a finding against the accepted model (effect_test.hpp): identifiable,
     // every new member's interval excluding its value without it, a significant and not negligible share.
-    const std::vector<std::string> in_m0 = names_of_effects(present);
     const EffectTestThresholds thresholds{o.min_explained, o.min_z};
-    if (!best.identifiable || best.explained < o.min_explained || best.z_score < o.min_z) {
+    if (!best.identifiable || share.explained < o.min_explained || share.z_score < o.min_z) {
       last_rejection = fmt::format(
           "the best set of {} ({}) is not accepted: {}", k, names,
           best.identifiable ? fmt::format("it {}; a larger set needs at least {:.0f}% and z >= {:g}",
-                                          share_text(best.explained, best.explained_ci, best.z_score, left_text),
+                                          share_text(share.explained, share.explained_ci, share.z_score, judged.what),
                                           100.0 * o.min_explained, o.min_z)
                             : test_effect(best, thresholds, in_m0).reason);
       continue;
@@ -233,7 +238,7 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     std::sort(kept.begin(), kept.end());
     std::vector<std::string> before = accepted;
     std::sort(before.begin(), before.end());
-    const EffectTestResult finding = test_effect(best, thresholds, in_m0);
+    const EffectTestResult finding = test_effect(best, thresholds, in_m0, accepted);
     if (kept == before || !finding.accepted) {
       last_rejection = fmt::format(
           "the best set of {} ({}) comes to {} after dropping members whose intervals contain their values without "

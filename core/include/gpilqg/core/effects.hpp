@@ -40,6 +40,9 @@ struct EffectParameter {
   /// Physical bounds (a mass stays positive); infinite when the sign is free.
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
+  /// A quantity that cannot be zero (a mass, a length; `lower` is then above 0): its own value is the
+  /// yardstick of what the data can weigh (effect_test.hpp, test 1).
+  bool strictly_positive = false;
 };
 
 /// A generalised force Q(x, u; theta) with k_Q entries, in the components of the system's

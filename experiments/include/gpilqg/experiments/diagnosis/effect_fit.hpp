@@ -30,7 +30,9 @@
 ///    squared residual explained, 1 - S_after / S_before, with a 95% interval and a z score from batch
 ///    means of the per-sample reduction (batches of consecutive samples within an episode, so the
 ///    serial correlation of the residual does not inflate the significance): with K batches, Student's
-///    quantile on K - 1 degrees of freedom and z the normal equivalent of the studentised mean.
+///    quantile on K - 1 degrees of freedom and z the normal equivalent of the studentised mean. The
+///    batches are kept per channel, so the same share can be taken on some channels only
+///    (heldout_share): an effect is judged on the channels it acts on (effect_test.hpp, test 3).
 ///
 /// Inverse dynamics (FitCriterion::InverseDynamics). A force effect enters the generalised-force
 /// residual as r(theta) = r^0 - Q_e(theta), so for forces linear in their parameters the residual is
@@ -111,6 +113,8 @@ struct EffectValues {
   /// The value without the effect: its value in the model it is added to (a force 0, a gain 1, the
   /// model's parameter, no delay); the null hypothesis of its interval test (effect_test.hpp).
   Vector null_value = {};
+  /// The criterion's channels it acts on (EffectFit::acts_on).
+  std::vector<int> acts_on = {};
 };
 
 struct EffectFit {
@@ -143,6 +147,13 @@ struct EffectFit {
   /// of one context has the same batches, so two fits can be compared batch by batch
   /// (effect_test.hpp, compare_heldout).
   Vector heldout_batch_before, heldout_batch_reduction;
+  /// The same batches per channel (K x c); the two vectors above are their row sums.
+  Matrix heldout_channel_before, heldout_channel_reduction;
+  /// The criterion's channels this effect acts on: those where its columns of the weighted regressor
+  /// over the training rows are not zero (above 1e-12 of the largest channel's squared sum). Under
+  /// inverse dynamics a joint's friction acts on its own joint's torque only; under the one-step and
+  /// simulation criteria a force usually acts on every state through the inverse inertia.
+  std::vector<int> acts_on;
   Vector regressor;            ///< weighted J at theta_0 over the training rows (first parameter), for aliasing
   /// False when the data do not determine the fit: the effect does not change the predictions, its
   /// covariance is not finite, or a parameter of the set ran away (effect_test.hpp, test 1).
@@ -152,6 +163,19 @@ struct EffectFit {
   /// one effect alone. The scores above (objective, held-out RMSE, explained) are those of the set.
   std::vector<EffectValues> refitted;
 };
+
+/// A share of the held-out residual that a fit removes, with its 95% half-width and z score (step 4).
+struct HeldoutShare {
+  double explained = 0.0;
+  double explained_ci = 0.0;
+  double z_score = 0.0;
+};
+
+/// Step 4's share on the channels `channels` of the criterion (all of them when empty): the ratio
+/// estimator R = D / B of the batches' reductions and "before" terms summed over those channels, with
+/// Var(R) ~ K / (K - 1) sum_b (d_b - R b_b)^2 / B^2 and Student's quantile on K - 1 degrees of freedom.
+/// On every channel it is the fit's own explained, explained_ci and z_score.
+HeldoutShare heldout_share(const EffectFit& fit, const std::vector<int>& channels);
 
 /// `fit` with the values of `values` (one effect of its joint fit) as its own effect's: its name,
 /// parameters, start, estimate, interval and smoothing; the scores stay those of the joint fit.
@@ -163,10 +187,13 @@ EffectValues own_values(const EffectFit& fit);
 /// The central-difference step of parameter j of theta (spec its parameter): theta -+ h e_j with
 /// h = 1e-4 max(|theta_j|, spec.scale), each point kept within the physical range [lower, upper]
 /// (one-sided, theta itself, when theta sits on a bound: an input delay fitted to its largest value
-/// is probed below it, never beyond). The derivative is (f(plus) - f(minus)) / width.
+/// is probed below it, never beyond). The derivative is (f(plus) - f(minus)) / width, and 0 when the
+/// range is the single point theta_j (width 0: a parameter that cannot move).
 struct DifferenceStep {
   Vector minus, plus;
   double width = 0.0;
+  /// 1 / width, 0 when the width is 0: the derivative is (f(plus) - f(minus)) * inverse_width().
+  double inverse_width() const { return width > 0.0 ? 1.0 / width : 0.0; }
 };
 DifferenceStep difference_step(const EffectParameter& spec, const Vector& theta, Eigen::Index j);
 

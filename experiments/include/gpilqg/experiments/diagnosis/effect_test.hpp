@@ -12,7 +12,7 @@
 ///     effect than kRunawayFactor (100) times its scale on these data (EffectFit::scale). An
 ///     armature of 2.7e21 kg m^2 on a wrist, or a link of 318 kg on an arm of 3 kg links, is a fit
 ///     that ran away along a direction the data barely see; its z score and zero-width interval say
-///     nothing. A quantity that must stay positive (a mass: its lower bound is above 0) is measured
+///     nothing. A quantity that cannot be zero (a mass: EffectParameter::strictly_positive) is measured
 ///     against its own value too: when only a change of more than kRunawayFactor times that value
 ///     moves the predictions as much as the model does, the data cannot weigh it (a body's mass in a
 ///     free swing, where MuJoCo scales the inertia with it and the motion does not change at all).
@@ -22,8 +22,15 @@
 ///     model's own parameter, no delay). An effect whose 95% interval contains that value in every
 ///     parameter is not significant, whatever its held-out z score: the training data do not
 ///     distinguish it from its absence. For a set, every member the model does not have must pass.
-///  3. **It removes a large and significant share of the held-out residual:** explained >=
-///     min_explained with a batch-means z >= min_z (effect_fit.hpp, step 4).
+///  3. **It removes a large and significant share of the held-out residual where it acts:**
+///     explained >= min_explained with a batch-means z >= min_z (effect_fit.hpp, step 4), on the
+///     criterion's channels that the effects under test act on (EffectFit::acts_on). A joint's
+///     friction in the torque residual of a six-joint arm is judged on that joint's torque: on every
+///     joint it is diluted by the others' residuals, and where a joint whose torque sensor is quiet
+///     carries a large error of its own (weights 1 / sigma^2), every other joint's friction explained
+///     under 1% of a real arm's residual while removing most of its own joint's. Where an effect acts
+///     on every channel (a force under the one-step and simulation criteria, through the inverse
+///     inertia) the share is the fit's own explained.
 ///
 /// Test 3 is on the held-out rows, tests 1 and 2 on the training rows; together they guard against
 /// an effect that soaks up the training residual along a direction that happens to help on the
@@ -57,9 +64,20 @@ bool interval_contains_null(const EffectValues& v);
 
 /// Tests 1-3 on `fit` (a single effect, or the lead of a joint fit with its members in fit.refitted).
 /// Test 2 skips the members named in `already_in_model`: effects the model had before the search are
-/// refitted with the new ones, not tested.
+/// refitted with the new ones, not tested. Test 3 is on the channels of the members in neither
+/// `already_in_model` nor `accepted_before` (judged_share): a search step is judged on what it adds.
 EffectTestResult test_effect(const EffectFit& fit, const EffectTestThresholds& thresholds,
-                             const std::vector<std::string>& already_in_model = {});
+                             const std::vector<std::string>& already_in_model = {},
+                             const std::vector<std::string>& accepted_before = {});
+
+/// The share test 3 judges: heldout_share on the union of the acts_on of the members of `fit` not
+/// named in `known` (all channels when that union is empty), and "<what>" for share_text: "the
+/// held-out residual" on every channel, else "the held-out residual on the 2 of 6 channels it acts on".
+struct JudgedShare {
+  HeldoutShare share;
+  std::string what;
+};
+JudgedShare judged_share(const EffectFit& fit, const std::vector<std::string>& known, const std::string& residual);
 
 /// Two fits of one context compared on the same held-out batches: the difference of their explained
 /// shares, D_a / B - D_b / B = (D_a - D_b) / B, with the ratio estimator's batch-means variance
