@@ -251,6 +251,19 @@ TEST(Arm7StandInCli, TheDefaultsChooseInverseDynamicsAndFindTheDryFrictionOfEver
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json report = nlohmann::json::parse(r.out);
   EXPECT_EQ(report["criterion"]["name"], "inverse-dynamics") << report["criterion"].dump();
+  // IDIM-WLS: each joint's equations weighted by 1 / max(noise, what the model leaves)^2; the hidden
+  // friction leaves more than the torque sensor's noise on every joint.
+  const nlohmann::json& weights = report["criterion"]["weights"];
+  ASSERT_EQ(weights.size(), static_cast<std::size_t>(test::kArm7Joints)) << report["criterion"].dump();
+  for (int j = 0; j < test::kArm7Joints; ++j) {
+    const nlohmann::json& w = weights[static_cast<std::size_t>(j)];
+    const double noise = w["noise"].get<double>(), left = w["left"].get<double>();
+    std::printf("  %s: noise %.3g, left %.3g N m (hidden Coulomb %.3g N m)\n", w["channel"].get<std::string>().c_str(),
+                noise, left, log.truth.coulomb(j));
+    EXPECT_GT(left, noise) << w.dump();
+    EXPECT_GT(left, 0.5 * log.truth.coulomb(j)) << w.dump();
+    EXPECT_NEAR(w["weight"].get<double>() * left * left, 1.0, 1e-9) << w.dump();
+  }
   const nlohmann::json& verdict = report["verdict"];
   std::printf("diagnose --auto: %.1f s; verdict %s with %zu effects\n", seconds,
               verdict["status"].get<std::string>().c_str(), verdict["members"].size());

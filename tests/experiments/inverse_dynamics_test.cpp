@@ -690,6 +690,57 @@ const FitContext& friction_fit_context() {
   return context;
 }
 
+// IDIM-WLS: each joint's equations are weighted by 1 / sigma_i^2, sigma_i = max(noise_i, left_i), the
+// white noise of its residual and the rms the model as given leaves of it on the training rows. The same
+// record twice, with white noise of 1e-3 and 0.1 N m added to the shoulder's torque: weighted by the
+// noise alone, the quiet record would give the shoulder at least 9 times the weight of the loud one
+// (the quiet one's noise is mostly the acceleration estimate's, 0.02 N m), though its model (without
+// the hidden damping of 0.4 N m s/rad) is wrong by far more than either noise. By what the model
+// leaves, its weight hardly moves.
+TEST(InverseDynamicsWeights, AJointsWeightFollowsWhatTheModelLeavesNotHowQuietItsSensorIs) {
+  const HiddenFrictionWorld& w = hidden_friction_world();
+  struct Weights {
+    Vector weight, noise, left;
+  };
+  const auto weights_with_shoulder_noise = [&](double torque_noise) {
+    std::vector<Matrix> controls = w.controls;
+    std::mt19937 rng(3);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    for (Matrix& u : controls)
+      for (Eigen::Index t = 0; t < u.rows(); ++t) u(t, 0) += torque_noise * gauss(rng);
+    Transitions data = transitions_of(noisy_states(w, 11), controls, w.dt);
+    for (std::size_t t = 0; t < data.episode.size(); ++t) data.heldout[t] = data.episode[t] == 2;
+    FitContext base;
+    base.data = &data;
+    base.model = w.model;  // the shoulder's damping is missing, the elbow's friction is there
+    base.model.forces.push_back({"joint_coulomb_friction:elbow", Vector::Constant(1, kElbowFriction)});
+    base.model.smoothing["joint_coulomb_friction:elbow"] = kElbowSmoothing;
+    base.dt = w.dt;
+    const FitContext c = criterion_context(base, FitCriterion::InverseDynamics, 1);
+    const InverseDynamicsCriterion& criterion = *c.criterion->inverse_dynamics();
+    const std::vector<int> training = data.rows(false);
+    for (Eigen::Index i = 0; i < 2; ++i) {
+      double square = 0.0;
+      for (int t : training) square += c.residual(t, i) * c.residual(t, i);
+      const double left = std::sqrt(square / static_cast<double>(training.size()));
+      EXPECT_NEAR(criterion.lack()(i), left, 1e-12 * left);
+      const double sigma = std::max(criterion.noise()(i), left);
+      EXPECT_NEAR(c.weights(i) * sigma * sigma, 1.0, 1e-12);
+    }
+    std::printf("shoulder torque noise %.0e N m: noise [%.3g, %.3g], left [%.3g, %.3g] N m, weights [%.4g, %.4g]\n",
+                torque_noise, criterion.noise()(0), criterion.noise()(1), criterion.lack()(0), criterion.lack()(1),
+                c.weights(0), c.weights(1));
+    return Weights{c.weights, criterion.noise(), criterion.lack()};
+  };
+  const Weights quiet = weights_with_shoulder_noise(1e-3), loud = weights_with_shoulder_noise(0.1);
+  // The estimate sees the sensor's noise ...
+  EXPECT_GT(loud.noise(0), 0.8 * 0.1);
+  EXPECT_GT(loud.noise(0), 3.0 * quiet.noise(0));
+  // ... but the missing damping leaves far more of the shoulder's torque than either noise, and sets its weight.
+  EXPECT_GT(quiet.left(0), 3.0 * loud.noise(0));
+  EXPECT_NEAR(loud.weight(0) / quiet.weight(0), 1.0, 0.05);
+}
+
 // Each criterion is one object (criteria/criterion.hpp) that the fits take row by row and the report
 // and the starts of every fit take whole: its rows for a fit must be its residual, weighted, for any
 // model (here the arm with a damping it was not made for), under each of the three criteria, with the

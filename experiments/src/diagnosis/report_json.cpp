@@ -146,6 +146,18 @@ json instruments_json(const DiagnosisReport& r) {
           {"restarts", instruments->restarts}};
 }
 
+json channel_weights_json(const DiagnosisReport& r) {
+  const InverseDynamicsCriterion* criterion = r.criterion->inverse_dynamics();
+  if (criterion == nullptr || criterion->noise().size() != static_cast<Eigen::Index>(r.channel_names.size())) return nullptr;
+  json out = json::array();
+  for (std::size_t i = 0; i < r.channel_names.size(); ++i) {
+    const auto c = static_cast<Eigen::Index>(i);
+    out.push_back({{"channel", r.channel_names[i]}, {"noise", criterion->noise()(c)}, {"left", criterion->lack()(c)},
+                   {"weight", r.criterion_weights(c)}});
+  }
+  return out;
+}
+
 json whiteness_json(const DiagnosisReport& r) {
   const Whiteness& w = r.whiteness;
   json states = json::array();
@@ -302,6 +314,7 @@ nlohmann::json report_json(const DiagnosisReport& r) {
            {{"name", r.criterion->name()},
             {"window", r.criterion->window()},
             {"instruments", instruments_json(r)},
+            {"weights", channel_weights_json(r)},
             {"restarts", r.window_restarts},
             {"starts", r.criterion->starts().empty() ? json(nullptr) : json(r.criterion->starts())},
             {"chosen_by", r.criterion_reason.empty() ? "user" : "data"},

@@ -33,21 +33,30 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(F
   // The model's own force: the residual at zero acceleration is -W_v^-1 f_v.
   out->own_force_ = std::make_shared<const Matrix>(
       -generalised_force_residual(c.model, data, *out->filtered_controls_, Matrix::Zero(data.size(), k), rows));
-  // w_i = 1 / sigma_i^2 with sigma_i the white noise of component i's residual, from its repeated
-  // differences within each record (difference_noise_std): the noise of the torque and of the
-  // acceleration estimate, which a smooth missing force does not raise. Taken from the residual with
-  // the controls as measured: the filter turns their white noise into a smooth one that differences
-  // no longer see, and it scales every component's noise variance by the same |m|^2, so the weights'
-  // ratios, which are all a fit uses, are those of the unfiltered noise.
+  // IDIM-WLS (Gautier): w_i = 1 / sigma_i^2 with sigma_i^2 the larger of component i's white noise
+  // (noise_i, from its repeated differences within each record: the noise of the torque and of the
+  // acceleration estimate) and the mean square of its residual on the training rows (lack_i: what
+  // the model as given leaves of that joint's equations). Each joint's equations then count by how
+  // well the model can be expected to fit them, not by how quiet its sensor is: a joint whose sensor
+  // is quiet but whose model is wrong by far more does not drown the others. The noise is taken from
+  // the residual with the controls as measured: the filter turns their white noise into a smooth one
+  // that differences no longer see, and it scales every component's noise variance by the same |m|^2.
   const Matrix unfiltered = generalised_force_residual(c.model, data, applied_controls(data, c.model.input_delay),
                                                        *out->accelerations_, rows);
   const std::vector<RowSegment> segments = row_segments(data);
+  const std::vector<int> training = data.rows(false);
   c.weights.resize(k);
+  out->noise_ = Vector(k);
+  out->lack_ = Vector(k);
   for (Eigen::Index i = 0; i < k; ++i) {
     std::vector<Vector> pieces;
     for (const RowSegment& s : segments) pieces.push_back(unfiltered.col(i).segment(s.first, s.end - s.first));
     const double rms = std::sqrt(unfiltered.col(i).squaredNorm() / std::max<double>(1.0, data.size()));
-    const double sigma = std::max(difference_noise_std(pieces), 1e-12 * (1.0 + rms));
+    out->noise_(i) = std::max(difference_noise_std(pieces), 1e-12 * (1.0 + rms));
+    double square = 0.0;
+    for (int t : training) square += c.residual(t, i) * c.residual(t, i);
+    out->lack_(i) = std::sqrt(square / std::max<double>(1.0, static_cast<double>(training.size())));
+    const double sigma = std::max(out->noise_(i), out->lack_(i));
     c.weights(i) = 1.0 / (sigma * sigma);
   }
   return out;
@@ -133,6 +142,15 @@ std::string InverseDynamicsCriterion::description(double, int) const {
       "derivative of the measured velocities";
   if (window_ > 0)
     out += fmt::format(" (Savitzky-Golay window of {} samples, the controls seen through the same weights)", window_);
+  if (noise_.size() > 0) {
+    std::string noise, lack;
+    for (Eigen::Index i = 0; i < noise_.size(); ++i) {
+      noise += fmt::format("{}{:.3g}", i == 0 ? "" : ", ", noise_(i));
+      lack += fmt::format("{}{:.3g}", i == 0 ? "" : ", ", lack_(i));
+    }
+    out += fmt::format("\n   weights (IDIM-WLS): each force component by 1 / max(noise, rms left by the model as given)^2, "
+                       "noise [{}], left [{}]", noise, lack);
+  }
   if (instruments_)
     out += fmt::format("\n   instrumental variables (IDIM-IV): instruments from the model simulated over windows of {} "
                        "samples from measured states, {} of {} rows instrumented{}",

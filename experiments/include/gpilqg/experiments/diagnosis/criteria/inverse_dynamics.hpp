@@ -26,10 +26,12 @@ struct Instruments;  // instrumental_variables.hpp
 class InverseDynamicsCriterion final : public Criterion {
  public:
   /// Estimates the accelerations on c.data and sets c.residual (N x k) to the force residual of
-  /// c.model and c.weights to 1 / sigma_i^2, sigma_i the white noise of component i's residual (its
-  /// repeated differences within each record, with the controls as applied: what a smooth missing
-  /// force does not raise). Throws std::invalid_argument on a system without a generalised-force map
-  /// or records too short for the estimate.
+  /// c.model and c.weights to the IDIM-WLS weights 1 / sigma_i^2 (Gautier), sigma_i = max(noise_i,
+  /// lack_i): noise_i the white noise of component i's residual (its repeated differences within each
+  /// record, with the controls as applied: what a smooth missing force does not raise), lack_i the
+  /// rms of its residual on the training rows (what the model as given leaves of joint i's
+  /// equations). Throws std::invalid_argument on a system without a generalised-force map or records
+  /// too short for the estimate.
   static std::shared_ptr<const InverseDynamicsCriterion> make(FitContext& c);
 
   /// The criterion with the same accelerations and instruments simulated from c.model
@@ -49,6 +51,10 @@ class InverseDynamicsCriterion final : public Criterion {
   int reach() const { return reach_; }
   /// The one window of the acceleration estimate; 0 at the instruments (controls as applied).
   int acceleration_window() const { return window_; }
+  /// Per force component: the white noise of its residual and the rms of its residual on the
+  /// training rows, the two sides of its weight's sigma_i = max(noise_i, lack_i) (make).
+  const Vector& noise() const { return noise_; }
+  const Vector& lack() const { return lack_; }
   /// The instruments of the IV form, or null for least squares.
   const Instruments* instruments() const { return instruments_.get(); }
 
@@ -85,6 +91,7 @@ class InverseDynamicsCriterion final : public Criterion {
   std::shared_ptr<const Matrix> filtered_controls_;  ///< force_controls for the delay filtered_delay_
   double filtered_delay_ = 0.0;
   std::shared_ptr<const Instruments> instruments_;
+  Vector noise_, lack_;
 };
 
 }  // namespace gpilqg::diagnosis
