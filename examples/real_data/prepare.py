@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Prepare the two benchmark recordings for `gpilqg data import` (Python 3 standard library only).
+"""Prepare the benchmark recordings for `gpilqg data import` (Python 3 standard library only).
 
 gpilqg's import maps columns and units; it does not select rows, subtract means or combine columns.
 This script does the three things these recordings need, and nothing else:
@@ -11,10 +11,18 @@ This script does the three things these recordings need, and nothing else:
   pendulum   double_pendulum_freeswing_1kHz.csv -> double_pendulum_relative.csv
              adds q2 = phi2 - phi1 and q2_dot = phi2_dot - phi1_dot (the model's second joint is
              relative to the first); every other column is kept as it is.
+  tx40       tx40_mdh_modified.urdf MESHES -> tx40.urdf
+             the Staubli TX40's URDF with a <mujoco> element after <robot>: the mesh folder MESHES
+             (an absolute path), visual meshes discarded, boundinertia 1e-6 (link 6 has zero inertia,
+             which MuJoCo refuses for a moving body), the recording's step of 0.2 ms and contacts off
+             (the arm's links touch at its joints); nothing else is changed.
 
 usage: prepare.py silverbox SNLS80mV.csv OUT.csv [--samples N]
        prepare.py pendulum double_pendulum_freeswing_1kHz.csv OUT.csv
+       prepare.py tx40 tx40_mdh_modified.urdf MESHES OUT.urdf
 """
+import os
+import re
 import csv
 import sys
 
@@ -52,6 +60,19 @@ def pendulum(src, dst):
     print(f"{dst}: {len(rows)} rows, added q2 = phi2 - phi1, q2_dot = phi2_dot - phi1_dot")
 
 
+def tx40(src, meshes, dst):
+    with open(src) as f:
+        text = f.read()
+    robot = re.search(r"<robot\b[^>]*>", text)
+    if robot is None:
+        sys.exit(f"{src}: no <robot> element")
+    element = (f'<mujoco><compiler meshdir="{os.path.abspath(meshes)}" discardvisual="true" boundinertia="1e-6"/>'
+               '<option timestep="0.0002"><flag contact="disable"/></option></mujoco>')
+    with open(dst, "w") as f:
+        f.write(text[:robot.end()] + element + text[robot.end():])
+    print(f"{dst}: {src} with {element}")
+
+
 if __name__ == "__main__":
     args = sys.argv[1:]
     if len(args) >= 3 and args[0] == "silverbox":
@@ -59,5 +80,7 @@ if __name__ == "__main__":
         silverbox(args[1], args[2], n)
     elif len(args) == 3 and args[0] == "pendulum":
         pendulum(args[1], args[2])
+    elif len(args) == 4 and args[0] == "tx40":
+        tx40(args[1], args[2], args[3])
     else:
         sys.exit(__doc__)

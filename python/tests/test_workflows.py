@@ -256,7 +256,7 @@ def test_diagnose_simulation_criterion_equals_the_command_lines(tmp_path):
     assert status == 0, err
     expected = json.loads(out)
     report = gpilqg.diagnose("cartpole", data, criterion="simulation", window=20, horizons=[1], gp_points=50)
-    assert report["criterion"] == {"name": "simulation", "window": 20, "restarts": 0, "starts": "estimated", "instruments": None,
+    assert report["criterion"] == {"name": "simulation", "window": 20, "restarts": 0, "starts": "estimated", "instruments": None, "weights": None,
                                    "chosen_by": "user", "excluded": [], "reason": None} == expected["criterion"]
     assert report["ranking"] == expected["ranking"]
     # The default, --criterion auto: these data (held commands at 50 Hz) choose one step, and say why.

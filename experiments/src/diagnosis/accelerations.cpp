@@ -98,33 +98,55 @@ Vector acceleration_weights(const SavitzkyGolayDerivative& filter, int position,
   return m;
 }
 
-Matrix filtered_controls(const Transitions& data, const Matrix& u, int window, int order, ControlHold hold) {
-  if (u.rows() != data.size())
-    throw std::invalid_argument(
-        fmt::format("filtered controls: {} rows of controls for {} transitions; expected one per transition", u.rows(),
-                    data.size()));
+Matrix filtered_at(const Transitions& data, const Matrix& y, const std::vector<int>& rows, int window, int order,
+                   ControlHold hold) {
+  if (y.rows() != data.size())
+    throw std::invalid_argument(fmt::format(
+        "filtered signal: {} rows for {} transitions; expected one per transition", y.rows(), data.size()));
   const SavitzkyGolayDerivative filter(window, order);
   std::vector<Vector> weights;
   for (int p = 0; p < window; ++p) weights.push_back(acceleration_weights(filter, p, hold));
   const int h = window / 2;
-  Matrix out(u.rows(), u.cols());
-  for (const RowSegment& s : row_segments(data)) {
-    if (s.samples() < window)
+  // The segment of every row, and each segment's samples of every column: its rows' values and, for
+  // the last sample (x_next of its last row), the last row's value again.
+  const std::vector<RowSegment> segments = row_segments(data);
+  std::vector<int> segment_of(static_cast<std::size_t>(data.size()), -1);
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    if (segments[s].samples() < window)
       throw std::invalid_argument(fmt::format(
-          "filtered controls: episode {} (rows {} to {}) has {} samples; the window spans {}", s.episode, s.first,
-          s.end - 1, s.samples(), window));
-    const int rows = s.end - s.first;
-    for (int t = 0; t < rows; ++t) {
-      // The window of sample t: centred, or the first / last w samples near the ends.
-      const int start = std::clamp(t - h, 0, s.samples() - window);
-      const Vector& m = weights[static_cast<std::size_t>(t - start)];
-      auto row = out.row(s.first + t);
-      row.setZero();
-      for (int r = 0; r < window; ++r)  // the segment's last sample takes its last row's control
-        row += m(r) * u.row(s.first + std::min(start + r, rows - 1));
+          "filtered signal: episode {} (rows {} to {}) has {} samples; the window spans {}", segments[s].episode,
+          segments[s].first, segments[s].end - 1, segments[s].samples(), window));
+    for (int t = segments[s].first; t < segments[s].end; ++t) segment_of[static_cast<std::size_t>(t)] = static_cast<int>(s);
+  }
+  std::vector<Matrix> samples(segments.size());
+  Matrix out(static_cast<Eigen::Index>(rows.size()), y.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const int t = rows[i];
+    if (t < 0 || t >= data.size())
+      throw std::invalid_argument(fmt::format("filtered signal: row {}; the data have {} transitions", t, data.size()));
+    const auto s = static_cast<std::size_t>(segment_of[static_cast<std::size_t>(t)]);
+    const RowSegment& segment = segments[s];
+    Matrix& column_samples = samples[s];
+    if (column_samples.size() == 0) {
+      const int n = segment.end - segment.first;
+      column_samples.resize(n + 1, y.cols());
+      column_samples.topRows(n) = y.middleRows(segment.first, n);
+      column_samples.row(n) = y.row(segment.end - 1);
     }
+    // The window of sample t: centred, or the first / last w samples near the ends.
+    const int place = t - segment.first;
+    const int start = std::clamp(place - h, 0, segment.samples() - window);
+    const Vector& m = weights[static_cast<std::size_t>(place - start)];
+    for (Eigen::Index j = 0; j < y.cols(); ++j)
+      out(static_cast<Eigen::Index>(i), j) = m.dot(column_samples.col(j).segment(start, window));
   }
   return out;
+}
+
+Matrix filtered_controls(const Transitions& data, const Matrix& u, int window, int order, ControlHold hold) {
+  std::vector<int> rows(static_cast<std::size_t>(data.size()));
+  for (std::size_t t = 0; t < rows.size(); ++t) rows[t] = static_cast<int>(t);
+  return filtered_at(data, u, rows, window, order, hold);
 }
 
 }  // namespace gpilqg::diagnosis

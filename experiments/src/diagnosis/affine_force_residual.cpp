@@ -6,6 +6,7 @@
 
 #include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
+#include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -36,12 +37,16 @@ Matrix weighted_force_regressor(const ModelSpec& model, const std::vector<const 
   const auto workspace = owner.make_workspace();
   const InverseDynamicsCriterion* criterion = c.criterion->inverse_dynamics();
   if (criterion == nullptr) throw std::invalid_argument("weighted_force_regressor: the context is not inverse dynamics");
-  const Matrix u = criterion->force_controls(model, *c.data);
+  const Matrix u = applied_controls(*c.data, model.input_delay);
   const Vector sqrt_w = c.weights.cwiseSqrt();
   const Eigen::Index k = sqrt_w.size();
   Eigen::Index p = 0;
   for (const LibraryEffect* e : effects) p += static_cast<Eigen::Index>(e->parameters.size());
-  Matrix out(static_cast<Eigen::Index>(rows.size()) * k, p);
+  // The bases at every sample a window of `rows` reaches (all rows when the criterion filters), then
+  // seen as the residual sees the model's forces (InverseDynamicsCriterion::filtered).
+  const bool filtering = criterion->acceleration_window() > 0;
+  const std::vector<int> sampled = filtering ? all_rows(*c.data) : rows;
+  std::vector<Matrix> bases(static_cast<std::size_t>(p), Matrix(static_cast<Eigen::Index>(sampled.size()), k));
   // The unit parameter vectors e_j of each effect, made once rather than per row.
   std::vector<std::vector<Vector>> units;
   for (const LibraryEffect* e : effects) {
@@ -50,17 +55,23 @@ Matrix weighted_force_regressor(const ModelSpec& model, const std::vector<const 
     for (Eigen::Index j = 0; j < size; ++j) units.back().push_back(Vector::Unit(size, j));
   }
   Vector x(system->state_dim()), u_t(system->control_dim()), Q(k);
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    x = c.data->x.row(rows[i]).transpose();
-    u_t = u.row(rows[i]).transpose();
-    Eigen::Index column = 0;
+  for (std::size_t i = 0; i < sampled.size(); ++i) {
+    x = c.data->x.row(sampled[i]).transpose();
+    u_t = u.row(sampled[i]).transpose();
+    std::size_t column = 0;
     for (std::size_t e = 0; e < effects.size(); ++e) {
       for (const Vector& unit : units[e]) {  // g_j = Q_e(x, u; e_j), Q_e linear in theta
         Q.setZero();
         effects[e]->force->add_force(x, u_t, unit, Q, nullptr, nullptr, *workspace);
-        out.block(static_cast<Eigen::Index>(i) * k, column++, k, 1) = sqrt_w.cwiseProduct(Q);
+        bases[column++].row(static_cast<Eigen::Index>(i)) = Q.transpose();
       }
     }
+  }
+  Matrix out(static_cast<Eigen::Index>(rows.size()) * k, p);
+  for (std::size_t j = 0; j < bases.size(); ++j) {
+    const Matrix seen = filtering ? criterion->filtered(*c.data, bases[j], rows) : bases[j];
+    for (Eigen::Index i = 0; i < seen.rows(); ++i)
+      out.block(i * k, static_cast<Eigen::Index>(j), k, 1) = sqrt_w.cwiseProduct(seen.row(i).transpose());
   }
   return out;
 }

@@ -24,15 +24,14 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(F
   const AccelerationEstimate estimate = estimate_accelerations(data, components.velocity_states(), c.dt);
   out->accelerations_ = std::make_shared<const Matrix>(estimate.qdd);
   out->reach_ = estimate.window / 2;
-  // Parallel filtering: the controls seen through the acceleration estimate's weights (accelerations.hpp).
+  // Parallel filtering: the controls and the model's forces seen through the acceleration
+  // estimate's weights (accelerations.hpp, force_residual).
   out->window_ = estimate.window;
-  out->filtered_delay_ = c.model.input_delay;
-  out->filtered_controls_ = std::make_shared<const Matrix>(out->force_controls(c.model, data));
   const std::vector<int> rows = all_rows(data);
-  c.residual = generalised_force_residual(c.model, data, *out->filtered_controls_, *out->accelerations_, rows);
-  // The model's own force: the residual at zero acceleration is -W_v^-1 f_v.
-  out->own_force_ = std::make_shared<const Matrix>(
-      -generalised_force_residual(c.model, data, *out->filtered_controls_, Matrix::Zero(data.size(), k), rows));
+  const ForceResidualParts parts = out->force_residual_parts(c.model, data, rows);
+  c.residual = parts.inertial - parts.forces;
+  // The model's own force W_v^-1 f_v, as the residual sees it.
+  out->own_force_ = std::make_shared<const Matrix>(parts.forces);
   // IDIM-WLS (Gautier): w_i = 1 / sigma_i^2 with sigma_i^2 the larger of component i's white noise
   // (noise_i, from its repeated differences within each record: the noise of the torque and of the
   // acceleration estimate) and the mean square of its residual on the training rows (lack_i: what
@@ -72,7 +71,6 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::at_ins
   std::shared_ptr<InverseDynamicsCriterion> out(new InverseDynamicsCriterion(*this));
   if (instruments_) out->accelerations_ = instruments_->accelerations;
   out->window_ = 0;
-  out->filtered_controls_ = nullptr;
   out->instruments_ = nullptr;
   return out;
 }
@@ -81,21 +79,44 @@ std::string InverseDynamicsCriterion::name() const {
   return fit_criterion_name(kind()) + (instruments_ ? "-iv" : "");
 }
 
-Matrix InverseDynamicsCriterion::force_controls(const ModelSpec& model, const Transitions& data) const {
-  if (window_ == 0) return applied_controls(data, model.input_delay);
-  if (filtered_controls_ && filtered_delay_ == model.input_delay && filtered_controls_->rows() == data.size())
-    return *filtered_controls_;
-  return filtered_controls(data, applied_controls(data, model.input_delay), window_);
+InverseDynamicsCriterion::ForceResidualParts InverseDynamicsCriterion::force_residual_parts(
+    const ModelSpec& model, const Transitions& data, const std::vector<int>& rows) const {
+  const DynamicsPtr system = model.build();
+  const Matrix u = applied_controls(data, model.input_delay);
+  const auto k = accelerations_->cols();
+  ForceResidualParts parts;
+  const std::vector<int> all = all_rows(data);
+  // z_t = -W_v^-1 f_v(x_t, u_t), the residual at zero acceleration, at every row a window reaches.
+  const Matrix z = generalised_force_residual(*system, data, u, Matrix::Zero(data.size(), k), window_ > 0 ? all : rows);
+  // The residual is linear in the acceleration: M qdd_t = r_t(qdd_t) - r_t(0).
+  parts.inertial = generalised_force_residual(*system, data, u, *accelerations_, rows);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    parts.inertial.row(static_cast<Eigen::Index>(i)) -= z.row(window_ > 0 ? rows[i] : static_cast<int>(i));
+  parts.forces = window_ > 0 ? Matrix(-filtered_at(data, z, rows, window_)) : Matrix(-z);
+  return parts;
+}
+
+Matrix InverseDynamicsCriterion::force_residual(const ModelSpec& model, const Transitions& data,
+                                                const std::vector<int>& rows) const {
+  const ForceResidualParts parts = force_residual_parts(model, data, rows);
+  return parts.inertial - parts.forces;
+}
+
+Matrix InverseDynamicsCriterion::filtered(const Transitions& data, const Matrix& y, const std::vector<int>& rows) const {
+  if (window_ > 0) return filtered_at(data, y, rows, window_);
+  Matrix out(static_cast<Eigen::Index>(rows.size()), y.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = y.row(rows[i]);
+  return out;
 }
 
 Matrix InverseDynamicsCriterion::residual(const ModelSpec& model, const FitContext& c, int* diverged) const {
   if (diverged != nullptr) *diverged = 0;
-  return generalised_force_residual(model, *c.data, force_controls(model, *c.data), *accelerations_, all_rows(*c.data));
+  return force_residual(model, *c.data, all_rows(*c.data));
 }
 
 Vector InverseDynamicsCriterion::weighted_residual(const ModelSpec& model, const FitContext& c,
                                                    const std::vector<int>& rows, bool*) const {
-  const Matrix r = generalised_force_residual(model, *c.data, force_controls(model, *c.data), *accelerations_, rows);
+  const Matrix r = force_residual(model, *c.data, rows);
   const Vector sqrt_w = c.weights.cwiseSqrt();
   const auto k = static_cast<Eigen::Index>(sqrt_w.size());
   Vector out(static_cast<Eigen::Index>(rows.size()) * k);
@@ -141,7 +162,8 @@ std::string InverseDynamicsCriterion::description(double, int) const {
       "criterion: inverse dynamics, the generalised-force residual M(q) qdd - h(q, qdot, u) with qdd a zero-phase "
       "derivative of the measured velocities";
   if (window_ > 0)
-    out += fmt::format(" (Savitzky-Golay window of {} samples, the controls seen through the same weights)", window_);
+    out += fmt::format(" (Savitzky-Golay window of {} samples, the controls and the model's forces seen through the same "
+                       "weights)", window_);
   if (noise_.size() > 0) {
     std::string noise, lack;
     for (Eigen::Index i = 0; i < noise_.size(); ++i) {

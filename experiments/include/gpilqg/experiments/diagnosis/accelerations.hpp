@@ -93,6 +93,12 @@ Vector acceleration_weights(const SavitzkyGolayDerivative& filter, int position,
 Matrix filtered_controls(const Transitions& data, const Matrix& u, int window, int order = 2,
                          ControlHold hold = ControlHold::Continuous);
 
+/// The same for any signal sampled at the rows of `data` (`y`, N x c: controls, or the model's forces
+/// at the measured states), at the rows `rows` only (rows.size() x c, in their order). Throws
+/// std::invalid_argument as filtered_controls does, and for a row outside the data.
+Matrix filtered_at(const Transitions& data, const Matrix& y, const std::vector<int>& rows, int window, int order = 2,
+                   ControlHold hold = ControlHold::Continuous);
+
 /// The accelerations of every row of `data` from the state columns `velocity_states` (file comment),
 /// sampled at `dt`, with fits of degree `order`. Throws std::invalid_argument for a column outside the
 /// state, dt not finite and positive, rows whose times t are not dt apart within a segment (naming the

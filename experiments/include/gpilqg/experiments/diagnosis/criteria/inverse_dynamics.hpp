@@ -6,8 +6,12 @@
 ///   r_t = W_v(x_t)^-1 (qdd_t - f_v(x_t, u_t)),
 ///
 /// with qdd_t a zero-phase Savitzky-Golay derivative of the measured velocities, one window for every
-/// coordinate (accelerations.hpp), and the controls seen through the same weights (parallel
-/// filtering). Friction and offsets are linear and directly visible there, and an error in a torque
+/// coordinate (accelerations.hpp), and the model's whole generalised force W_v^-1 f_v (the controls,
+/// gravity, Coriolis, friction, every effect) seen through the same weights: parallel filtering
+/// (Gautier 1997), which filters the torques and every column of the observation matrix with one
+/// filter. The estimate is the window's mean acceleration; a force evaluated at the window's centre
+/// alone would be compared with it, and a friction that changes sign within the window would look
+/// like a smooth one as wide as the window (a Coulomb friction as a tanh of width |qdd| w dt / 2). Friction and offsets are linear and directly visible there, and an error in a torque
 /// is not divided by the joint's inertia; it needs measured velocities and controls that are
 /// generalised forces (generalised_force_residual.hpp).
 ///
@@ -58,10 +62,19 @@ class InverseDynamicsCriterion final : public Criterion {
   /// The instruments of the IV form, or null for least squares.
   const Instruments* instruments() const { return instruments_.get(); }
 
-  /// The controls of `model`'s force residual on `data`: applied with model.input_delay, seen through
-  /// the acceleration estimate's weights (filtered_controls, accelerations.hpp); the cached matrix
-  /// for the base model's delay.
-  Matrix force_controls(const ModelSpec& model, const Transitions& data) const;
+  /// The force residual of `model` on `data` at `rows` (rows.size() x k): with the acceleration
+  /// window w > 0 (parallel filtering, file comment)
+  ///
+  ///   r_t = M(q_t) qdd_t - sum_s m_s g_s,   g_s = W_v^-1 f_v(x_s, u_s) at every sample s of t's window,
+  ///
+  /// the model's generalised force (controls, gravity, Coriolis, friction and every effect) seen
+  /// through the acceleration estimate's weights m (filtered_at), as the estimate sees the
+  /// acceleration; at the instruments (w = 0), r_t = M qdd_t - g_t. The controls are the measured ones
+  /// delayed by model.input_delay.
+  Matrix force_residual(const ModelSpec& model, const Transitions& data, const std::vector<int>& rows) const;
+  /// A per-sample quantity of `data`'s rows (N x c: the forces of an effect at the measured states)
+  /// as force_residual sees it at `rows`: through the same weights, or as it is at w = 0.
+  Matrix filtered(const Transitions& data, const Matrix& y, const std::vector<int>& rows) const;
 
   std::string scored_on() const override { return "the generalised-force (inverse-dynamics) residual"; }
   Matrix residual(const ModelSpec& model, const FitContext& c, int* diverged = nullptr) const override;
@@ -84,12 +97,17 @@ class InverseDynamicsCriterion final : public Criterion {
  private:
   InverseDynamicsCriterion() = default;
 
+  /// The two terms of force_residual: M(q_t) qdd_t and the model's generalised force as seen.
+  struct ForceResidualParts {
+    Matrix inertial, forces;
+  };
+  ForceResidualParts force_residual_parts(const ModelSpec& model, const Transitions& data,
+                                          const std::vector<int>& rows) const;
+
   std::shared_ptr<const Matrix> accelerations_;
-  std::shared_ptr<const Matrix> own_force_;  ///< N x k, W_v^-1 f_v of the base model
+  std::shared_ptr<const Matrix> own_force_;  ///< N x k, the base model's generalised force as the residual sees it
   int reach_ = 0;
   int window_ = 0;
-  std::shared_ptr<const Matrix> filtered_controls_;  ///< force_controls for the delay filtered_delay_
-  double filtered_delay_ = 0.0;
   std::shared_ptr<const Instruments> instruments_;
   Vector noise_, lack_;
 };
