@@ -82,7 +82,8 @@ class MujocoModel {
 /// A MujocoSystem's workspace: the caller's own mjData.
 struct MujocoWorkspace final : DynamicsWorkspace {
   MujocoModel::DataPtr data;
-  Vector scratch;  ///< nv entries for MujocoSystem::inverse_dynamics
+  Vector scratch;  ///< nv entries for MujocoSystem::inverse_dynamics_parts
+  Vector forces;   ///< nv entries for MujocoSystem::inverse_dynamics (its second term)
 };
 
 }  // namespace gpilqg

@@ -277,24 +277,33 @@ void MujocoSystem::generalised_force_map(const VectorCRef& x, Matrix& W, std::ve
 
 bool MujocoSystem::inverse_dynamics(const VectorCRef& x, const VectorCRef& u, const VectorCRef& qdd, VectorRef Q,
                                     DynamicsWorkspace& workspace) const {
+  Vector& forces = workspace_as<MujocoWorkspace>(workspace).forces;
+  forces.resize(model_->m()->nv);
+  if (!inverse_dynamics_parts(x, u, qdd, Q, forces, workspace)) return false;
+  Q += forces;
+  return true;
+}
+
+bool MujocoSystem::inverse_dynamics_parts(const VectorCRef& x, const VectorCRef& u, const VectorCRef& qdd,
+                                          VectorRef inertial, VectorRef forces, DynamicsWorkspace& workspace) const {
   const mjModel* m = model_->m();
   mjData* d = workspace_as<MujocoWorkspace>(workspace).data.get();
   const int nv = m->nv;
   model_->prepare(d, x, u);
   mj_fwdPosition(m, d);
-  if (d->nefc == 0) {  // the smooth forces are all: M qdd + c - Q_passive - Q_actuator
+  mj_mulM(m, d, inertial.data(), qdd.data());  // M qdd (both contiguous)
+  if (d->nefc == 0) {  // the smooth forces are all: c - Q_passive - Q_actuator
     mj_fwdVelocity(m, d);
     mj_fwdActuation(m, d);
-    mj_mulM(m, d, Q.data(), qdd.data());  // M qdd (both contiguous)
-    for (int i = 0; i < nv; ++i) Q(i) += d->qfrc_bias[i] - d->qfrc_passive[i] - d->qfrc_actuator[i];
+    for (int i = 0; i < nv; ++i) forces(i) = d->qfrc_bias[i] - d->qfrc_passive[i] - d->qfrc_actuator[i];
     return true;
   }
-  // Constraint rows: the rest of the forward pass solves for their forces, then M (qdd - qacc).
+  // Constraint rows: the rest of the forward pass solves for their forces, then -M qacc.
   mj_forwardSkip(m, d, mjSTAGE_POS, 1);
-  Vector& difference = workspace_as<MujocoWorkspace>(workspace).scratch;
-  difference.resize(nv);
-  for (int i = 0; i < nv; ++i) difference(i) = qdd(i) - d->qacc[i];
-  mj_mulM(m, d, Q.data(), difference.data());
+  Vector& scratch = workspace_as<MujocoWorkspace>(workspace).scratch;
+  scratch.resize(nv);
+  mj_mulM(m, d, scratch.data(), d->qacc);
+  forces = -scratch;
   return true;
 }
 

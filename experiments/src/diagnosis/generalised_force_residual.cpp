@@ -60,8 +60,8 @@ ForceComponents force_components(const Dynamics& model) {
   return out;
 }
 
-Matrix generalised_force_residual(const Dynamics& model, const Transitions& data, const Matrix& applied_u,
-                                  const Matrix& accelerations, const std::vector<int>& rows) {
+GeneralisedForceParts generalised_force_parts(const Dynamics& model, const Transitions& data, const Matrix& applied_u,
+                                              const Matrix& accelerations, const std::vector<int>& rows) {
   const Dynamics& owner = force_map_system(model);
   const auto& map = dynamic_cast<const GeneralisedForceInput&>(owner);
   const ForceComponents components = force_components(model);
@@ -82,21 +82,28 @@ Matrix generalised_force_residual(const Dynamics& model, const Transitions& data
 
   const auto model_workspace = model.make_workspace();
   const auto map_workspace = owner.make_workspace();
-  // The direct form where the owner has one (GeneralisedForceInput::inverse_dynamics): `model` is the
-  // owner, or effects over it, which apply k u to it and add their forces Q_e.
+  // The direct form where the owner has one (GeneralisedForceInput::inverse_dynamics_parts): `model`
+  // is the owner, or effects over it, which apply k u to it and add their forces Q_e.
   const auto* decorated = dynamic_cast<const EffectDynamics*>(&model);
   const bool direct = &owner == &model || (decorated != nullptr && &decorated->base() == &owner);
   const double gain = decorated != nullptr ? decorated->actuator_gain() : 1.0;
   const bool effects = decorated != nullptr && !decorated->effects().empty();
-  Vector qdd(k), Q(k), Q_e(k);
+  Vector qdd(k), inertial(k), forces(k), Q_e(k);
   Vector x(n);
   Vector u(model.control_dim());
   Vector xdot(n);
   Matrix W(n, k);
   Matrix W_v(k, k);
-  Vector e(k);
+  Vector f_v(k);
   Eigen::ColPivHouseholderQR<Matrix> factor(k, k);
-  Matrix out(static_cast<Eigen::Index>(rows.size()), k);
+  GeneralisedForceParts out{Matrix(static_cast<Eigen::Index>(rows.size()), k),
+                            Matrix(static_cast<Eigen::Index>(rows.size()), k)};
+  const auto not_finite = [&](int t, const std::string& what) {
+    return std::invalid_argument(fmt::format("inverse-dynamics residual: at row {} (episode {}, t = {}) the model's {}; "
+                                             "no force residual there",
+                                             t, data.episode[static_cast<std::size_t>(t)],
+                                             data.t.size() > t ? data.t(t) : 0.0, what));
+  };
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const int t = rows[i];
     if (t < 0 || t >= data.size())
@@ -105,35 +112,34 @@ Matrix generalised_force_residual(const Dynamics& model, const Transitions& data
     x = data.x.row(t).transpose();
     u = applied_u.row(t).transpose();
     qdd = accelerations.row(t).transpose();
-    if (direct && map.inverse_dynamics(x, gain * u, qdd, Q, *map_workspace)) {
-      if (effects) {
-        decorated->generalised_force(x, u, Q_e, *model_workspace);
-        Q -= Q_e;
+    if (!(direct && map.inverse_dynamics_parts(x, gain * u, qdd, inertial, forces, *map_workspace))) {
+      model.evaluate(x, u, xdot, nullptr, *model_workspace);
+      map.generalised_force_map(x, W, nullptr, *map_workspace);
+      for (Eigen::Index c = 0; c < k; ++c) {
+        const int v = velocity[static_cast<std::size_t>(c)];
+        W_v.row(c) = W.row(v);
+        f_v(c) = xdot(v);
       }
-      if (!Q.allFinite())
-        throw std::invalid_argument(fmt::format(
-            "inverse-dynamics residual: at row {} (episode {}, t = {}) the model's acceleration or the measured one "
-            "is not finite; no force residual there", t, data.episode[static_cast<std::size_t>(t)],
-            data.t.size() > t ? data.t(t) : 0.0));
-      out.row(static_cast<Eigen::Index>(i)) = Q.transpose();
-      continue;
+      factor.compute(W_v);
+      if (factor.rank() < k) throw not_finite(t, "generalised-force map is singular");
+      inertial = factor.solve(qdd);
+      forces = -factor.solve(f_v);
+    } else if (effects) {
+      decorated->generalised_force(x, u, Q_e, *model_workspace);
+      forces -= Q_e;
     }
-    model.evaluate(x, u, xdot, nullptr, *model_workspace);
-    map.generalised_force_map(x, W, nullptr, *map_workspace);
-    for (Eigen::Index c = 0; c < k; ++c) {
-      const int v = velocity[static_cast<std::size_t>(c)];
-      W_v.row(c) = W.row(v);
-      e(c) = accelerations(t, c) - xdot(v);
-    }
-    factor.compute(W_v);
-    if (factor.rank() < k || !e.allFinite())
-      throw std::invalid_argument(fmt::format(
-          "inverse-dynamics residual: at row {} (episode {}, t = {}) the model's {}; no force residual there", t,
-          data.episode[static_cast<std::size_t>(t)], data.t.size() > t ? data.t(t) : 0.0,
-          e.allFinite() ? "generalised-force map is singular" : "acceleration or the measured one is not finite"));
-    out.row(static_cast<Eigen::Index>(i)) = factor.solve(e).transpose();
+    if (!inertial.allFinite() || !forces.allFinite()) throw not_finite(t, "acceleration or the measured one is not finite");
+    out.inertial.row(static_cast<Eigen::Index>(i)) = inertial.transpose();
+    out.forces.row(static_cast<Eigen::Index>(i)) = forces.transpose();
   }
   return out;
+}
+
+Matrix generalised_force_residual(const Dynamics& model, const Transitions& data, const Matrix& applied_u,
+                                  const Matrix& accelerations, const std::vector<int>& rows) {
+  GeneralisedForceParts parts = generalised_force_parts(model, data, applied_u, accelerations, rows);
+  parts.inertial += parts.forces;
+  return parts.inertial;
 }
 
 Matrix generalised_force_residual(const ModelSpec& model, const Transitions& data, const Matrix& accelerations,

@@ -61,6 +61,15 @@ class GeneralisedForceInput {
     return false;
   }
 
+  /// The same in its two terms, Q = inertial + forces: inertial = M(q) qdd, the term linear in the
+  /// accelerations, and forces = -h(q, q_dot, u) = -W_v^-1 f_v(x, u), the generalised force at zero
+  /// acceleration (what parallel filtering sees through the acceleration estimate's weights). Returns
+  /// false, with both unspecified, where the system has no direct form; the default always does.
+  virtual bool inverse_dynamics_parts(const VectorCRef& /*x*/, const VectorCRef& /*u*/, const VectorCRef& /*qdd*/,
+                                      VectorRef /*inertial*/, VectorRef /*forces*/, DynamicsWorkspace&) const {
+    return false;
+  }
+
   /// The coordinates the force components act on, for systems whose components do not follow the
   /// naming convention of generalised_coordinates() (the quadrotor: F_x acts on px and vx, tau_x on
   /// rx and wx). Empty by default: the convention applies.

@@ -87,6 +87,10 @@ class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public
   /// forces come from the forward solver: the rest of the forward pass, then M (qdd - qacc).
   bool inverse_dynamics(const VectorCRef& x, const VectorCRef& u, const VectorCRef& qdd, VectorRef Q,
                         DynamicsWorkspace& workspace) const override;
+  /// The same in its two terms: M qdd (one product with M) and c - Q_passive - Q_actuator, or with
+  /// constraint rows -M qacc.
+  bool inverse_dynamics_parts(const VectorCRef& x, const VectorCRef& u, const VectorCRef& qdd, VectorRef inertial,
+                              VectorRef forces, DynamicsWorkspace& workspace) const override;
 
   /// The model's integrator and timestep with `decorated`'s effects (this system, or an EffectDynamics
   /// over it). Throws std::invalid_argument when dt is not a whole multiple of the timestep.

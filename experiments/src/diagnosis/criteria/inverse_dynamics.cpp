@@ -83,17 +83,18 @@ InverseDynamicsCriterion::ForceResidualParts InverseDynamicsCriterion::force_res
     const ModelSpec& model, const Transitions& data, const std::vector<int>& rows) const {
   const DynamicsPtr system = model.build();
   const Matrix u = applied_controls(data, model.input_delay);
-  const auto k = accelerations_->cols();
-  ForceResidualParts parts;
-  const std::vector<int> all = all_rows(data);
-  // z_t = -W_v^-1 f_v(x_t, u_t), the residual at zero acceleration, at every row a window reaches.
-  const Matrix z = generalised_force_residual(*system, data, u, Matrix::Zero(data.size(), k), window_ > 0 ? all : rows);
-  // The residual is linear in the acceleration: M qdd_t = r_t(qdd_t) - r_t(0).
-  parts.inertial = generalised_force_residual(*system, data, u, *accelerations_, rows);
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    parts.inertial.row(static_cast<Eigen::Index>(i)) -= z.row(window_ > 0 ? rows[i] : static_cast<int>(i));
-  parts.forces = window_ > 0 ? Matrix(-filtered_at(data, z, rows, window_)) : Matrix(-z);
-  return parts;
+  if (window_ == 0) {
+    GeneralisedForceParts parts = generalised_force_parts(*system, data, u, *accelerations_, rows);
+    return {std::move(parts.inertial), -parts.forces};
+  }
+  // Both terms at every row a window of `rows` reaches, from one evaluation per row; the forces
+  // then seen through the weights.
+  const GeneralisedForceParts parts = generalised_force_parts(*system, data, u, *accelerations_, all_rows(data));
+  ForceResidualParts out;
+  out.inertial.resize(static_cast<Eigen::Index>(rows.size()), parts.inertial.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) out.inertial.row(static_cast<Eigen::Index>(i)) = parts.inertial.row(rows[i]);
+  out.forces = -filtered_at(data, parts.forces, rows, window_);
+  return out;
 }
 
 Matrix InverseDynamicsCriterion::force_residual(const ModelSpec& model, const Transitions& data,

@@ -77,6 +77,16 @@ const Dynamics& force_map_system(const Dynamics& model);
 Matrix generalised_force_residual(const Dynamics& model, const Transitions& data, const Matrix& applied_u,
                                   const Matrix& accelerations, const std::vector<int>& rows);
 
+/// r_t in its two terms, r_t = inertial_t + forces_t: inertial_t = W_v^-1 qdd_t (M(q) qdd_t, the
+/// term linear in the accelerations) and forces_t = -W_v^-1 f_v(x_t, u_t) (the residual at zero
+/// acceleration: minus the model's generalised force, effects included), from one evaluation of the
+/// model per row. Same arguments and errors as generalised_force_residual.
+struct GeneralisedForceParts {
+  Matrix inertial, forces;
+};
+GeneralisedForceParts generalised_force_parts(const Dynamics& model, const Transitions& data, const Matrix& applied_u,
+                                              const Matrix& accelerations, const std::vector<int>& rows);
+
 /// The same for a model description: model.build(), driven by the measured inputs delayed by
 /// model.input_delay.
 Matrix generalised_force_residual(const ModelSpec& model, const Transitions& data, const Matrix& accelerations,
