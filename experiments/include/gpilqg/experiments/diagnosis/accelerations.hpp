@@ -38,12 +38,12 @@
 /// acceleration around t: an error as large as the control's change over the window.
 ///
 /// Parallel filtering (Gautier 1997; IDIM practice filters the torques and every column of the
-/// observation matrix with one low-pass filter): the controls are seen through the same weights,
-/// u~_t = sum_r m_r u_r (filtered_controls), so that force and acceleration are both the window's mean.
-/// Exact when the dynamics are affine in the controls with a constant gain and the state changes
-/// little over the window (the inverse-dynamics criterion's conditions); the weights assume a
-/// continuous control (measured torques); for held controls they differ by half a sample, which
-/// criterion_choice.hpp charges to the criterion when it chooses.
+/// observation matrix with one low-pass filter): the model's generalised force at every sample of the
+/// window, controls included, is seen through the same weights, g~_t = sum_r m_r g_r (filtered_at;
+/// filtered_controls for the controls alone), so that force and acceleration are both the window's
+/// mean (criteria/inverse_dynamics.hpp). Exact when the inertia changes little over the window; the
+/// weights assume a continuous signal (measured torques); for held controls they differ by half a
+/// sample, which criterion_choice.hpp charges to the criterion when it chooses.
 
 #include <vector>
 
