@@ -307,6 +307,19 @@ bool MujocoSystem::inverse_dynamics_parts(const VectorCRef& x, const VectorCRef&
   return true;
 }
 
+bool MujocoSystem::control_forces(const VectorCRef& x, const VectorCRef& u, VectorRef Q,
+                                  DynamicsWorkspace& workspace) const {
+  const mjModel* m = model_->m();
+  if (Q.size() != m->nv) return false;
+  mjData* d = workspace_as<MujocoWorkspace>(workspace).data.get();
+  model_->prepare(d, x, u);
+  mj_fwdPosition(m, d);
+  mj_fwdVelocity(m, d);
+  mj_fwdActuation(m, d);
+  for (int i = 0; i < m->nv; ++i) Q(i) = d->qfrc_actuator[i];
+  return true;
+}
+
 std::shared_ptr<const StepModel> MujocoSystem::own_step_model(DynamicsPtr decorated, double dt) const {
   return std::make_shared<MujocoStepModel>(model_, std::move(decorated), dt);
 }

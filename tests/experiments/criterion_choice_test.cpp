@@ -9,6 +9,7 @@
 #include <H5Cpp.h>
 #include <nlohmann/json.hpp>
 
+#include <Eigen/LU>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -24,6 +25,7 @@
 #include "gpilqg/experiments/data_info.hpp"
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
 #include "gpilqg/experiments/diagnosis/criterion_choice.hpp"
+#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/motion_period.hpp"
 #include "gpilqg/experiments/diagnosis/transitions.hpp"
 #include "gpilqg/experiments/import_map.hpp"
@@ -308,6 +310,41 @@ TEST(CriterionChoice, SmoothMeasuredTorquesAtOneKilohertzChooseInverseDynamics) 
   EXPECT_GE(actual, kInverseDynamicsRatio);
   EXPECT_NEAR(std::log(c.facts.ratio / actual), 0.0, std::log(2.0)) << "within a factor of 2 of the actual ratio";
   EXPECT_FALSE(c.instruments) << "velocity noise of 5e-3 rad/s biases least squares by " << c.facts.attenuation;
+}
+
+// A model with MuJoCo's dry friction (frictionloss, a soft constraint of the forward solver) on the elbow:
+// near the elbow's reversals the constraint sticks and absorbs part of the torque, so the forward
+// Jacobian's W_v^-1 df_v/du is not the actuators' map there. The controls are still generalised forces
+// with a constant gain, which the actuation itself says (GeneralisedForceInput::control_forces): the
+// same data choose inverse dynamics with the friction in the model as without it, so a diagnosed model
+// holding a frictionloss keeps the criterion in the next round.
+TEST(CriterionChoice, ADryFrictionConstraintInTheModelIsNotTakenForAStateDependentGain) {
+  const MeasurementSet set = arm_data(0, 5e-3, 2e-3);
+  ModelSpec model = arm_spec();
+  model.parameters["elbow.frictionloss"] = 1.0;  // N m, above most of the elbow's torque: it sticks often
+  const CriterionChoice c = choose_criterion(set, model);
+  std::printf("arm with a frictionloss of 1 N m on the elbow: %s\n", c.reason.c_str());
+  EXPECT_EQ(c.facts.not_forces, "");
+  EXPECT_EQ(c.criterion, FitCriterion::InverseDynamics) << c.reason;
+  // The forward Jacobian does see the constraint: its gain W_v^-1 df_v/du changes over the measured
+  // states by more than the rule's tolerance (what the rule took for a state-dependent gain).
+  const DynamicsPtr arm = model.build();
+  const auto& map = dynamic_cast<const GeneralisedForceInput&>(diagnosis::force_map_system(*arm));
+  Matrix reference;
+  double largest = 0.0;
+  for (const Episode& e : set.episodes)
+    for (Eigen::Index t = 0; t < e.length(); t += 20) {
+      DynamicsJacobians jac;
+      Vector xdot(4);
+      arm->evaluate(e.x.row(t).transpose(), e.u.row(t).transpose(), xdot, &jac);
+      Matrix W;
+      map.generalised_force_map(e.x.row(t).transpose(), W, nullptr);
+      const Matrix G = W.bottomRows(2).fullPivLu().solve(jac.fu.bottomRows(2));
+      if (reference.size() == 0) reference = G;
+      largest = std::max(largest, (G - reference).cwiseAbs().maxCoeff() / reference.cwiseAbs().maxCoeff());
+    }
+  std::printf("largest change of the forward Jacobian's gain: %.3g of the largest gain\n", largest);
+  EXPECT_GT(largest, 0.1);
 }
 
 /// sigma^2 / var(v) of state `state` of `set` for white noise of std `sigma` on it: the attenuation of a

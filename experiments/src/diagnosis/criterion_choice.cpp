@@ -83,6 +83,36 @@ std::pair<const Episode*, Eigen::Index> sample_at(const MeasurementSet& data, lo
   return {&data.episodes.back(), data.episodes.back().length() - 1};
 }
 
+/// G (k x m) at (x, u), the generalised force per unit of each control, from the system's own
+/// actuation (GeneralisedForceInput::control_forces, applied as `model` applies its controls: k u
+/// under an EffectDynamics' gain k): G_j = Q_u(x, k (u + e_j)) - Q_u(x, k u), exact for actuators
+/// linear in their input. False when the system does not compute its actuation or an effect's force
+/// depends on the controls; the caller then takes W_v^-1 df_v/du from the forward Jacobian.
+bool actuation_gain(const Dynamics& model, const VectorCRef& x, const VectorCRef& u, Matrix& G) {
+  const Dynamics* owner = &model;
+  double gain = 1.0;
+  if (const auto* decorated = dynamic_cast<const EffectDynamics*>(&model)) {
+    if (decorated->input_dependent()) return false;
+    gain = decorated->actuator_gain();
+    owner = &decorated->base();
+  }
+  const auto* input = dynamic_cast<const GeneralisedForceInput*>(owner);
+  if (input == nullptr) return false;
+  const auto k = static_cast<Eigen::Index>(input->generalised_forces().size());
+  const auto workspace = owner->make_workspace();
+  Vector base(k), moved(k);
+  const Vector applied = gain * u;
+  if (!input->control_forces(x, applied, base, *workspace)) return false;
+  G.resize(k, u.size());
+  for (Eigen::Index j = 0; j < u.size(); ++j) {
+    Vector step = applied;
+    step(j) += gain;
+    input->control_forces(x, step, moved, *workspace);
+    G.col(j) = moved - base;
+  }
+  return G.allFinite();
+}
+
 /// Why the controls of `model` are not generalised forces with a constant gain (header, rule 2), or
 /// "" when they are.
 std::string why_not_forces(const Dynamics& model, const std::vector<GeneralisedCoordinate>& coordinates,
@@ -125,7 +155,8 @@ std::string why_not_forces(const Dynamics& model, const std::vector<GeneralisedC
     }
     const Eigen::FullPivLU<Matrix> lu(Wv);
     if (!lu.isInvertible()) return "the generalised-force map is singular at a measured state";
-    const Matrix G = lu.solve(bv);
+    Matrix G;
+    if (!actuation_gain(model, x, u, G)) G = lu.solve(bv);
     if (s == 0) {
       reference = G;
       if (reference.cwiseAbs().maxCoeff() == 0.0) return "the controls do not act on the model";

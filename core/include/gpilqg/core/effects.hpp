@@ -139,6 +139,8 @@ class EffectDynamics final : public Dynamics {
 
   const Dynamics& base() const { return *base_; }
   double actuator_gain() const { return gain_; }
+  /// Whether an effect's force depends on the controls (then the input matrix is not k times the base's).
+  bool input_dependent() const { return input_dependent_; }
   const std::vector<AppliedEffect>& effects() const { return effects_; }
 
  private:

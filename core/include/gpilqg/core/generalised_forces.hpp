@@ -70,6 +70,16 @@ class GeneralisedForceInput {
     return false;
   }
 
+  /// The generalised force the controls apply at (x, u), Q_u = B(x) u for actuators linear in their
+  /// input (k entries): the actuation alone, without the reaction of constraints that the forward
+  /// dynamics hold (a MuJoCo frictionloss that sticks near a reversal absorbs part of a torque, so
+  /// there the forward Jacobian's W_v^-1 df_v/du is not B). Returns false, with Q unspecified, where
+  /// the system does not compute it; the default always does.
+  virtual bool control_forces(const VectorCRef& /*x*/, const VectorCRef& /*u*/, VectorRef /*Q*/,
+                              DynamicsWorkspace&) const {
+    return false;
+  }
+
   /// The coordinates the force components act on, for systems whose components do not follow the
   /// naming convention of generalised_coordinates() (the quadrotor: F_x acts on px and vx, tau_x on
   /// rx and wx). Empty by default: the convention applies.

@@ -91,6 +91,9 @@ class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public
   /// constraint rows -M qacc.
   bool inverse_dynamics_parts(const VectorCRef& x, const VectorCRef& u, const VectorCRef& qdd, VectorRef inertial,
                               VectorRef forces, DynamicsWorkspace& workspace) const override;
+  /// MuJoCo's actuator forces in joint space (qfrc_actuator) from the position, velocity and
+  /// actuation stages: no constraint solve.
+  bool control_forces(const VectorCRef& x, const VectorCRef& u, VectorRef Q, DynamicsWorkspace& workspace) const override;
 
   /// The model's integrator and timestep with `decorated`'s effects (this system, or an EffectDynamics
   /// over it). Throws std::invalid_argument when dt is not a whole multiple of the timestep.
