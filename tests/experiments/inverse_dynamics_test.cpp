@@ -723,14 +723,14 @@ TEST(InverseDynamicsWeights, AJointsWeightFollowsWhatTheModelLeavesNotHowQuietIt
       double square = 0.0;
       for (int t : training) square += c.residual(t, i) * c.residual(t, i);
       const double left = std::sqrt(square / static_cast<double>(training.size()));
-      EXPECT_NEAR(criterion.lack()(i), left, 1e-12 * left);
+      EXPECT_NEAR(criterion.left()(i), left, 1e-12 * left);
       const double sigma = std::max(criterion.noise()(i), left);
       EXPECT_NEAR(c.weights(i) * sigma * sigma, 1.0, 1e-12);
     }
     std::printf("shoulder torque noise %.0e N m: noise [%.3g, %.3g], left [%.3g, %.3g] N m, weights [%.4g, %.4g]\n",
-                torque_noise, criterion.noise()(0), criterion.noise()(1), criterion.lack()(0), criterion.lack()(1),
+                torque_noise, criterion.noise()(0), criterion.noise()(1), criterion.left()(0), criterion.left()(1),
                 c.weights(0), c.weights(1));
-    return Weights{c.weights, criterion.noise(), criterion.lack()};
+    return Weights{c.weights, criterion.noise(), criterion.left()};
   };
   const Weights quiet = weights_with_shoulder_noise(1e-3), loud = weights_with_shoulder_noise(0.1);
   // The estimate sees the sensor's noise ...

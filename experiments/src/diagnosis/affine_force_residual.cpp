@@ -42,11 +42,12 @@ Matrix weighted_force_regressor(const ModelSpec& model, const std::vector<const 
   const Eigen::Index k = sqrt_w.size();
   Eigen::Index p = 0;
   for (const LibraryEffect* e : effects) p += static_cast<Eigen::Index>(e->parameters.size());
-  // The bases at every sample a window of `rows` reaches (all rows when the criterion filters), then
-  // seen as the residual sees the model's forces (InverseDynamicsCriterion::filtered).
+  // The bases g_j (sampled x k each, side by side: column j k + i is component i of g_j) at every
+  // sample a window of `rows` reaches (all rows when the criterion filters), then seen as the
+  // residual sees the model's forces (InverseDynamicsCriterion::filtered), all in one pass.
   const bool filtering = criterion->acceleration_window() > 0;
   const std::vector<int> sampled = filtering ? all_rows(*c.data) : rows;
-  std::vector<Matrix> bases(static_cast<std::size_t>(p), Matrix(static_cast<Eigen::Index>(sampled.size()), k));
+  Matrix bases(static_cast<Eigen::Index>(sampled.size()), p * k);
   // The unit parameter vectors e_j of each effect, made once rather than per row.
   std::vector<std::vector<Vector>> units;
   for (const LibraryEffect* e : effects) {
@@ -58,21 +59,21 @@ Matrix weighted_force_regressor(const ModelSpec& model, const std::vector<const 
   for (std::size_t i = 0; i < sampled.size(); ++i) {
     x = c.data->x.row(sampled[i]).transpose();
     u_t = u.row(sampled[i]).transpose();
-    std::size_t column = 0;
+    Eigen::Index column = 0;
     for (std::size_t e = 0; e < effects.size(); ++e) {
       for (const Vector& unit : units[e]) {  // g_j = Q_e(x, u; e_j), Q_e linear in theta
         Q.setZero();
         effects[e]->force->add_force(x, u_t, unit, Q, nullptr, nullptr, *workspace);
-        bases[column++].row(static_cast<Eigen::Index>(i)) = Q.transpose();
+        bases.block(static_cast<Eigen::Index>(i), column, 1, k) = Q.transpose();
+        column += k;
       }
     }
   }
+  const Matrix seen = filtering ? criterion->filtered(*c.data, bases, rows) : bases;
   Matrix out(static_cast<Eigen::Index>(rows.size()) * k, p);
-  for (std::size_t j = 0; j < bases.size(); ++j) {
-    const Matrix seen = filtering ? criterion->filtered(*c.data, bases[j], rows) : bases[j];
-    for (Eigen::Index i = 0; i < seen.rows(); ++i)
-      out.block(i * k, static_cast<Eigen::Index>(j), k, 1) = sqrt_w.cwiseProduct(seen.row(i).transpose());
-  }
+  for (Eigen::Index i = 0; i < seen.rows(); ++i)
+    for (Eigen::Index j = 0; j < p; ++j)
+      out.block(i * k, j, k, 1) = sqrt_w.cwiseProduct(seen.row(i).segment(j * k, k).transpose());
   return out;
 }
 

@@ -28,6 +28,12 @@ std::vector<int> all_rows(const Transitions& data) {
   return rows;
 }
 
+Matrix rows_of(const Matrix& y, const std::vector<int>& rows) {
+  Matrix out(static_cast<Eigen::Index>(rows.size()), y.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = y.row(rows[i]);
+  return out;
+}
+
 Matrix simulated_predictions(const StepModel& model, const Transitions& data, const Matrix& u,
                              const std::vector<int>& rows, int window, int* restarts) {
   if (window < 1) throw std::invalid_argument("simulated_predictions: the window must be >= 1 row");

@@ -34,19 +34,19 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(F
   out->own_force_ = std::make_shared<const Matrix>(parts.forces);
   // IDIM-WLS (Gautier): w_i = 1 / sigma_i^2 with sigma_i^2 the larger of component i's white noise
   // (noise_i, from its repeated differences within each record: the noise of the torque and of the
-  // acceleration estimate) and the mean square of its residual on the training rows (lack_i: what
+  // acceleration estimate) and the mean square of its residual on the training rows (left_i: what
   // the model as given leaves of that joint's equations). Each joint's equations then count by how
   // well the model can be expected to fit them, not by how quiet its sensor is: a joint whose sensor
   // is quiet but whose model is wrong by far more does not drown the others. The noise is taken from
-  // the residual with the controls as measured: the filter turns their white noise into a smooth one
-  // that differences no longer see, and it scales every component's noise variance by the same |m|^2.
-  const Matrix unfiltered = generalised_force_residual(c.model, data, applied_controls(data, c.model.input_delay),
-                                                       *out->accelerations_, rows);
+  // the residual with the controls and forces as they are at each row: the filter turns their white
+  // noise into a smooth one that differences no longer see, and it scales every component's noise
+  // variance by the same |m|^2.
+  const Matrix unfiltered = parts.inertial - parts.forces_at_rows;
   const std::vector<RowSegment> segments = row_segments(data);
   const std::vector<int> training = data.rows(false);
   c.weights.resize(k);
   out->noise_ = Vector(k);
-  out->lack_ = Vector(k);
+  out->left_ = Vector(k);
   for (Eigen::Index i = 0; i < k; ++i) {
     std::vector<Vector> pieces;
     for (const RowSegment& s : segments) pieces.push_back(unfiltered.col(i).segment(s.first, s.end - s.first));
@@ -54,8 +54,8 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(F
     out->noise_(i) = std::max(difference_noise_std(pieces), 1e-12 * (1.0 + rms));
     double square = 0.0;
     for (int t : training) square += c.residual(t, i) * c.residual(t, i);
-    out->lack_(i) = std::sqrt(square / std::max<double>(1.0, static_cast<double>(training.size())));
-    const double sigma = std::max(out->noise_(i), out->lack_(i));
+    out->left_(i) = std::sqrt(square / std::max<double>(1.0, static_cast<double>(training.size())));
+    const double sigma = std::max(out->noise_(i), out->left_(i));
     c.weights(i) = 1.0 / (sigma * sigma);
   }
   return out;
@@ -85,16 +85,14 @@ InverseDynamicsCriterion::ForceResidualParts InverseDynamicsCriterion::force_res
   const Matrix u = applied_controls(data, model.input_delay);
   if (window_ == 0) {
     GeneralisedForceParts parts = generalised_force_parts(*system, data, u, *accelerations_, rows);
-    return {std::move(parts.inertial), -parts.forces};
+    ForceResidualParts out{std::move(parts.inertial), -parts.forces, Matrix()};
+    out.forces_at_rows = out.forces;
+    return out;
   }
   // Both terms at every row a window of `rows` reaches, from one evaluation per row; the forces
   // then seen through the weights.
   const GeneralisedForceParts parts = generalised_force_parts(*system, data, u, *accelerations_, all_rows(data));
-  ForceResidualParts out;
-  out.inertial.resize(static_cast<Eigen::Index>(rows.size()), parts.inertial.cols());
-  for (std::size_t i = 0; i < rows.size(); ++i) out.inertial.row(static_cast<Eigen::Index>(i)) = parts.inertial.row(rows[i]);
-  out.forces = -filtered_at(data, parts.forces, rows, window_);
-  return out;
+  return {rows_of(parts.inertial, rows), -filtered_at(data, parts.forces, rows, window_), -rows_of(parts.forces, rows)};
 }
 
 Matrix InverseDynamicsCriterion::force_residual(const ModelSpec& model, const Transitions& data,
@@ -104,10 +102,7 @@ Matrix InverseDynamicsCriterion::force_residual(const ModelSpec& model, const Tr
 }
 
 Matrix InverseDynamicsCriterion::filtered(const Transitions& data, const Matrix& y, const std::vector<int>& rows) const {
-  if (window_ > 0) return filtered_at(data, y, rows, window_);
-  Matrix out(static_cast<Eigen::Index>(rows.size()), y.cols());
-  for (std::size_t i = 0; i < rows.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = y.row(rows[i]);
-  return out;
+  return window_ > 0 ? filtered_at(data, y, rows, window_) : rows_of(y, rows);
 }
 
 Matrix InverseDynamicsCriterion::residual(const ModelSpec& model, const FitContext& c, int* diverged) const {
@@ -166,13 +161,13 @@ std::string InverseDynamicsCriterion::description(double, int) const {
     out += fmt::format(" (Savitzky-Golay window of {} samples, the controls and the model's forces seen through the same "
                        "weights)", window_);
   if (noise_.size() > 0) {
-    std::string noise, lack;
+    std::string noise, left;
     for (Eigen::Index i = 0; i < noise_.size(); ++i) {
       noise += fmt::format("{}{:.3g}", i == 0 ? "" : ", ", noise_(i));
-      lack += fmt::format("{}{:.3g}", i == 0 ? "" : ", ", lack_(i));
+      left += fmt::format("{}{:.3g}", i == 0 ? "" : ", ", left_(i));
     }
     out += fmt::format("\n   weights (IDIM-WLS): each force component by 1 / max(noise, rms left by the model as given)^2, "
-                       "noise [{}], left [{}]", noise, lack);
+                       "noise [{}], left [{}]", noise, left);
   }
   if (instruments_)
     out += fmt::format("\n   instrumental variables (IDIM-IV): instruments from the model simulated over windows of {} "

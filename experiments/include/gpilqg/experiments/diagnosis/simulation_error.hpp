@@ -74,4 +74,7 @@ Matrix simulated_predictions(const StepModel& model, const Transitions& data, co
 /// All rows of `data` (0, ..., N - 1).
 std::vector<int> all_rows(const Transitions& data);
 
+/// The rows `rows` of `y` in their order (rows.size() x y.cols()).
+Matrix rows_of(const Matrix& y, const std::vector<int>& rows);
+
 }  // namespace gpilqg::diagnosis

@@ -31,8 +31,8 @@ class InverseDynamicsCriterion final : public Criterion {
  public:
   /// Estimates the accelerations on c.data and sets c.residual (N x k) to the force residual of
   /// c.model and c.weights to the IDIM-WLS weights 1 / sigma_i^2 (Gautier), sigma_i = max(noise_i,
-  /// lack_i): noise_i the white noise of component i's residual (its repeated differences within each
-  /// record, with the controls as applied: what a smooth missing force does not raise), lack_i the
+  /// left_i): noise_i the white noise of component i's residual (its repeated differences within each
+  /// record, with the controls as applied: what a smooth missing force does not raise), left_i the
   /// rms of its residual on the training rows (what the model as given leaves of joint i's
   /// equations). Throws std::invalid_argument on a system without a generalised-force map or records
   /// too short for the estimate.
@@ -56,9 +56,9 @@ class InverseDynamicsCriterion final : public Criterion {
   /// The one window of the acceleration estimate; 0 at the instruments (controls as applied).
   int acceleration_window() const { return window_; }
   /// Per force component: the white noise of its residual and the rms of its residual on the
-  /// training rows, the two sides of its weight's sigma_i = max(noise_i, lack_i) (make).
+  /// training rows, the two sides of its weight's sigma_i = max(noise_i, left_i) (make).
   const Vector& noise() const { return noise_; }
-  const Vector& lack() const { return lack_; }
+  const Vector& left() const { return left_; }
   /// The instruments of the IV form, or null for least squares.
   const Instruments* instruments() const { return instruments_.get(); }
 
@@ -97,9 +97,10 @@ class InverseDynamicsCriterion final : public Criterion {
  private:
   InverseDynamicsCriterion() = default;
 
-  /// The two terms of force_residual: M(q_t) qdd_t and the model's generalised force as seen.
+  /// The two terms of force_residual: M(q_t) qdd_t and the model's generalised force as seen; and
+  /// that force as it is at the rows (W_v^-1 f_v(x_t, u_t), not seen through the weights).
   struct ForceResidualParts {
-    Matrix inertial, forces;
+    Matrix inertial, forces, forces_at_rows;
   };
   ForceResidualParts force_residual_parts(const ModelSpec& model, const Transitions& data,
                                           const std::vector<int>& rows) const;
@@ -109,7 +110,7 @@ class InverseDynamicsCriterion final : public Criterion {
   int reach_ = 0;
   int window_ = 0;
   std::shared_ptr<const Instruments> instruments_;
-  Vector noise_, lack_;
+  Vector noise_, left_;
 };
 
 }  // namespace gpilqg::diagnosis
