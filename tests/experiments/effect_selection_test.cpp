@@ -20,6 +20,7 @@
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/delay_start.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 
@@ -264,6 +265,30 @@ TEST(EffectSelection, AddingASecondEffectRefitsTheFirstJointly) {
   EXPECT_NEAR(second.added[0].estimate(0), 0.8, 0.15 * 0.8);
   EXPECT_NEAR(second.model.current_values(find_effect("cartpole", "cart_coulomb_friction"))(0),
               second.refitted[0].estimate(0), 1e-12);
+}
+
+// The model as given already holds one of the world's effects at its value (a round after the one that
+// found it); --auto refits it beside every candidate. Its refitted interval then holds its value in the
+// model, which says nothing about the candidate: the verdict must judge the candidate alone (effect_test.hpp,
+// as the search does) and name the missing force.
+TEST(EffectSelection, AnEffectTheModelHoldsAtItsValueDoesNotHideTheMissingOne) {
+  const Truth truth{{"cart_coulomb_friction", 1.5}, {"external_force_x", 0.8}};
+  const MeasurementSet data = data_of(world_with("cartpole", truth), 5, 8, 150, 0.02);
+  diagnosis::DiagnosisOptions o = auto_options("cartpole");
+  o.model = world_with("cartpole", {{"cart_coulomb_friction", 1.5}});
+  const DiagnosisReport r = diagnosis::diagnose(data, o);
+  ASSERT_FALSE(r.ranking.empty());
+  const EffectFit& best = r.ranking.front().fit;
+  ASSERT_EQ(best.effect, "external_force_x") << r.verdict.reason;
+  ASSERT_EQ(best.refitted.size(), 1u);
+  const diagnosis::EffectValues& held = best.refitted.front();
+  EXPECT_EQ(held.effect, "cart_coulomb_friction");
+  EXPECT_TRUE(diagnosis::interval_contains_null(held)) << "the case must put the model's value in the refit's interval: "
+                                                        << held.ci_low(0) << " .. " << held.ci_high(0);
+  EXPECT_EQ(r.verdict.status, "explained") << r.verdict.reason;
+  ASSERT_TRUE(r.verdict.effect.has_value()) << r.verdict.reason;
+  EXPECT_EQ(r.verdict.effect->effect, "external_force_x");
+  EXPECT_NEAR(r.verdict.effect->estimate(0), 0.8, 0.15 * 0.8);
 }
 
 // A 2-step actuation delay is the verdict, within 0.25 steps; without a delay none is proposed.

@@ -80,7 +80,10 @@ Matrix shares(Matrix sensitivity) {
   return sensitivity;
 }
 
-Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
+/// The single-effect verdict on the ranking. `in_model`: the model's own effects that each fit of
+/// the ranking refits beside its candidate (--auto), which are not findings of their own: their
+/// intervals and channels are not judged (effect_test.hpp), as in the search.
+Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o, const std::vector<std::string>& in_model) {
   Verdict v;
   if (r.model_diverges) {
     v.status = "model_diverges";
@@ -102,7 +105,7 @@ Verdict decide(const DiagnosisReport& r, const DiagnosisOptions& o) {
   }
   const RankedEffect& best = r.ranking.front();
   const EffectFit& f = best.fit;
-  const EffectTestResult finding = test_effect(f, {o.min_explained, o.min_z});
+  const EffectTestResult finding = test_effect(f, {o.min_explained, o.min_z}, in_model);
   v.left = 1.0 - f.explained;
   v.gp_left = 1.0 - r.gp_explained_total;
   v.reason = fmt::format("the best candidate '{}' removes {:.1f}% of the held-out residual (z = {:.1f}); the GP removes {:.1f}%",
@@ -419,9 +422,11 @@ void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidat
   // The GP sees (x_t, u_t) only: the residual of an effect of the input history (input_delay) looks
   // like noise to it. An effect that removes a large and significant share of the held-out residual
   // shows that the residual is not at its floor, whatever the GP found.
-  if (R.consistent && !R.ranking.empty() && test_effect(R.ranking.front().fit, {o.min_explained, o.min_z}).accepted)
+  const std::vector<std::string> in_model = names_of_effects(present);
+  if (R.consistent && !R.ranking.empty() &&
+      test_effect(R.ranking.front().fit, {o.min_explained, o.min_z}, in_model).accepted)
     R.consistent = false;
-  R.verdict = decide(R, o);
+  R.verdict = decide(R, o, in_model);
   if (!o.auto_select || R.model_diverges) return;
   SelectionOptions so;
   so.method = o.search;
