@@ -341,11 +341,14 @@ StateRatio state_ratio(const Dynamics& model, const std::vector<GeneralisedCoord
       const Vector du = u * (continuous[p] - held[p]);
       // What parallel filtering misses of the model (header, a_s): the estimate the model's own
       // increments would give against its generalised force seen through the weights, in
-      // acceleration units at x_t.
+      // acceleration units at x_t. A window where the map is singular (no finite force) is not counted.
       const Vector filtered_force = own.force[episode].middleRows(start, window).transpose() * continuous[p];
-      const double seen =
-          velocity_map(input, coordinates, e.x.row(t).transpose(), *map_workspace).row(static_cast<Eigen::Index>(component)).dot(filtered_force);
-      smear += std::pow(window_mean_acceleration(own.derivative[episode].col(state), held[p], start) - seen, 2);
+      const double seen = velocity_map(input, coordinates, e.x.row(t).transpose(), *map_workspace)
+                              .row(static_cast<Eigen::Index>(component))
+                              .dot(filtered_force);
+      const double missed = window_mean_acceleration(own.derivative[episode].col(state), held[p], start) - seen;
+      if (!std::isfinite(missed)) continue;
+      smear += missed * missed;
       const Vector filtered_u = u * continuous[p];
       model.evaluate(e.x.row(t).transpose(), filtered_u, xdot, &jac, *workspace);
       hold += std::pow(jac.fu.row(state).dot(du), 2);
