@@ -27,22 +27,15 @@ constexpr int kGainSamples = 8;
 /// Rows at which the control's error in the acceleration estimate is averaged (evenly strided).
 constexpr long kControlErrorRows = 2000;
 
-/// The system whose generalised-force map `model` uses: itself, or the base of an EffectDynamics;
-/// null when there is none.
-const Dynamics* force_owner(const Dynamics& model) {
+/// The system whose generalised-force map `model` uses: itself, or the base of an EffectDynamics.
+const GeneralisedForceInput* force_input(const Dynamics& model) {
   const Dynamics* system = &model;
-  while (dynamic_cast<const GeneralisedForceInput*>(system) == nullptr) {
+  while (true) {
+    if (const auto* input = dynamic_cast<const GeneralisedForceInput*>(system)) return input;
     const auto* decorated = dynamic_cast<const EffectDynamics*>(system);
     if (decorated == nullptr) return nullptr;
     system = &decorated->base();
   }
-  return system;
-}
-
-/// Its generalised-force map, or null.
-const GeneralisedForceInput* force_input(const Dynamics& model) {
-  const Dynamics* owner = force_owner(model);
-  return owner == nullptr ? nullptr : dynamic_cast<const GeneralisedForceInput*>(owner);
 }
 
 /// The coordinates of the model's force components, when every component has one (else empty).
@@ -51,7 +44,10 @@ std::vector<GeneralisedCoordinate> force_coordinates(const Dynamics& model) {
   if (input == nullptr) return {};
   std::vector<GeneralisedCoordinate> coordinates(input->generalised_forces().size());
   std::vector<bool> found(coordinates.size(), false);
-  for (const GeneralisedCoordinate& c : generalised_coordinates(*force_owner(model))) {
+  const Dynamics* owner = &model;
+  while (dynamic_cast<const GeneralisedForceInput*>(owner) == nullptr)
+    owner = &dynamic_cast<const EffectDynamics*>(owner)->base();
+  for (const GeneralisedCoordinate& c : generalised_coordinates(*owner)) {
     coordinates[static_cast<std::size_t>(c.component)] = c;
     found[static_cast<std::size_t>(c.component)] = true;
   }
@@ -185,7 +181,6 @@ struct StateRatio {
   int window = 0;
   double control_error = 0.0;  ///< sqrt(mean a_h^2) / E_ID
   double smear_error = 0.0;    ///< sqrt(mean a_s^2) / E_ID
-  double smear = 0.0;          ///< sqrt(mean a_s^2)
   /// sqrt((mean a_s^2 + mean a_h^2) / mean |b_v u|^2): the filter's misfit on the model against the
   /// force the controls apply (infinite when they apply none)
   double misfit = 0.0;
@@ -226,73 +221,26 @@ std::vector<Vector> state_segments(const MeasurementSet& data, int state) {
   return segments;
 }
 
-/// The model at every sample of every episode, as measured: its state derivative f(x_t, u_t)
-/// (T x n) and its generalised force g_t = W_v(x_t)^-1 f_v(x_t, u_t) (T x k, component order: the
-/// controls, gravity, Coriolis, friction and every effect, what parallel filtering filters).
-struct ModelSamples {
-  std::vector<Matrix> derivative, force;
-};
-
-/// W_v(x) (k x k): the rows of the generalised-force map at the coordinates' velocities.
-Matrix velocity_map(const GeneralisedForceInput& input, const std::vector<GeneralisedCoordinate>& coordinates,
-                    const VectorCRef& x, DynamicsWorkspace& workspace) {
-  Matrix W;
-  input.generalised_force_map(x, W, nullptr, workspace);
-  Matrix Wv(static_cast<Eigen::Index>(coordinates.size()), W.cols());
-  for (std::size_t c = 0; c < coordinates.size(); ++c)
-    Wv.row(static_cast<Eigen::Index>(c)) = W.row(coordinates[c].velocity);
-  return Wv;
-}
-
-ModelSamples model_samples(const Dynamics& model, const std::vector<GeneralisedCoordinate>& coordinates,
-                           const MeasurementSet& data) {
+/// The model's state derivative f(x_t, u_t) at every sample of every episode, as measured (T x n each).
+std::vector<Matrix> model_derivatives(const Dynamics& model, const MeasurementSet& data) {
   const auto workspace = model.make_workspace();
-  const GeneralisedForceInput& input = *force_input(model);
-  const auto map_workspace = force_owner(model)->make_workspace();
-  const auto k = static_cast<Eigen::Index>(coordinates.size());
-  Vector xdot(model.state_dim()), fv(k);
-  ModelSamples out;
+  Vector xdot(model.state_dim());
+  std::vector<Matrix> out;
   for (const Episode& e : data.episodes) {
-    Matrix f(e.length(), model.state_dim()), g(e.length(), k);
+    Matrix f(e.length(), model.state_dim());
     for (Eigen::Index r = 0; r < e.length(); ++r) {
       model.evaluate(e.x.row(r).transpose(), e.u.row(r).transpose(), xdot, nullptr, *workspace);
       f.row(r) = xdot.transpose();
-      for (Eigen::Index c = 0; c < k; ++c) fv(c) = xdot(coordinates[static_cast<std::size_t>(c)].velocity);
-      g.row(r) = velocity_map(input, coordinates, e.x.row(r).transpose(), *map_workspace).partialPivLu().solve(fv).transpose();
     }
-    out.derivative.push_back(std::move(f));
-    out.force.push_back(std::move(g));
+    out.push_back(std::move(f));
   }
   return out;
 }
 
-/// (1/dt) sum_s k_s dv_s for the model's own velocity increments dv_s over the window's steps
-/// (k = acceleration_weights(.., ZeroOrder), the weights of the increments): what the acceleration
-/// estimate of a record the model generated would be. Each increment dt * (mean acceleration over
-/// its step) from the model's accelerations `a` at the samples (one episode's column) by the cubic
-/// through the four samples around the step, (-a_{i-1} + 13 a_i + 13 a_{i+1} - a_{i+2}) / 24, exact
-/// to O(dt^4) for a smooth motion, where the trapezoid (a_i + a_{i+1}) / 2 that parallel filtering
-/// applies is only O(dt^2) (at 9 samples a period of a sinusoid it is 4.3% off); the trapezoid at an
-/// episode's first and last step.
-double window_mean_acceleration(const Eigen::Ref<const Vector>& a, const Vector& increment_weights, Eigen::Index start) {
-  const Eigen::Index T = a.size();
-  double sum = 0.0;
-  for (Eigen::Index s = 0; s + 1 < increment_weights.size(); ++s) {
-    const Eigen::Index i = start + s;
-    const double step = i >= 1 && i + 2 < T ? (-a(i - 1) + 13.0 * a(i) + 13.0 * a(i + 1) - a(i + 2)) / 24.0
-                                            : 0.5 * (a(i) + a(i + 1));
-    sum += increment_weights(s) * step;
-  }
-  return sum;
-}
-
-/// rho of the velocity state of force component `component` (coordinates[component].velocity) with
-/// the acceleration estimate of window `window` (the one window of every coordinate,
-/// accelerations.hpp); `own` the model at the samples (model_samples).
-StateRatio state_ratio(const Dynamics& model, const std::vector<GeneralisedCoordinate>& coordinates,
-                       const MeasurementSet& data, const ModelSamples& own, std::size_t component, double dt,
-                       int window) {
-  const int state = coordinates[component].velocity;
+/// rho of velocity state `state` with the acceleration estimate of window `window` (the one window of
+/// every coordinate, accelerations.hpp); `own` the model's derivatives at the samples (model_derivatives).
+StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own, int state,
+                       double dt, int window) {
   const std::vector<Vector> segments = state_segments(data, state);
   StateRatio out;
   if (segments.empty()) return out;
@@ -323,8 +271,6 @@ StateRatio state_ratio(const Dynamics& model, const std::vector<GeneralisedCoord
   DynamicsJacobians jac;
   Vector xdot(model.state_dim());
   const auto workspace = model.make_workspace();
-  const GeneralisedForceInput& input = *force_input(model);
-  const auto map_workspace = force_owner(model)->make_workspace();
   double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0, applied = 0.0;
   long count = 0, position = 0;
   for (std::size_t episode = 0; episode < data.episodes.size(); ++episode) {
@@ -339,18 +285,11 @@ StateRatio state_ratio(const Dynamics& model, const std::vector<GeneralisedCoord
       const auto u = e.u.middleRows(start, window).transpose();
       // The two holds' filtered controls differ by what the data cannot tell apart.
       const Vector du = u * (continuous[p] - held[p]);
-      // What parallel filtering misses of the model (header, a_s): the estimate the model's own
-      // increments would give against its generalised force seen through the weights, in
-      // acceleration units at x_t. A window where the map is singular (no finite force) is not counted.
-      const Vector filtered_force = own.force[episode].middleRows(start, window).transpose() * continuous[p];
-      const double seen = velocity_map(input, coordinates, e.x.row(t).transpose(), *map_workspace)
-                              .row(static_cast<Eigen::Index>(component))
-                              .dot(filtered_force);
-      const double missed = window_mean_acceleration(own.derivative[episode].col(state), held[p], start) - seen;
-      if (!std::isfinite(missed)) continue;
-      smear += missed * missed;
+      // What the filter smears: the window's mean of the model's acceleration against the model's
+      // acceleration at x_t under the window's mean control (0 when nothing but the control changes).
       const Vector filtered_u = u * continuous[p];
       model.evaluate(e.x.row(t).transpose(), filtered_u, xdot, &jac, *workspace);
+      smear += std::pow(own[episode].col(state).segment(start, window).dot(continuous[p]) - xdot(state), 2);
       hold += std::pow(jac.fu.row(state).dot(du), 2);
       applied += std::pow(jac.fu.row(state).dot(e.u.row(t)), 2);
       const double noise = jac.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
@@ -369,7 +308,6 @@ StateRatio state_ratio(const Dynamics& model, const std::vector<GeneralisedCoord
                                 : (e1_squared > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
   out.control_error = eid_squared > 0.0 ? std::sqrt(hold_mse / eid_squared) : 0.0;
   out.smear_error = eid_squared > 0.0 ? std::sqrt(smear_mse / eid_squared) : 0.0;
-  out.smear = std::sqrt(smear_mse);
   out.misfit = applied > 0.0 ? std::sqrt((smear + hold) / applied) : std::numeric_limits<double>::infinity();
   return out;
 }
@@ -542,18 +480,17 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
     if (!segments.empty()) window = std::max(window, choose_derivative_window(segments, facts.dt, 2).window);
   }
   facts.ratio = std::numeric_limits<double>::infinity();
-  const ModelSamples own = window > 0 ? model_samples(*dynamics, coordinates, data) : ModelSamples();
-  for (std::size_t c = 0; c < coordinates.size(); ++c) {
+  const std::vector<Matrix> own = window > 0 ? model_derivatives(*dynamics, data) : std::vector<Matrix>();
+  for (const GeneralisedCoordinate& c : coordinates) {
     if (window == 0) break;
-    const StateRatio r = state_ratio(*dynamics, coordinates, data, own, c, facts.dt, window);
-    const std::string name = data.system.states[static_cast<std::size_t>(coordinates[c].velocity)].name;
+    const StateRatio r = state_ratio(*dynamics, data, own, c.velocity, facts.dt, window);
+    const std::string name = data.system.states[static_cast<std::size_t>(c.velocity)].name;
     if (r.ratio < facts.ratio || facts.ratio_state.empty()) {
       facts.ratio = r.ratio;
       facts.ratio_state = name;
       facts.acceleration_window = r.window;
       facts.control_error = r.control_error;
       facts.smear_error = r.smear_error;
-      facts.smear = r.smear;
     }
     if (r.misfit > facts.misfit || facts.misfit_state.empty()) {
       facts.misfit = r.misfit;
@@ -570,13 +507,13 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
     return choice;
   }
   const std::string measured = fmt::format(
-      "{}: acceleration window of {} samples at {:.4g} Hz; of its mean squared error {:.0f}% from what filtering the "
-      "model's forces misses within the window, {:.0f}% from not knowing how the controls are held",
+      "{}: acceleration window of {} samples at {:.4g} Hz; of its mean squared error {:.0f}% from the motion within "
+      "the window, {:.0f}% from not knowing how the controls are held",
       facts.ratio_state, facts.acceleration_window, 1.0 / facts.dt, 100.0 * facts.smear_error * facts.smear_error,
       100.0 * facts.control_error * facts.control_error);
   const std::string misfit = fmt::format(
-      "the filter's misfit on the model (what filtering its forces misses within the acceleration window of {} "
-      "samples, and the controls' hold) is {:.3g}% of the force the controls apply on {} (at most {:g}%)",
+      "the filter's misfit on the model (the motion within the acceleration window of {} samples and the controls' "
+      "hold) is {:.2g}% of the force the controls apply on {} (at most {:g}%)",
       facts.acceleration_window, 100.0 * facts.misfit, facts.misfit_state, 100.0 * kFilterMisfit);
   if (estimated) {
     if (facts.misfit <= kFilterMisfit) {

@@ -45,64 +45,51 @@
 ///                                           accelerations.hpp; the estimate has no bias against the
 ///                                           window's mean acceleration, which is what the filtered
 ///                                           residual compares),
-///                + mean_t a_s,t^2           what parallel filtering misses of the model,
+///                + mean_t a_s,t^2           what the filter smears,
 ///                + mean_t a_h,t^2           what the data cannot tell about the controls' hold,
 ///                + |m|^2 mean_t |b_v o sigma_u|^2   and the controls' noise seen through the filter;
-///       a_s,t  = (1/dt) sum_s k_s dv_s - W_v(x_t) sum_r m_r g_r,   g_r = W_v(x_r)^-1 f_v(x_r, u_r):
-///                                           the acceleration estimate of the model's own velocity
-///                                           increments dv_s over the window's steps (k_s their weights,
-///                                           acceleration_weights with a held control; each increment
-///                                           from the model's accelerations at the samples by the cubic
-///                                           through the four around the step, good to O(dt^4)) against
-///                                           the model's whole generalised force seen through the
-///                                           weights m, in acceleration units at x_t: the residual the
-///                                           filtered criterion leaves on a true model. Two things are
-///                                           left: the inertia's change over the window (W_v(x_t)
-///                                           against W_v(x_r)) and the trapezoid the weights apply to
-///                                           a continuous signal (4.3% of a sinusoid's acceleration at 9
-///                                           samples a period); a force that changes within the window,
-///                                           a friction's reversal included, is filtered exactly;
+///       a_s,t  = sum_r m_r f_v(x_r, u_r) - f_v(x_t, sum_r m_r u_r), the window's mean of the model's
+///                                           acceleration against the model's acceleration at x_t
+///                                           under the window's mean control: the residual the
+///                                           filtered criterion would leave on a true model, zero when
+///                                           only the control changes within the window;
 ///       a_h,t  = b_v(x_t) ((m - m_0) * u)_t,  m and m_0 the weights of acceleration_weights for a
 ///                                           continuous control and for one held over each step, at
 ///                                           the window's centre.
 ///
-///     The inverse-dynamics residual sees the model's forces, the controls among them, through the
-///     weights the acceleration estimate puts on the accelerations (parallel filtering,
-///     accelerations.hpp), so a force that changes within the window costs nothing as long as the
-///     inertia barely changes over it and the weights integrate the motion (a_s), and the control is
-///     the signal the weights assume (a_h: the filter assumes a continuous one, measured torques; a
-///     command held over each step differs from that by half a sample at every change, which an input
-///     delay of half a step would absorb).
+///     The inverse-dynamics residual sees the controls through the weights the acceleration estimate
+///     puts on the accelerations (parallel filtering, accelerations.hpp), so a control that changes
+///     within the window costs nothing as long as the state barely moves over it (a_s) and the
+///     control is the signal the weights assume (a_h: the filter assumes a continuous one, measured
+///     torques; a command held over each step differs from that by half a sample at every change).
 ///     sigma_v is estimated from the velocity column itself and a_s, a_h from the model at the
 ///     measured states, so rho depends on the noise, the sampling rate and the motion only through
-///     the data. On the two-link arm at 1 kHz with smooth measured torques rho = 17.8, and the actual
-///     ratio of the two residuals' errors under the true model is 20.5 (the rms of a_s there is within
-///     1% of the residual the criterion leaves on noise-free data of the same motion; a force taken at
-///     the window's centre alone would leave 2.4 times as much); with the torques held for 20 ms
-///     rho = 2.23 (actual 2.05); the cart-pole test data (50 Hz, held 5 samples) give 0.21
-///     (tests/experiments/criterion_choice_test.cpp).
+///     the data. On the two-link arm at 1 kHz with smooth measured torques rho = 10.9, and the actual
+///     ratio of the two residuals' errors under the true model is 11.5; with the torques held for
+///     20 ms rho = 2.23 (actual 2.0); on the two-link arm's 50 Hz command-line data (held commands,
+///     a window of 173 samples) the motion within the window gives 0.46; the cart-pole test data
+///     (50 Hz, held 5 samples) give 0.21; the cart-pole loop's rollouts of 16 samples at 20 Hz, where
+///     most samples lie within a window of an end, 2.76 (tests/experiments/criterion_choice_test.cpp,
+///     loop_diagnosis_test.cpp).
 ///
 ///     eps, per velocity state v, the largest over them, at the window w above:
 ///
 ///       eps^2 = (mean_t a_s,t^2 + mean_t a_h,t^2) / mean_t |b_v(x_t) u_t|^2
 ///
-///     the residual the filtered criterion leaves on a true model (what parallel filtering misses, what
-///     the data cannot tell about the controls' hold) against the force the controls apply, both in
+///     the residual the filtered criterion leaves on a true model (what the filter smears, what the
+///     data cannot tell about the controls' hold) against the force the controls apply, both in
 ///     acceleration units. This residual is systematic, not noise: least squares can put it into any
 ///     candidate effect it correlates with, by up to eps of the applied force, and the instruments do
 ///     not remove it. eps <= 0.03 (eps^2 <= 0.1% of the applied force's variance) bounds that bias at 3%
 ///     of the force. eps does not depend on the noise, which the filter and the instruments deal
 ///     with, but on how fast the data are sampled against the motion and the controls' changes.
-///     Measured (tests/support/ball_drive.hpp, tests/experiments/duffing_diagnosis_test.cpp): 0.0089
-///     and 0.0083 on the heavy and light stand-in drives at 1 kHz (the controls' hold, a command that
+///     Measured (tests/support/ball_drive.hpp, tests/experiments/duffing_diagnosis_test.cpp): 0.011
+///     and 0.009 on the heavy and light stand-in drives at 1 kHz (the controls' hold, a command that
 ///     jitters with the encoder's counts, is nearly all of it), where inverse dynamics finds all three
-///     true effects; 0.0303 on the Duffing stand-in at 100 Hz, nearly all of it the hold of its
-///     commands, held over each step, where inverse dynamics adds an input delay (the half step the
-///     hold amounts to) and simulation, which integrates the held command, does not; 0.22 on an
-///     imported cart-pole log (criterion_choice_test.cpp); 0.39 on the Silverbox at 610 Hz (a 70 Hz
-///     resonance: 9 samples a period); on the Staubli TX40 at 5 kHz (window 359) 0.0086 for the
-///     model without friction, 0.0018 with its stated friction (a dry friction of v0 = 0.01 rad/s on
-///     every joint, whose reversals parallel filtering follows exactly).
+///     true effects; 0.053 on the Duffing stand-in (smear 0.044, hold 0.030), where it adds a
+///     stiffness and an input delay the data do not hold and simulation does not; 0.22 on an imported
+///     cart-pole log (criterion_choice_test.cpp); 0.49 on the Silverbox at 610 Hz (a 70 Hz resonance:
+///     9 samples a period).
 ///
 ///     Why 3: the pure noise ratio of the shortest window (w = 3) is sqrt(2) / (dt G(3)) = 2, so rho >= 3
 ///     needs a longer window, i.e. a signal smooth over several samples; and a factor 3 in error
@@ -193,7 +180,6 @@ struct CriterionFacts {
   int acceleration_window = 0;                ///< its derivative window w [samples]
   double control_error = 0.0;                 ///< sqrt(mean a_h^2) / E_ID there: the hold's share
   double smear_error = 0.0;                   ///< sqrt(mean a_s^2) / E_ID there: the motion's share
-  double smear = 0.0;                         ///< sqrt(mean a_s^2) there [the state's unit / s]
   double misfit = 0.0;                        ///< eps = max over velocity states (0: not measured)
   std::string misfit_state;                   ///< the velocity state of the maximum
   double slowest_period = 0.0;                ///< P of the slowest velocity state [s] (inf: slower than the episodes)
