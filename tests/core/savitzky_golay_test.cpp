@@ -106,6 +106,51 @@ TEST(SavitzkyGolay, WeightsAreTheFitSolvedAtEveryPosition) {
   }
 }
 
+// The second derivative (derivative 2) against closed forms: exact for polynomials of degree <= order
+// at every position; centred weights symmetric; the centred order-2 fit over 3 samples is the
+// central difference (1, -2, 1); and its weights are 2 times row 2 of the fit solved at each position.
+TEST(SavitzkyGolay, SecondDerivativeIsExactForPolynomialsAndIsTheFitsSecondCoefficient) {
+  const double dt = 0.01;
+  for (const auto& [window, order] : std::vector<std::pair<int, int>>{{3, 2}, {7, 2}, {9, 3}, {21, 4}}) {
+    const SavitzkyGolayDerivative sg(window, order, 2);
+    EXPECT_EQ(sg.derivative(), 2);
+    const auto p = [&](double t) {
+      double v = 0.0;
+      for (int k = 0; k <= order; ++k) v += (k + 1.5) * std::pow(t - 0.2, k);
+      return v;
+    };
+    const auto ddp = [&](double t) {
+      double v = 0.0;
+      for (int k = 2; k <= order; ++k) v += k * (k - 1) * (k + 1.5) * std::pow(t - 0.2, k - 2);
+      return v;
+    };
+    const Vector d2y = sg.differentiate(sample(50, dt, p), dt);
+    for (int i = 0; i < 50; ++i)
+      EXPECT_NEAR(d2y(i), ddp(i * dt), 1e-6 * (1.0 + std::abs(ddp(i * dt)))) << "window " << window << " i " << i;
+    const Vector& c = sg.weights(window / 2);
+    for (int i = 0; i < window; ++i) EXPECT_NEAR(c(i), c(window - 1 - i), 1e-12);
+    for (int e = 0; e < window; ++e) {
+      Matrix A(window, order + 1);
+      for (int j = 0; j < window; ++j)
+        for (int k = 0; k <= order; ++k) A(j, k) = std::pow(static_cast<double>(j - e), k);
+      const Vector solved = 2.0 * A.colPivHouseholderQr().solve(Matrix::Identity(window, window)).row(2).transpose();
+      EXPECT_LE((sg.weights(e) - solved).norm(), 1e-9 * solved.norm()) << "window " << window << ", position " << e;
+    }
+  }
+  const SavitzkyGolayDerivative three(3, 2, 2);
+  const Vector& central = three.weights(1);
+  EXPECT_NEAR(central(0), 1.0, 1e-12);
+  EXPECT_NEAR(central(1), -2.0, 1e-12);
+  EXPECT_NEAR(central(2), 1.0, 1e-12);
+  // Centred, order 2 is exact to degree 3 (symmetric weights): t^3 gives 6 t exactly.
+  const SavitzkyGolayDerivative sg(7, 2, 2);
+  const Vector d2y = sg.differentiate(sample(20, dt, [](double t) { return t * t * t; }), dt);
+  for (int i = 3; i < 17; ++i) EXPECT_NEAR(d2y(i), 6.0 * i * dt, 1e-7) << i;
+  EXPECT_NEAR(sg.noise_gain(dt), sg.weights(3).norm() / (dt * dt), 1e-6);
+  EXPECT_THROW(SavitzkyGolayDerivative(5, 1, 2), std::invalid_argument);  // a line has no curvature
+  EXPECT_THROW(SavitzkyGolayDerivative(5, 2, 3), std::invalid_argument);
+}
+
 TEST(SavitzkyGolay, RejectsBadSettingsAndShortSignals) {
   EXPECT_THROW(SavitzkyGolayDerivative(6, 2), std::invalid_argument);
   EXPECT_THROW(SavitzkyGolayDerivative(1, 0), std::invalid_argument);

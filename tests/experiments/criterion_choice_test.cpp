@@ -282,7 +282,7 @@ double actual_ratio(const MeasurementSet& set) {
   const AccelerationEstimate qdd = estimate_accelerations(data, {2, 3}, dt);
   // The inverse-dynamics residual compares the estimate with the model under the controls seen
   // through the same filter (parallel filtering, accelerations.hpp).
-  const Matrix u = filtered_controls(data, data.u, qdd.window, qdd.order);
+  const Matrix u = filtered_controls(data, data.u, qdd.filter());
   const DynamicsPtr arm = spec.build();
   const auto workspace = arm->make_workspace();
   Vector xdot(4);

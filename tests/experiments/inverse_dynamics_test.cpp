@@ -128,7 +128,7 @@ TEST(InverseDynamicsAccelerations, ParallelFilteringSeesTheControlsAsTheEstimate
             filter.differentiate(states[e].col(j), dt).head(rows);
         row += static_cast<std::size_t>(rows);
       }
-      const Matrix filtered = filtered_controls(data, data.u, window, 2, hold);
+      const Matrix filtered = filtered_controls(data, data.u, {window, 2, 1}, hold);
       for (int r = 0; r < data.size(); ++r) {
         EXPECT_NEAR(qdd(r, 0), filtered(r, 0), 1e-8) << "window " << window << " row " << r;
         EXPECT_NEAR(qdd(r, 1), filtered(r, 0) - 2.0 * filtered(r, 1), 1e-8) << "window " << window << " row " << r;
@@ -137,6 +137,59 @@ TEST(InverseDynamicsAccelerations, ParallelFilteringSeesTheControlsAsTheEstimate
       EXPECT_GT((filtered - data.u).cwiseAbs().maxCoeff(), 0.3) << window;
       for (int p = 0; p < window; ++p) EXPECT_NEAR(acceleration_weights(filter, p, hold).sum(), 1.0, 1e-12);
     }
+  }
+}
+
+// The same from positions (accelerations.hpp, derivative 2): a position q' = v, v' = u integrated
+// exactly from random controls, continuous (linear within each step: v gains dt (u_s + u_{s+1}) / 2, q
+// gains dt v_s + dt^2 (u_s / 3 + u_{s+1} / 6)) or held (v gains dt u_s, q gains dt v_s + dt^2 u_s / 2),
+// with only the positions measured. The velocity estimated from the position makes the estimate
+// differentiate the position twice, and that estimate must be the controls seen through the
+// second derivative's weights at every row, the ends included; the weights of the first derivative
+// (the velocity's filter) differ from it by far more.
+TEST(InverseDynamicsAccelerations, ParallelFilteringOfPositionsSeesTheControlsAsTheirSecondDerivativeSees) {
+  const double dt = 0.001;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (const ControlHold hold : {ControlHold::Continuous, ControlHold::ZeroOrder}) {
+    std::vector<Matrix> states, controls;
+    for (const int T : {500, 300}) {
+      Matrix u(T, 1), x(T, 2);
+      for (int s = 0; s < T; ++s) u(s, 0) = (s < T / 3 ? 0.0 : 40.0) + std::sin(0.03 * s) + 0.5 * gauss(rng);  // a step
+      u.row(T - 1) = u.row(T - 2);  // no control after the last row: the filter holds the last one
+      x.row(0) << 0.1, 0.0;
+      for (int s = 0; s + 1 < T; ++s) {
+        const bool held = hold == ControlHold::ZeroOrder;
+        x(s + 1, 1) = x(s, 1) + dt * (held ? u(s, 0) : 0.5 * (u(s, 0) + u(s + 1, 0)));
+        x(s + 1, 0) = x(s, 0) + dt * x(s, 1) +
+                      dt * dt * (held ? 0.5 * u(s, 0) : u(s, 0) / 3.0 + u(s + 1, 0) / 6.0);
+      }
+      states.push_back(x);
+      controls.push_back(u);
+    }
+    Transitions data = transitions_of(states, controls, dt);
+    data.position_of = {-1, 0};  // the velocity (column 1) estimated from its position (column 0)
+    for (const int window : {5, 31}) {
+      const AccelerationFilter filter{window, 2, 2};
+      const SavitzkyGolayDerivative second(window, 2, 2);
+      Vector qdd(data.size());
+      for (std::size_t e = 0, row = 0; e < states.size(); ++e) {
+        const auto rows = static_cast<Eigen::Index>(states[e].rows() - 1);
+        qdd.segment(static_cast<Eigen::Index>(row), rows) = second.differentiate(states[e].col(0), dt).head(rows);
+        row += static_cast<std::size_t>(rows);
+      }
+      const Matrix filtered = filtered_controls(data, data.u, filter, hold);
+      const Matrix of_velocities = filtered_controls(data, data.u, {window, 2, 1}, hold);
+      for (int r = 0; r < data.size(); ++r) EXPECT_NEAR(qdd(r), filtered(r, 0), 1e-6) << "window " << window << " row " << r;
+      EXPECT_GT((of_velocities - filtered).cwiseAbs().maxCoeff(), 1.0) << window;
+      for (int p = 0; p < window; ++p) EXPECT_NEAR(acceleration_weights(second, p, hold).sum(), 1.0, 1e-12);
+    }
+    // estimate_accelerations takes the positions by itself, and its estimate is the same.
+    const AccelerationEstimate estimate = estimate_accelerations(data, {1}, dt);
+    EXPECT_EQ(estimate.derivative, 2);
+    EXPECT_EQ(estimate.differentiated_states, std::vector<int>{0});
+    const Matrix filtered = filtered_controls(data, data.u, estimate.filter(), hold);
+    EXPECT_LT((estimate.qdd.col(0) - filtered.col(0)).cwiseAbs().maxCoeff(), 1e-6);
   }
 }
 
@@ -850,7 +903,7 @@ TEST(InverseDynamicsFit, LinearForcesFitAsLeastSquaresOfTheResidualOnTheirRegres
   const LibraryEffect viscous = find_candidate(c.model, "joint_viscous_damping:shoulder");
   const int window = c.criterion->inverse_dynamics()->acceleration_window();
   ASSERT_GT(window, 1);
-  const Matrix seen = filtered_at(data, data.x.col(2), training, window);
+  const Matrix seen = filtered_at(data, data.x.col(2), training, {window, 2, 1});
   Matrix X = Matrix::Zero(r0.size(), 1);
   for (std::size_t i = 0; i < training.size(); ++i)
     X(static_cast<Eigen::Index>(i) * k, 0) = -std::sqrt(c.weights(0)) * seen(static_cast<Eigen::Index>(i), 0);
@@ -976,7 +1029,7 @@ DampingFits fit_damping_both_ways(double velocity_noise, unsigned seed) {
   // theta = Z'r0 / Z'J on the training rows.
   const std::vector<int> training = data.rows(false);
   const Vector r0 = weighted_residual_of(base.model, ls, training);
-  const Matrix seen = filtered_at(data, data.x.col(2), training, ls.criterion->inverse_dynamics()->acceleration_window());
+  const Matrix seen = filtered_at(data, data.x.col(2), training, ls.criterion->inverse_dynamics()->acceleration_filter());
   double zr = 0.0, zj = 0.0;
   for (std::size_t k = 0; k < training.size(); ++k) {
     const int t = training[k];
@@ -1031,7 +1084,7 @@ TEST(InverseDynamicsFit, InstrumentsFromTheSimulatedModelRemoveTheNoiseBiasOfLea
   std::vector<int> training;
   for (int t = 0; t < clean.size(); ++t)
     if (clean.episode[static_cast<std::size_t>(t)] != 2) training.push_back(t);
-  const double S = filtered_at(clean, clean.x.col(2), training, window).squaredNorm();
+  const double S = filtered_at(clean, clean.x.col(2), training, {window, 2, 1}).squaredNorm();
   const double m2 = acceleration_weights(SavitzkyGolayDerivative(window, 2), window / 2, ControlHold::Continuous).squaredNorm();
   const double lambda = S / (S + static_cast<double>(training.size()) * 0.25 * m2);
   std::printf("means: least squares %.4f (lambda %.4f: expected %.4f), IV %.4f; intervals holding the world's value: "

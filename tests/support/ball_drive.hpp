@@ -90,12 +90,19 @@ inline std::filesystem::path drive_world(const std::filesystem::path& model, con
   return file;
 }
 
+/// How a record begins.
+enum class DriveStart {
+  Tracking,  ///< the carriage on the reference, moving with it: a record of a running machine
+  AtRest,    ///< the carriage at rest at 0 while the reference is not: the loop's step response first
+};
+
 /// `seconds` of the rig's PD loop at 1 kHz, tracking a sum of three sines (5, 3 and 2 cm at 0.5, 1.3 and
 /// 2.9 Hz; `record` shifts their phases, so record 1 is a second trajectory of the same machine), with
 /// the rig's force noise on the motor, simulated by RK4 at 0.25 ms; the log is a CSV with the columns t,
 /// encoder_mm (to the count of 1 um) and command (N / gear), in `dir`.
 inline std::filesystem::path drive_log(const std::filesystem::path& world_file, const std::filesystem::path& dir,
-                                       const DriveRig& rig, double seconds, std::uint64_t seed, int record = 0) {
+                                       const DriveRig& rig, double seconds, std::uint64_t seed, int record = 0,
+                                       DriveStart start = DriveStart::Tracking) {
   const DynamicsPtr world = find_system(world_file.string())->build(Preset::Simulator, {}, {});
   const double dt = 1e-3, count = 1e-6;
   const auto step = make_step_model(world, Integrator::RK4, dt, 4);
@@ -116,6 +123,7 @@ inline std::filesystem::path drive_log(const std::filesystem::path& world_file, 
   };
   Vector x(2), next(2);
   x << reference_at(0.0, false), reference_at(0.0, true);
+  if (start == DriveStart::AtRest) x.setZero();
   double previous = std::round((x(0) - x(1) * dt) / count) * count;  // the encoder one sample earlier
   const auto file = dir / fmt::format("drive_log_{}.csv", record);
   std::ofstream out(file);

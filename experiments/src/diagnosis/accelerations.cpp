@@ -47,6 +47,18 @@ void check_time_steps(const Transitions& data, const RowSegment& segment, double
 
 }  // namespace
 
+DifferentiatedColumns differentiated_columns(const std::vector<int>& position_of, const std::vector<int>& velocity_states) {
+  DifferentiatedColumns out{velocity_states, 1};
+  if (velocity_states.empty() || position_of.empty()) return out;
+  std::vector<int> positions;
+  for (const int v : velocity_states) {
+    const int position = v >= 0 && v < static_cast<int>(position_of.size()) ? position_of[static_cast<std::size_t>(v)] : -1;
+    if (position < 0) return out;
+    positions.push_back(position);
+  }
+  return {positions, 2};
+}
+
 AccelerationEstimate estimate_accelerations(const Transitions& data, const std::vector<int>& velocity_states, double dt,
                                             int order) {
   if (!(std::isfinite(dt) && dt > 0.0))
@@ -67,16 +79,19 @@ AccelerationEstimate estimate_accelerations(const Transitions& data, const std::
 
   AccelerationEstimate out;
   out.velocity_states = velocity_states;
+  const DifferentiatedColumns columns = differentiated_columns(data.position_of, velocity_states);
+  out.differentiated_states = columns.states;
+  out.derivative = columns.derivative;
   out.order = order;
   out.qdd.resize(data.size(), static_cast<Eigen::Index>(velocity_states.size()));
   std::vector<std::vector<Vector>> samples(velocity_states.size());
   for (std::size_t k = 0; k < velocity_states.size(); ++k) {
-    for (const RowSegment& s : segments) samples[k].push_back(column_samples(data, s, velocity_states[k]));
-    out.windows.push_back(choose_derivative_window(samples[k], dt, order));
+    for (const RowSegment& s : segments) samples[k].push_back(column_samples(data, s, columns.states[k]));
+    out.windows.push_back(choose_derivative_window(samples[k], dt, order, columns.derivative));
     out.window = std::max(out.window, out.windows.back().window);
   }
   if (velocity_states.empty()) return out;
-  const SavitzkyGolayDerivative filter(out.window, order);
+  const SavitzkyGolayDerivative filter(out.window, order, columns.derivative);
   for (std::size_t k = 0; k < velocity_states.size(); ++k)
     for (std::size_t s = 0; s < segments.size(); ++s) {
       const Vector derivative = filter.differentiate(samples[k][s], dt);
@@ -86,9 +101,30 @@ AccelerationEstimate estimate_accelerations(const Transitions& data, const std::
   return out;
 }
 
+namespace {
+
+/// acceleration_weights of a second derivative of positions (header): m_r = sum_k c_k beta_{k,r}.
+Vector position_acceleration_weights(const Vector& c, ControlHold hold) {
+  const auto w = static_cast<int>(c.size());
+  Vector m = Vector::Zero(w);
+  for (int k = 1; k < w; ++k) {
+    if (hold == ControlHold::ZeroOrder) {
+      for (int r = 0; r < k; ++r) m(r) += c(k) * (k - r - 0.5);
+      continue;
+    }
+    m(0) += c(k) * (0.5 * k - 1.0 / 6.0);
+    for (int r = 1; r < k; ++r) m(r) += c(k) * (k - r);
+    m(k) += c(k) / 6.0;
+  }
+  return m;
+}
+
+}  // namespace
+
 Vector acceleration_weights(const SavitzkyGolayDerivative& filter, int position, ControlHold hold) {
   const int w = filter.window();
   const Vector& c = filter.weights(position);
+  if (filter.derivative() == 2) return position_acceleration_weights(c, hold);
   // k_s = sum_{j > s} c_j: the weight of the increment from sample s to s + 1 (s = 0 .. w-2).
   Vector k = Vector::Zero(w);  // k(w - 1) = 0: no increment leaves the last sample
   for (int s = w - 2; s >= 0; --s) k(s) = k(s + 1) + c(s + 1);
@@ -98,12 +134,13 @@ Vector acceleration_weights(const SavitzkyGolayDerivative& filter, int position,
   return m;
 }
 
-Matrix filtered_at(const Transitions& data, const Matrix& y, const std::vector<int>& rows, int window, int order,
-                   ControlHold hold) {
+Matrix filtered_at(const Transitions& data, const Matrix& y, const std::vector<int>& rows,
+                   const AccelerationFilter& acceleration_filter, ControlHold hold) {
   if (y.rows() != data.size())
     throw std::invalid_argument(fmt::format(
         "filtered signal: {} rows for {} transitions; expected one per transition", y.rows(), data.size()));
-  const SavitzkyGolayDerivative filter(window, order);
+  const int window = acceleration_filter.window;
+  const SavitzkyGolayDerivative filter(window, acceleration_filter.order, acceleration_filter.derivative);
   std::vector<Vector> weights;
   for (int p = 0; p < window; ++p) weights.push_back(acceleration_weights(filter, p, hold));
   const int h = window / 2;
@@ -143,10 +180,10 @@ Matrix filtered_at(const Transitions& data, const Matrix& y, const std::vector<i
   return out;
 }
 
-Matrix filtered_controls(const Transitions& data, const Matrix& u, int window, int order, ControlHold hold) {
+Matrix filtered_controls(const Transitions& data, const Matrix& u, const AccelerationFilter& filter, ControlHold hold) {
   std::vector<int> rows(static_cast<std::size_t>(data.size()));
   for (std::size_t t = 0; t < rows.size(); ++t) rows[t] = static_cast<int>(t);
-  return filtered_at(data, u, rows, window, order, hold);
+  return filtered_at(data, u, rows, filter, hold);
 }
 
 }  // namespace gpilqg::diagnosis

@@ -55,13 +55,6 @@ std::vector<GeneralisedCoordinate> force_coordinates(const Dynamics& model) {
   return coordinates;
 }
 
-/// The state `<q>` whose velocity the state `<q>_dot` at `velocity` is by its name, -1 when there is none.
-int position_by_name(const SystemSignature& system, int velocity) {
-  const std::string& name = system.states[static_cast<std::size_t>(velocity)].name;
-  if (name.size() <= 4 || !name.ends_with("_dot")) return -1;
-  return index_of(system.states, name.substr(0, name.size() - 4));
-}
-
 /// The velocity states (file comment of the header): the coordinates', else `<q>_dot`, else all.
 std::vector<int> velocity_states(const std::vector<GeneralisedCoordinate>& coordinates, const SystemSignature& system) {
   std::vector<int> out;
@@ -237,11 +230,13 @@ std::vector<Matrix> model_derivatives(const Dynamics& model, const MeasurementSe
   return out;
 }
 
-/// rho of velocity state `state` with the acceleration estimate of window `window` (the one window of
-/// every coordinate, accelerations.hpp); `own` the model's derivatives at the samples (model_derivatives).
+/// rho of velocity state `state` with the acceleration estimate `estimate` (the one filter of every
+/// coordinate, accelerations.hpp) of the column `differentiated` (the state itself or its measured
+/// position); `own` the model's derivatives at the samples (model_derivatives).
 StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own, int state,
-                       double dt, int window) {
+                       int differentiated, double dt, const AccelerationFilter& estimate) {
   const std::vector<Vector> segments = state_segments(data, state);
+  const int window = estimate.window;
   StateRatio out;
   if (segments.empty()) return out;
   // The noise of the controls, which both residuals carry (b_v n_u in acceleration units), the
@@ -255,7 +250,7 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
   }
   out.window = window;
   const int h = window / 2;
-  const SavitzkyGolayDerivative filter(window, 2);
+  const SavitzkyGolayDerivative filter(window, estimate.order, estimate.derivative);
   // The weights on the accelerations at every place in the window (accelerations.hpp), for a
   // continuous control and for one held over each step.
   std::vector<Vector> continuous, held;
@@ -302,8 +297,13 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
   const double n = std::max(1.0, static_cast<double>(count));
   const double hold_mse = hold / n, smear_mse = smear / n, shared_mse = shared / n;
   const double sigma = robust_noise_std(segments, 2, 4);
+  // The estimate's own noise: that of the column it differentiates, through its weights.
+  const double sigma_differentiated =
+      differentiated == state ? sigma : robust_noise_std(state_segments(data, differentiated), 2, 4);
+  const double step = estimate.derivative == 2 ? dt * dt : dt;
   const double e1_squared = 2.0 * sigma * sigma / (dt * dt) + shared_mse;
-  const double eid_squared = sigma * sigma * gain / n / (dt * dt) + smear_mse + hold_mse + filtered_noise / n;
+  const double eid_squared = sigma_differentiated * sigma_differentiated * gain / n / (step * step) + smear_mse +
+                             hold_mse + filtered_noise / n;
   out.ratio = eid_squared > 0.0 ? std::sqrt(e1_squared / eid_squared)
                                 : (e1_squared > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
   out.control_error = eid_squared > 0.0 ? std::sqrt(hold_mse / eid_squared) : 0.0;
@@ -343,12 +343,9 @@ std::string names(const std::vector<std::string>& list) { return fmt::format("{}
 /// position that drifts (no finite period) says nothing of the oscillation, and the velocity's own is
 /// kept.
 MotionPeriod velocity_period(const MeasurementSet& data, int velocity) {
-  const auto estimated = [&](int state) {
-    const std::string& name = data.system.states[static_cast<std::size_t>(state)].name;
-    return std::find(data.estimated_states.begin(), data.estimated_states.end(), name) != data.estimated_states.end();
-  };
-  const int position = position_by_name(data.system, velocity);
-  if (position >= 0 && estimated(velocity) && !estimated(position)) {
+  const std::vector<int> positions = estimated_velocity_positions(data);
+  const int position = positions.empty() ? -1 : positions[static_cast<std::size_t>(velocity)];
+  if (position >= 0) {
     const MotionPeriod of_position = motion_period(data, position);
     if (!of_position.still && std::isfinite(of_position.period)) return of_position;
   }
@@ -473,17 +470,26 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
                                 facts.not_forces);
     return choice;
   }
-  // The one window of the acceleration estimate: the widest of the coordinates' own (accelerations.hpp).
-  int window = 0;
-  for (const GeneralisedCoordinate& c : coordinates) {
-    const std::vector<Vector> segments = state_segments(data, c.velocity);
-    if (!segments.empty()) window = std::max(window, choose_derivative_window(segments, facts.dt, 2).window);
+  // The one filter of the acceleration estimate: of the velocities, or of the measured positions when
+  // every velocity was estimated from its position; the widest of the coordinates' own windows
+  // (accelerations.hpp).
+  std::vector<int> coordinate_velocities;
+  for (const GeneralisedCoordinate& c : coordinates) coordinate_velocities.push_back(c.velocity);
+  const DifferentiatedColumns columns = differentiated_columns(estimated_velocity_positions(data), coordinate_velocities);
+  AccelerationFilter filter{0, 2, columns.derivative};
+  for (const int column : columns.states) {
+    const std::vector<Vector> segments = state_segments(data, column);
+    if (!segments.empty())
+      filter.window =
+          std::max(filter.window, choose_derivative_window(segments, facts.dt, filter.order, filter.derivative).window);
   }
+  facts.acceleration_derivative = filter.derivative;
   facts.ratio = std::numeric_limits<double>::infinity();
-  const std::vector<Matrix> own = window > 0 ? model_derivatives(*dynamics, data) : std::vector<Matrix>();
-  for (const GeneralisedCoordinate& c : coordinates) {
-    if (window == 0) break;
-    const StateRatio r = state_ratio(*dynamics, data, own, c.velocity, facts.dt, window);
+  const std::vector<Matrix> own = filter.window > 0 ? model_derivatives(*dynamics, data) : std::vector<Matrix>();
+  for (std::size_t i = 0; i < coordinates.size(); ++i) {
+    if (filter.window == 0) break;
+    const GeneralisedCoordinate& c = coordinates[i];
+    const StateRatio r = state_ratio(*dynamics, data, own, c.velocity, columns.states[i], facts.dt, filter);
     const std::string name = data.system.states[static_cast<std::size_t>(c.velocity)].name;
     if (r.ratio < facts.ratio || facts.ratio_state.empty()) {
       facts.ratio = r.ratio;
@@ -512,9 +518,10 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
       facts.ratio_state, facts.acceleration_window, 1.0 / facts.dt, 100.0 * facts.smear_error * facts.smear_error,
       100.0 * facts.control_error * facts.control_error);
   const std::string misfit = fmt::format(
-      "the filter's misfit on the model (the motion within the acceleration window of {} samples and the controls' "
+      "the filter's misfit on the model (the motion within the acceleration window of {} samples{} and the controls' "
       "hold) is {:.2g}% of the force the controls apply on {} (at most {:g}%)",
-      facts.acceleration_window, 100.0 * facts.misfit, facts.misfit_state, 100.0 * kFilterMisfit);
+      facts.acceleration_window, facts.acceleration_derivative == 2 ? " on the measured positions" : "",
+      100.0 * facts.misfit, facts.misfit_state, 100.0 * kFilterMisfit);
   if (estimated) {
     if (facts.misfit <= kFilterMisfit) {
       choice.criterion = FitCriterion::InverseDynamics;

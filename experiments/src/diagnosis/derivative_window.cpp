@@ -39,12 +39,14 @@ double centred_estimate(const Vector& c, const Vector& y, Eigen::Index i) {
 
 /// R_hat(w) of the file comment with the noise level `sigma`; +inf when no sample has both filters
 /// centred.
-double estimated_risk(const std::vector<Vector>& segments, double dt, int order, int window, double sigma) {
+double estimated_risk(const std::vector<Vector>& segments, double dt, int order, int derivative, int window,
+                      double sigma) {
   const int needed = shortest_differentiable_segment(order);
-  const double noise_variance = sigma * sigma / (dt * dt);  // per unit squared weight
-  const SavitzkyGolayDerivative filter(window, order);
+  const double step = derivative == 2 ? dt * dt : dt;
+  const double noise_variance = sigma * sigma / (step * step);  // per unit squared weight
+  const SavitzkyGolayDerivative filter(window, order, derivative);
   // The reference: degree order + 2 on the same window (or the shortest it has).
-  const SavitzkyGolayDerivative reference(std::max(window, needed), order + 2);
+  const SavitzkyGolayDerivative reference(std::max(window, needed), order + 2, derivative);
   const int half = reference.window() / 2;
   const Vector c = centred_weights(filter, half);
   const Vector difference = c - centred_weights(reference, half);
@@ -52,7 +54,7 @@ double estimated_risk(const std::vector<Vector>& segments, double dt, int order,
   Eigen::Index count = 0;
   for (const Vector& y : segments)
     for (Eigen::Index i = half; i + half < y.size(); ++i) {
-      const double d = centred_estimate(difference, y, i) / dt;
+      const double d = centred_estimate(difference, y, i) / step;
       sum += d * d;
       ++count;
     }
@@ -84,10 +86,13 @@ double difference_noise_std(const std::vector<Vector>& segments) {
 
 int shortest_differentiable_segment(int order) { return smallest_window(order + 2); }
 
-DerivativeWindow choose_derivative_window(const std::vector<Vector>& segments, double dt, int order) {
+DerivativeWindow choose_derivative_window(const std::vector<Vector>& segments, double dt, int order, int derivative) {
   if (!(std::isfinite(dt) && dt > 0.0))
     throw std::invalid_argument(fmt::format("derivative window: dt = {}; expected a finite positive step", dt));
-  if (order < 1) throw std::invalid_argument(fmt::format("derivative window: order {}; expected >= 1", order));
+  if (derivative < 1 || derivative > 2)
+    throw std::invalid_argument(fmt::format("derivative window: derivative {}; expected 1 or 2", derivative));
+  if (order < derivative)
+    throw std::invalid_argument(fmt::format("derivative window: order {}; expected >= {}", order, derivative));
   if (segments.empty()) throw std::invalid_argument("derivative window: no samples");
   const int needed = shortest_differentiable_segment(order);
   Eigen::Index shortest = std::numeric_limits<Eigen::Index>::max();
@@ -105,18 +110,19 @@ DerivativeWindow choose_derivative_window(const std::vector<Vector>& segments, d
 
   DerivativeWindow best;
   best.order = order;
+  best.derivative = derivative;
   best.noise_std = sigma;
   best.risk = std::numeric_limits<double>::infinity();
   int candidates = 0;
   for (int h = smallest_window(order) / 2; 2 * h + 1 <= shortest;
        h = std::max(h + 1, static_cast<int>(std::lround(1.2 * h)))) {
-    const double risk = estimated_risk(segments, dt, order, 2 * h + 1, sigma);
+    const double risk = estimated_risk(segments, dt, order, derivative, 2 * h + 1, sigma);
     if (!std::isfinite(risk)) break;
     ++candidates;
     if (risk < best.risk) {
       best.window = 2 * h + 1;
       best.risk = risk;
-      best.noise_gain = SavitzkyGolayDerivative(2 * h + 1, order).noise_gain(dt);
+      best.noise_gain = SavitzkyGolayDerivative(2 * h + 1, order, derivative).noise_gain(dt);
     } else if (risk > 4.0 * best.risk) {
       break;
     }

@@ -28,6 +28,26 @@ std::vector<int> heldout_episodes(const MeasurementSet& set, double fraction) {
   return heldout_indices(count, fraction);
 }
 
+int position_by_name(const SystemSignature& system, int velocity) {
+  const std::string& name = system.states[static_cast<std::size_t>(velocity)].name;
+  if (name.size() <= 4 || !name.ends_with("_dot")) return -1;
+  return index_of(system.states, name.substr(0, name.size() - 4));
+}
+
+std::vector<int> estimated_velocity_positions(const MeasurementSet& set) {
+  if (set.estimated_states.empty()) return {};
+  const auto estimated = [&](int state) {
+    const std::string& name = set.system.states[static_cast<std::size_t>(state)].name;
+    return std::find(set.estimated_states.begin(), set.estimated_states.end(), name) != set.estimated_states.end();
+  };
+  std::vector<int> out(set.system.states.size(), -1);
+  for (int v = 0; v < static_cast<int>(out.size()); ++v) {
+    const int position = position_by_name(set.system, v);
+    if (position >= 0 && estimated(v) && !estimated(position)) out[static_cast<std::size_t>(v)] = position;
+  }
+  return out;
+}
+
 Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& heldout, double dt) {
   const auto n = static_cast<Eigen::Index>(set.system.states.size());
   const auto m = static_cast<Eigen::Index>(set.system.controls.size());
@@ -63,6 +83,7 @@ Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& 
     }
     row += steps;
   }
+  out.position_of = estimated_velocity_positions(set);
   return out;
 }
 

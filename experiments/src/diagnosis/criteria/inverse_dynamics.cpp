@@ -26,7 +26,7 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(F
   out->reach_ = estimate.window / 2;
   // Parallel filtering: the controls and the model's forces seen through the acceleration
   // estimate's weights (accelerations.hpp, force_residual).
-  out->window_ = estimate.window;
+  out->filter_ = estimate.filter();
   const std::vector<int> rows = all_rows(data);
   const ForceResidualParts parts = out->force_residual_parts(c.model, data, rows);
   c.residual = parts.inertial - parts.forces;
@@ -70,7 +70,7 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::with_i
 std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::at_instruments() const {
   std::shared_ptr<InverseDynamicsCriterion> out(new InverseDynamicsCriterion(*this));
   if (instruments_) out->accelerations_ = instruments_->accelerations;
-  out->window_ = 0;
+  out->filter_.window = 0;
   out->instruments_ = nullptr;
   return out;
 }
@@ -83,7 +83,7 @@ InverseDynamicsCriterion::ForceResidualParts InverseDynamicsCriterion::force_res
     const ModelSpec& model, const Transitions& data, const std::vector<int>& rows) const {
   const DynamicsPtr system = model.build();
   const Matrix u = applied_controls(data, model.input_delay);
-  if (window_ == 0) {
+  if (filter_.window == 0) {
     GeneralisedForceParts parts = generalised_force_parts(*system, data, u, *accelerations_, rows);
     ForceResidualParts out{std::move(parts.inertial), -parts.forces, Matrix()};
     out.forces_at_rows = out.forces;
@@ -92,7 +92,7 @@ InverseDynamicsCriterion::ForceResidualParts InverseDynamicsCriterion::force_res
   // Both terms at every row a window of `rows` reaches, from one evaluation per row; the forces
   // then seen through the weights.
   const GeneralisedForceParts parts = generalised_force_parts(*system, data, u, *accelerations_, all_rows(data));
-  return {rows_of(parts.inertial, rows), -filtered_at(data, parts.forces, rows, window_), -rows_of(parts.forces, rows)};
+  return {rows_of(parts.inertial, rows), -filtered_at(data, parts.forces, rows, filter_), -rows_of(parts.forces, rows)};
 }
 
 Matrix InverseDynamicsCriterion::force_residual(const ModelSpec& model, const Transitions& data,
@@ -102,7 +102,7 @@ Matrix InverseDynamicsCriterion::force_residual(const ModelSpec& model, const Tr
 }
 
 Matrix InverseDynamicsCriterion::filtered(const Transitions& data, const Matrix& y, const std::vector<int>& rows) const {
-  return window_ > 0 ? filtered_at(data, y, rows, window_) : rows_of(y, rows);
+  return filter_.window > 0 ? filtered_at(data, y, rows, filter_) : rows_of(y, rows);
 }
 
 Matrix InverseDynamicsCriterion::residual(const ModelSpec& model, const FitContext& c, int* diverged) const {
@@ -155,11 +155,13 @@ double InverseDynamicsCriterion::flexible_share(const ModelSpec& model, const On
 
 std::string InverseDynamicsCriterion::description(double, int) const {
   std::string out =
-      "criterion: inverse dynamics, the generalised-force residual M(q) qdd - h(q, qdot, u) with qdd a zero-phase "
-      "derivative of the measured velocities";
-  if (window_ > 0)
+      fmt::format("criterion: inverse dynamics, the generalised-force residual M(q) qdd - h(q, qdot, u) with qdd a "
+                  "zero-phase {}",
+                  filter_.derivative == 2 ? "second derivative of the measured positions (the velocities were estimated)"
+                                          : "derivative of the measured velocities");
+  if (filter_.window > 0)
     out += fmt::format(" (Savitzky-Golay window of {} samples, the controls and the model's forces seen through the same "
-                       "weights)", window_);
+                       "weights)", filter_.window);
   if (noise_.size() > 0) {
     std::string noise, left;
     for (Eigen::Index i = 0; i < noise_.size(); ++i) {

@@ -47,7 +47,10 @@
 ///                                           residual compares),
 ///                + mean_t a_s,t^2           what the filter smears,
 ///                + mean_t a_h,t^2           what the data cannot tell about the controls' hold,
-///                + |m|^2 mean_t |b_v o sigma_u|^2   and the controls' noise seen through the filter;
+///                + |m|^2 mean_t |b_v o sigma_u|^2   and the controls' noise seen through the filter
+///                                           (when the accelerations come from the measured positions,
+///                                           accelerations.hpp, sigma_q^2 mean_t |c_t|^2 / dt^4 for the
+///                                           first term, sigma_q the positions' noise);
 ///       a_s,t  = sum_r m_r f_v(x_r, u_r) - f_v(x_t, sum_r m_r u_r), the window's mean of the model's
 ///                                           acceleration against the model's acceleration at x_t
 ///                                           under the window's mean control: the residual the
@@ -178,6 +181,7 @@ struct CriterionFacts {
   double ratio = 0.0;                         ///< rho = min over velocity states of E_1 / E_ID (0: not measured)
   std::string ratio_state;                    ///< the velocity state of the minimum
   int acceleration_window = 0;                ///< its derivative window w [samples]
+  int acceleration_derivative = 1;            ///< 1: of the velocities; 2: of the measured positions (accelerations.hpp)
   double control_error = 0.0;                 ///< sqrt(mean a_h^2) / E_ID there: the hold's share
   double smear_error = 0.0;                   ///< sqrt(mean a_s^2) / E_ID there: the motion's share
   double misfit = 0.0;                        ///< eps = max over velocity states (0: not measured)

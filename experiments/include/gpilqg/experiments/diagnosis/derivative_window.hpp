@@ -58,6 +58,10 @@
 /// longer for noisier data, shorter for faster signals, and 10^(1/7) = 1.39 times shorter at ten
 /// times the sampling rate for the same noise per sample.
 ///
+/// The second derivative (derivative 2: the accelerations from measured positions, accelerations.hpp)
+/// is chosen the same way, with dt^2 for dt: R(w) = sigma^2 |c^w|^2 / dt^4 + mean_i b_w(i)^2, the
+/// reference of degree p + 2 on the same window.
+///
 /// Assumptions: white noise on the samples (a velocity computed from encoder positions by
 /// differences has correlated noise, for which sigma_hat^2 |c|^2 misstates the noise term), a uniform
 /// step, and one window for all segments of the signal.
@@ -72,9 +76,10 @@ namespace gpilqg::diagnosis {
 struct DerivativeWindow {
   int window = 0;           ///< w, odd: the centred least-squares fit spans w samples, (w - 1) dt seconds
   int order = 0;            ///< p, the degree of the fitted polynomial
+  int derivative = 1;       ///< 1: dy/dt; 2: d^2y/dt^2
   double noise_std = 0.0;   ///< sigma_hat, the estimated noise of the samples (units of y)
-  double noise_gain = 0.0;  ///< G(w) = |c^w| / dt [1/s]: derivative noise per unit sample noise
-  double risk = 0.0;        ///< R_hat(w), the estimated mean squared error of the derivative [(units of y / s)^2]
+  double noise_gain = 0.0;  ///< G(w) = |c^w| / dt^d [1/s^d]: derivative noise per unit sample noise
+  double risk = 0.0;        ///< R_hat(w), the estimated mean squared error of the derivative [(units of y / s^d)^2]
   int candidates = 0;       ///< windows whose risk was estimated
 };
 
@@ -87,10 +92,12 @@ double difference_noise_std(const std::vector<Vector>& segments);
 /// shortest window of the reference differentiator (order + 3, rounded up to an odd number).
 int shortest_differentiable_segment(int order);
 
-/// The window of least R_hat (file comment) for differentiating `segments` (each uniformly sampled at
-/// `dt`) with Savitzky-Golay fits of degree `order`. Throws std::invalid_argument for dt not finite
-/// and positive, order < 1, no segment, or a segment shorter than shortest_differentiable_segment
+/// The window of least R_hat (file comment) for the `derivative`-th derivative (1 or 2) of `segments`
+/// (each uniformly sampled at `dt`) by Savitzky-Golay fits of degree `order`. Throws
+/// std::invalid_argument for dt not finite and positive, a derivative other than 1 or 2, order below
+/// the derivative, no segment, or a segment shorter than shortest_differentiable_segment
 /// (naming its index in `segments` and its length), or a sample that is not finite.
-DerivativeWindow choose_derivative_window(const std::vector<Vector>& segments, double dt, int order = 2);
+DerivativeWindow choose_derivative_window(const std::vector<Vector>& segments, double dt, int order = 2,
+                                          int derivative = 1);
 
 }  // namespace gpilqg::diagnosis

@@ -23,6 +23,10 @@ struct Transitions {
   Vector t;                   ///< N, time of x
   std::vector<int> episode;   ///< N, index of the episode in MeasurementSet::episodes
   std::vector<bool> heldout;  ///< N, true for rows of held-out episodes
+  /// n or empty (every state measured): for a velocity `<q>_dot` estimated from its measured position
+  /// `<q>` (MeasurementSet::estimated_states, e.g. by `gpilqg data import`), the column of `<q>`; -1
+  /// for every other state (estimated_velocity_positions).
+  std::vector<int> position_of;
   int size() const { return static_cast<int>(x.rows()); }
   /// Indices of the training rows (heldout == false) or of the held-out rows.
   std::vector<int> rows(bool heldout_rows) const;
@@ -34,7 +38,15 @@ struct Transitions {
 /// Throws std::invalid_argument when the set has fewer than 2 episodes or fraction is outside (0, 1).
 std::vector<int> heldout_episodes(const MeasurementSet& set, double fraction);
 
-/// The transitions of `set`, with held-out rows marked. Throws std::invalid_argument when an episode's
+/// The state `<q>` whose velocity the state `<q>_dot` at `velocity` is by its name, -1 when there is none.
+int position_by_name(const SystemSignature& system, int velocity);
+
+/// Transitions::position_of for `set`: per state, the column of the measured position `<q>` of a
+/// velocity `<q>_dot` in set.estimated_states whose `<q>` is not, else -1; empty when every state was
+/// measured.
+std::vector<int> estimated_velocity_positions(const MeasurementSet& set);
+
+/// The transitions of `set`, with held-out rows marked and the states' provenance (position_of). Throws std::invalid_argument when an episode's
 /// dt differs from `dt` by more than 1e-6 relative (naming the episode and both values).
 Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& heldout, double dt);
 

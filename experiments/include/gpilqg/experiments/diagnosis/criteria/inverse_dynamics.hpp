@@ -5,8 +5,9 @@
 ///
 ///   r_t = W_v(x_t)^-1 (qdd_t - f_v(x_t, u_t)),
 ///
-/// with qdd_t a zero-phase Savitzky-Golay derivative of the measured velocities, one window for every
-/// coordinate (accelerations.hpp), and the model's whole generalised force W_v^-1 f_v (the controls,
+/// with qdd_t a zero-phase Savitzky-Golay derivative of the measured velocities (of the measured
+/// positions, twice, when the velocities were estimated from them), one window for every coordinate
+/// (accelerations.hpp), and the model's whole generalised force W_v^-1 f_v (the controls,
 /// gravity, Coriolis, friction, every effect) seen through the same weights: parallel filtering
 /// (Gautier 1997), which filters the torques and every column of the observation matrix with one
 /// filter. The estimate is the window's mean acceleration; a force evaluated at the window's centre
@@ -21,6 +22,7 @@
 
 #include <memory>
 
+#include "gpilqg/experiments/diagnosis/accelerations.hpp"
 #include "gpilqg/experiments/diagnosis/criteria/criterion.hpp"
 
 namespace gpilqg::diagnosis {
@@ -54,7 +56,9 @@ class InverseDynamicsCriterion final : public Criterion {
   /// h, the half-width of the acceleration estimate's window (the rows one sample's noise reaches).
   int reach() const { return reach_; }
   /// The one window of the acceleration estimate; 0 at the instruments (controls as applied).
-  int acceleration_window() const { return window_; }
+  int acceleration_window() const { return filter_.window; }
+  /// The acceleration estimate's filter (window 0 at the instruments).
+  const AccelerationFilter& acceleration_filter() const { return filter_; }
   /// Per force component: the white noise of its residual and the rms of its residual on the
   /// training rows, the two sides of its weight's sigma_i = max(noise_i, left_i) (make).
   const Vector& noise() const { return noise_; }
@@ -108,7 +112,7 @@ class InverseDynamicsCriterion final : public Criterion {
   std::shared_ptr<const Matrix> accelerations_;
   std::shared_ptr<const Matrix> own_force_;  ///< N x k, the base model's generalised force as the residual sees it
   int reach_ = 0;
-  int window_ = 0;
+  AccelerationFilter filter_;
   std::shared_ptr<const Instruments> instruments_;
   Vector noise_, left_;
 };
