@@ -173,13 +173,13 @@ TEST(RealMachineCli, ClosedLoopDriveAtOneKilohertzFindsItsThreeFrictionTerms) {
 
 // The same loop on the scale of an industrial ball-screw axis: 95 kg commanded in volts through a motor
 // constant of 35 N/V, viscous friction 200 N s/m, Coulomb 20 N, a constant -3 N, one record of 25 s
-// that begins with the carriage at rest away from the reference (the loop's step response, some 7 kN
-// within the first samples, as a record started with the machine does). The velocity is estimated by
+// that begins with the carriage at rest 4 cm from the reference (the loop's step response, some 6 kN
+// in the first sample, as a record started with the machine does). The velocity is estimated by
 // the import and the commands are generalised forces sampled fast against the motion, so the defaults
 // take the inverse-dynamics criterion in its instrumental-variable form, as drives are identified
-// (IDIM-IV), on the positions differentiated twice (accelerations.hpp). With the defaults the diagnosis must name the three effects
-// (viscous within 5%, Coulomb within 10%, the constant within 35%: it is 1.5% of the force the loop
-// applies), add no proxy, and its written model must leave on a second record (a new trajectory) a
+// (IDIM-IV), on the positions differentiated twice (accelerations.hpp). With the defaults the
+// diagnosis must name the three effects (viscous within 5%, Coulomb within 10%, the constant within
+// 35%: it is 1.5% of the force the loop applies), add no proxy, and its written model must leave on a second record (a new trajectory) a
 // held-out force residual within 2% of the world's own.
 TEST(RealMachineCli, HeavyDriveWithEstimatedVelocitiesTakesInverseDynamicsAndPredictsASecondRecord) {
   const auto rig = test::DriveRig::heavy();
