@@ -193,44 +193,6 @@ TEST(InverseDynamicsAccelerations, ParallelFilteringOfPositionsSeesTheControlsAs
   }
 }
 
-// standstill_rows against a direct count: a velocity at rest (creeping at 0.1% of the motion's rms
-// speed), a move, a reversal through 0 and rest again; a row stands still exactly when every sample of
-// its window (centred, or the first / last window at the ends) is within 1% of the rms speed. The
-// rests' inner rows are marked, a window that reaches one moving sample is not, and neither is the
-// reversal, whose velocity passes 0 within the window.
-TEST(InverseDynamicsAccelerations, StandstillIsWhereTheWholeWindowRests) {
-  const double dt = 0.001;
-  const int T = 801, window = 21;
-  Matrix x(T, 2);
-  for (int s = 0; s < T; ++s) {
-    double v = 0.001 * std::sin(0.7 * s);  // rest, creeping
-    if (s >= 200 && s < 400) v = std::sin(M_PI * (s - 200) / 200.0);
-    if (s >= 400 && s < 600) v = std::sin(2.0 * M_PI * (s - 400) / 200.0);
-    x(s, 1) = v;
-    x(s, 0) = s == 0 ? 0.0 : x(s - 1, 0) + dt * v;
-  }
-  const Transitions data = transitions_of({x}, {Matrix::Zero(T, 1)}, dt);
-  const auto still = standstill_rows(data, {1}, {window, 2, 2});
-  const double band = kStandstillSpeed * std::sqrt(x.col(1).squaredNorm() / T);
-  ASSERT_GT(band, 0.001) << "the creep must be inside the band for this case";
-  int marked = 0;
-  for (int t = 0; t < data.size(); ++t) {
-    const int start = std::clamp(t - window / 2, 0, T - window);
-    bool rests = true;
-    for (int j = start; j < start + window; ++j) rests = rests && std::abs(x(j, 1)) <= band;
-    EXPECT_EQ(still(t, 0), rests) << "row " << t;
-    marked += rests ? 1 : 0;
-  }
-  EXPECT_TRUE(still(50, 0));
-  EXPECT_TRUE(still(700, 0));
-  EXPECT_FALSE(still(195, 0));  // its window reaches the move's first samples
-  EXPECT_FALSE(still(300, 0));
-  EXPECT_FALSE(still(500, 0));  // the reversal
-  EXPECT_GT(marked, 350);
-  // No filter, no standstill.
-  EXPECT_EQ(standstill_rows(data, {1}, {0, 2, 2}).count(), 0);
-}
-
 // Every column is differentiated with one window, the widest of the columns' own choices: a noisy
 // column beside a clean one sets it for both.
 TEST(InverseDynamicsAccelerations, EveryColumnTakesTheWidestWindow) {
