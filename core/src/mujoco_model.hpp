@@ -83,7 +83,6 @@ class MujocoModel {
 struct MujocoWorkspace final : DynamicsWorkspace {
   MujocoModel::DataPtr data;
   Vector scratch;  ///< nv entries for MujocoSystem::inverse_dynamics_parts
-  Vector forces;   ///< nv entries for MujocoSystem::inverse_dynamics (its second term)
 };
 
 }  // namespace gpilqg

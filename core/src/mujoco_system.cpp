@@ -275,15 +275,6 @@ void MujocoSystem::generalised_force_map(const VectorCRef& x, Matrix& W, std::ve
   }
 }
 
-bool MujocoSystem::inverse_dynamics(const VectorCRef& x, const VectorCRef& u, const VectorCRef& qdd, VectorRef Q,
-                                    DynamicsWorkspace& workspace) const {
-  Vector& forces = workspace_as<MujocoWorkspace>(workspace).forces;
-  forces.resize(model_->m()->nv);
-  if (!inverse_dynamics_parts(x, u, qdd, Q, forces, workspace)) return false;
-  Q += forces;
-  return true;
-}
-
 bool MujocoSystem::inverse_dynamics_parts(const VectorCRef& x, const VectorCRef& u, const VectorCRef& qdd,
                                           VectorRef inertial, VectorRef forces, DynamicsWorkspace& workspace) const {
   const mjModel* m = model_->m();

@@ -516,9 +516,9 @@ TEST(InverseDynamicsResidual, DirectMujocoInverseDynamicsIsTheSolvedForwardDynam
       EXPECT_MATRIX_NEAR(direct.row(t).transpose(), solved.row(t).transpose(), 1e-9 * (1.0 + solved.row(t).norm()));
     const auto& owner = dynamic_cast<const GeneralisedForceInput&>(force_map_system(*system));
     const auto workspace = force_map_system(*system).make_workspace();
-    Vector Q(2);
-    EXPECT_TRUE(owner.inverse_dynamics(data.x.row(0).transpose(), data.u.row(0).transpose(), qdd.row(0).transpose(), Q,
-                                       *workspace));
+    Vector inertial(2), forces(2);
+    EXPECT_TRUE(owner.inverse_dynamics_parts(data.x.row(0).transpose(), data.u.row(0).transpose(),
+                                             qdd.row(0).transpose(), inertial, forces, *workspace));
   }
 }
 

@@ -13,6 +13,7 @@
 #include "gpilqg/core/savitzky_golay.hpp"
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
 #include "gpilqg/experiments/diagnosis/derivative_window.hpp"
+#include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
 #include "gpilqg/experiments/diagnosis/motion_period.hpp"
 
@@ -27,15 +28,9 @@ constexpr int kGainSamples = 8;
 /// Rows at which the control's error in the acceleration estimate is averaged (evenly strided).
 constexpr long kControlErrorRows = 2000;
 
-/// The system whose generalised-force map `model` uses: itself, or the base of an EffectDynamics.
+/// The generalised-force map of the system `model` uses (force_map_owner), or null.
 const GeneralisedForceInput* force_input(const Dynamics& model) {
-  const Dynamics* system = &model;
-  while (true) {
-    if (const auto* input = dynamic_cast<const GeneralisedForceInput*>(system)) return input;
-    const auto* decorated = dynamic_cast<const EffectDynamics*>(system);
-    if (decorated == nullptr) return nullptr;
-    system = &decorated->base();
-  }
+  return dynamic_cast<const GeneralisedForceInput*>(force_map_owner(model));
 }
 
 /// The coordinates of the model's force components, when every component has one (else empty).
@@ -44,10 +39,7 @@ std::vector<GeneralisedCoordinate> force_coordinates(const Dynamics& model) {
   if (input == nullptr) return {};
   std::vector<GeneralisedCoordinate> coordinates(input->generalised_forces().size());
   std::vector<bool> found(coordinates.size(), false);
-  const Dynamics* owner = &model;
-  while (dynamic_cast<const GeneralisedForceInput*>(owner) == nullptr)
-    owner = &dynamic_cast<const EffectDynamics*>(owner)->base();
-  for (const GeneralisedCoordinate& c : generalised_coordinates(*owner)) {
+  for (const GeneralisedCoordinate& c : generalised_coordinates(*force_map_owner(model))) {
     coordinates[static_cast<std::size_t>(c.component)] = c;
     found[static_cast<std::size_t>(c.component)] = true;
   }
@@ -82,14 +74,13 @@ std::pair<const Episode*, Eigen::Index> sample_at(const MeasurementSet& data, lo
 /// linear in their input. False when the system does not compute its actuation or an effect's force
 /// depends on the controls; the caller then takes W_v^-1 df_v/du from the forward Jacobian.
 bool actuation_gain(const Dynamics& model, const VectorCRef& x, const VectorCRef& u, Matrix& G) {
-  const Dynamics* owner = &model;
   double gain = 1.0;
   if (const auto* decorated = dynamic_cast<const EffectDynamics*>(&model)) {
     if (decorated->input_dependent()) return false;
     gain = decorated->actuator_gain();
-    owner = &decorated->base();
   }
-  const auto* input = dynamic_cast<const GeneralisedForceInput*>(owner);
+  const Dynamics* owner = force_map_owner(model);
+  const GeneralisedForceInput* input = force_input(model);
   if (input == nullptr) return false;
   const auto k = static_cast<Eigen::Index>(input->generalised_forces().size());
   const auto workspace = owner->make_workspace();

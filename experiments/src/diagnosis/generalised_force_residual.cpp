@@ -9,10 +9,6 @@
 
 namespace gpilqg::diagnosis {
 
-namespace {
-
-/// The system whose generalised-force map `model` uses: itself, or the base of an EffectDynamics
-/// (effects add forces through the base's map), or null.
 const Dynamics* force_map_owner(const Dynamics& model) {
   const Dynamics* system = &model;
   while (dynamic_cast<const GeneralisedForceInput*>(system) == nullptr) {
@@ -22,8 +18,6 @@ const Dynamics* force_map_owner(const Dynamics& model) {
   }
   return system;
 }
-
-}  // namespace
 
 const Dynamics& force_map_system(const Dynamics& model) {
   const Dynamics* owner = force_map_owner(model);

@@ -54,17 +54,11 @@ class GeneralisedForceInput {
   ///
   /// (k entries) that gives the accelerations `qdd` (one per component, in component order) at
   /// (x, u), where f_v and W_v are the velocity rows of the state derivative and of
-  /// generalised_force_map. Returns false, with Q unspecified, where the system has no direct form
-  /// at (x, u) and the caller must solve W_v Q = qdd - f_v itself; the default always does.
-  virtual bool inverse_dynamics(const VectorCRef& /*x*/, const VectorCRef& /*u*/, const VectorCRef& /*qdd*/,
-                                VectorRef /*Q*/, DynamicsWorkspace&) const {
-    return false;
-  }
-
-  /// The same in its two terms, Q = inertial + forces: inertial = M(q) qdd, the term linear in the
-  /// accelerations, and forces = -h(q, q_dot, u) = -W_v^-1 f_v(x, u), the generalised force at zero
-  /// acceleration (what parallel filtering sees through the acceleration estimate's weights). Returns
-  /// false, with both unspecified, where the system has no direct form; the default always does.
+  /// generalised_force_map, in its two terms, Q = inertial + forces: inertial = M(q) qdd, the term
+  /// linear in the accelerations, and forces = -h(q, q_dot, u) = -W_v^-1 f_v(x, u), the generalised
+  /// force at zero acceleration (what parallel filtering sees through the acceleration estimate's
+  /// weights). Returns false, with both unspecified, where the system has no direct form at (x, u) and
+  /// the caller must solve W_v Q = qdd - f_v itself; the default always does.
   virtual bool inverse_dynamics_parts(const VectorCRef& /*x*/, const VectorCRef& /*u*/, const VectorCRef& /*qdd*/,
                                       VectorRef /*inertial*/, VectorRef /*forces*/, DynamicsWorkspace&) const {
     return false;

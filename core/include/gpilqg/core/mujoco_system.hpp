@@ -80,15 +80,12 @@ class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public
   void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx) const override;
   void generalised_force_map(const VectorCRef& x, Matrix& W, std::vector<Matrix>* d_dx,
                              DynamicsWorkspace& workspace) const override;
-  /// W_v^-1 (qdd - f_v) = M(q) (qdd - qacc) with W = [0; M^-1]; always true. Without constraint rows
-  /// at x (frictionloss, an active limit or contact) f_v = M^-1 (Q_passive + Q_actuator - c), so
-  /// Q = M qdd + c - Q_passive - Q_actuator from MuJoCo's position, velocity and actuation stages and
-  /// one product with M (mj_mulM): no factorisation and no forward solve. With constraint rows their
-  /// forces come from the forward solver: the rest of the forward pass, then M (qdd - qacc).
-  bool inverse_dynamics(const VectorCRef& x, const VectorCRef& u, const VectorCRef& qdd, VectorRef Q,
-                        DynamicsWorkspace& workspace) const override;
-  /// The same in its two terms: M qdd (one product with M) and c - Q_passive - Q_actuator, or with
-  /// constraint rows -M qacc.
+  /// W_v^-1 (qdd - f_v) = M(q) (qdd - qacc) with W = [0; M^-1], in its two terms; always true. Without
+  /// constraint rows at x (frictionloss, an active limit or contact) f_v = M^-1 (Q_passive +
+  /// Q_actuator - c), so the terms are M qdd (one product with M, mj_mulM) and c - Q_passive -
+  /// Q_actuator from MuJoCo's position, velocity and actuation stages: no factorisation and no forward
+  /// solve. With constraint rows their forces come from the forward solver: the rest of the forward
+  /// pass, then -M qacc.
   bool inverse_dynamics_parts(const VectorCRef& x, const VectorCRef& u, const VectorCRef& qdd, VectorRef inertial,
                               VectorRef forces, DynamicsWorkspace& workspace) const override;
   /// MuJoCo's actuator forces in joint space (qfrc_actuator) from the position, velocity and

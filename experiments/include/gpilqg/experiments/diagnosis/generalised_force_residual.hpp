@@ -67,6 +67,8 @@ ForceComponents force_components(const Dynamics& model);
 /// ForceEffect::add_force takes. Throws std::invalid_argument naming the system when it has no
 /// generalised-force map.
 const Dynamics& force_map_system(const Dynamics& model);
+/// The same, or null when `model` has no generalised-force map.
+const Dynamics* force_map_owner(const Dynamics& model);
 
 /// r_t (file comment) for the rows `rows` of `data` (rows.size() x k, in the order of `rows`):
 /// `applied_u` the inputs the model applies at every row of data (N x m, applied_controls) and
