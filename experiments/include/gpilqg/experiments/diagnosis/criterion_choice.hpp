@@ -86,13 +86,13 @@
 ///     not remove it. eps <= 0.03 (eps^2 <= 0.1% of the applied force's variance) bounds that bias at 3%
 ///     of the force. eps does not depend on the noise, which the filter and the instruments deal
 ///     with, but on how fast the data are sampled against the motion and the controls' changes.
-///     Measured (tests/support/ball_drive.hpp, tests/experiments/duffing_diagnosis_test.cpp): 0.011
-///     and 0.009 on the heavy and light stand-in drives at 1 kHz (the controls' hold, a command that
-///     jitters with the encoder's counts, is nearly all of it), where inverse dynamics finds all three
-///     true effects; 0.053 on the Duffing stand-in (smear 0.044, hold 0.030), where it adds a
-///     stiffness and an input delay the data do not hold and simulation does not; 0.22 on an imported
-///     cart-pole log (criterion_choice_test.cpp); 0.49 on the Silverbox at 610 Hz (a 70 Hz resonance:
-///     9 samples a period).
+///     Measured (tests/support/ball_drive.hpp, tests/experiments/duffing_diagnosis_test.cpp), with
+///     the accelerations from the measured positions (accelerations.hpp): 0.0088 and 0.0083 on the
+///     heavy and light stand-in drives at 1 kHz (the controls' hold, a command that jitters with the
+///     encoder's counts, is nearly all of it), where inverse dynamics finds all three true effects;
+///     0.067 on the Duffing stand-in, where it adds a stiffness and an input delay the data do not
+///     hold and simulation does not; 0.15 on an imported cart-pole log (criterion_choice_test.cpp);
+///     0.45 on the Silverbox at 610 Hz (a 70 Hz resonance: 9 samples a period).
 ///
 ///     Why 3: the pure noise ratio of the shortest window (w = 3) is sqrt(2) / (dt G(3)) = 2, so rho >= 3
 ///     needs a longer window, i.e. a signal smooth over several samples; and a factor 3 in error
