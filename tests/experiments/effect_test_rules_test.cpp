@@ -364,6 +364,40 @@ TEST(EffectTest, TwoFitsAreComparedBatchByBatchOnTheSameHeldOutRows) {
   EXPECT_FALSE(compare_heldout(a, b).comparable);
 }
 
+// A criterion that leaves equations out (inverse dynamics at a standstill) leaves batches whose every
+// residual is zero, before and after, on the channels it judges. They are no batches: appended to the
+// eight batches of the closed form above, channel 1's share, half-width (t_{0.975, 7}, K = 8) and z are
+// as without them, while on channel 0, which has equations there, they count. compare_heldout skips
+// them the same way.
+TEST(EffectTest, BatchesWithoutEquationsAreNoBatchesOfTheShareOrTheComparison) {
+  EffectFit f = passing_fit("joint_viscous_friction:joint_2");
+  constexpr int K = 8, still = 4;
+  f.heldout_channel_before.resize(K + still, 2);
+  f.heldout_channel_reduction.resize(K + still, 2);
+  for (int b = 0; b < K + still; ++b) {
+    f.heldout_channel_before.row(b) << 100.0, b < K ? 1.0 : 0.0;
+    f.heldout_channel_reduction.row(b) << 0.0, b < K ? (b % 2 == 0 ? 0.6 : 0.5) : 0.0;
+  }
+  const diagnosis::HeldoutShare own = diagnosis::heldout_share(f, {1});
+  EXPECT_NEAR(own.explained, 0.55, 1e-15);
+  EXPECT_NEAR(own.explained_ci, 2.3646242510103 * std::sqrt(8.0 / 7.0 * 8.0 * 0.0025) / 8.0, 1e-4);  // t_{0.975, 7}
+  const auto [before, reduction] =
+      diagnosis::batches_with_equations(f.heldout_channel_before.col(1), f.heldout_channel_reduction.col(1));
+  EXPECT_EQ(before.size(), K);
+  EXPECT_EQ(reduction.size(), K);
+  EXPECT_EQ(diagnosis::batches_with_equations(f.heldout_channel_before.col(0), f.heldout_channel_reduction.col(0)).first.size(),
+            K + still);
+
+  EffectFit a, b;
+  a.heldout_batch_before = b.heldout_batch_before = (Vector(6) << 1.0, 1.0, 0.0, 1.0, 1.0, 0.0).finished();
+  a.heldout_batch_reduction = (Vector(6) << 0.5, 0.5, 0.0, 0.5, 0.5, 0.0).finished();
+  b.heldout_batch_reduction = (Vector(6) << 0.3, 0.5, 0.0, 0.3, 0.5, 0.0).finished();
+  const HeldoutComparison c = compare_heldout(a, b);
+  ASSERT_TRUE(c.comparable);
+  EXPECT_NEAR(c.difference, 0.1, 1e-15);
+  EXPECT_NEAR(c.difference_ci, 3.182446305284263 * std::sqrt(4.0 / 3.0 * 0.04) / 4.0, 1e-12);  // K = 4, as above
+}
+
 // Inverse dynamics on a real arm: a joint whose torque sensor is quiet (weight 1 / sigma^2) carries a
 // large error of its own, and a friction on another joint removes most of that joint's torque residual
 // but under 1% of the whole. Closed form: two channels, eight batches; channel 0 has 100 per batch and

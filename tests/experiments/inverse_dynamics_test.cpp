@@ -28,6 +28,7 @@
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/instrumental_variables.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
+#include "gpilqg/experiments/diagnosis/residual_analysis.hpp"
 #include "gpilqg/experiments/diagnosis/simulation_error.hpp"
 #include "gpilqg/experiments/diagnosis/student_t.hpp"
 #include "test_support.hpp"
@@ -191,6 +192,78 @@ TEST(InverseDynamicsAccelerations, ParallelFilteringOfPositionsSeesTheControlsAs
     const Matrix filtered = filtered_controls(data, data.u, estimate.filter(), hold);
     EXPECT_LT((estimate.qdd.col(0) - filtered.col(0)).cwiseAbs().maxCoeff(), 1e-6);
   }
+}
+
+// standstill_rows against a direct count: a velocity at rest (creeping at 0.1% of the motion's rms
+// speed), a move, a reversal through 0 and rest again; a row stands still exactly when every sample of
+// its window (centred, or the first / last window at the ends) is within 1% of the rms speed. The
+// rests' inner rows are marked, a window that reaches one moving sample is not, and neither is the
+// reversal, whose velocity passes 0 within the window.
+TEST(InverseDynamicsAccelerations, StandstillIsWhereTheWholeWindowRests) {
+  const double dt = 0.001;
+  const int T = 801, window = 21;
+  Matrix x(T, 2);
+  for (int s = 0; s < T; ++s) {
+    double v = 0.001 * std::sin(0.7 * s);  // rest, creeping
+    if (s >= 200 && s < 400) v = std::sin(M_PI * (s - 200) / 200.0);
+    if (s >= 400 && s < 600) v = std::sin(2.0 * M_PI * (s - 400) / 200.0);
+    x(s, 1) = v;
+    x(s, 0) = s == 0 ? 0.0 : x(s - 1, 0) + dt * v;
+  }
+  const Transitions data = transitions_of({x}, {Matrix::Zero(T, 1)}, dt);
+  const auto still = standstill_rows(data, {1}, {window, 2, 2});
+  const double band = kStandstillSpeed * std::sqrt(x.col(1).squaredNorm() / T);
+  ASSERT_GT(band, 0.001) << "the creep must be inside the band for this case";
+  int marked = 0;
+  for (int t = 0; t < data.size(); ++t) {
+    const int start = std::clamp(t - window / 2, 0, T - window);
+    bool rests = true;
+    for (int j = start; j < start + window; ++j) rests = rests && std::abs(x(j, 1)) <= band;
+    EXPECT_EQ(still(t, 0), rests) << "row " << t;
+    marked += rests ? 1 : 0;
+  }
+  EXPECT_TRUE(still(50, 0));
+  EXPECT_TRUE(still(700, 0));
+  EXPECT_FALSE(still(195, 0));  // its window reaches the move's first samples
+  EXPECT_FALSE(still(300, 0));
+  EXPECT_FALSE(still(500, 0));  // the reversal
+  EXPECT_GT(marked, 350);
+  // No filter, no standstill.
+  EXPECT_EQ(standstill_rows(data, {1}, {0, 2, 2}).count(), 0);
+}
+
+// The GP of the remainder test learns the equations the criterion has. A residual that is sin(3 x) where
+// the coordinate moves and zero where the criterion leaves it out (every third row of a slow stretch,
+// as a standstill is): with the left-out entries passed, the GP is not trained on those zeros, its mean
+// there is exactly 0 (target - mean adds nothing to a score), and at the other rows it is the sine; a
+// GP trained on every row, the zeros included, is pulled towards them.
+TEST(InverseDynamicsRemainder, TheGpOfWhatIsLeftIsNotTrainedOnTheRowsLeftOut) {
+  const int T = 241;
+  Matrix x(T, 2);
+  for (int s = 0; s < T; ++s) x.row(s) << -1.0 + 2.0 * s / (T - 1), 0.0;
+  const Transitions data = transitions_of({x}, {Matrix::Zero(T, 1)}, 0.01);
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> left_out =
+      Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(data.size(), 1, false);
+  Matrix target(data.size(), 1);
+  for (int t = 0; t < data.size(); ++t) {
+    left_out(t, 0) = data.x(t, 0) > 0.0 && t % 3 != 0;
+    target(t, 0) = left_out(t, 0) ? 0.0 : std::sin(3.0 * data.x(t, 0));
+  }
+  GpSettings settings;
+  settings.points = 200;
+  const Matrix masked = gp_column_means(data, target, settings, &left_out);
+  const Matrix every_row = gp_column_means(data, target, settings);
+  double error_masked = 0.0, error_every_row = 0.0;
+  for (int t = 0; t < data.size(); ++t) {
+    if (left_out(t, 0)) {
+      EXPECT_EQ(masked(t, 0), 0.0) << "row " << t;
+      continue;
+    }
+    error_masked = std::max(error_masked, std::abs(masked(t, 0) - target(t, 0)));
+    error_every_row = std::max(error_every_row, std::abs(every_row(t, 0) - target(t, 0)));
+  }
+  EXPECT_LT(error_masked, 0.05);
+  EXPECT_GT(error_every_row, 0.2);  // the zeros beside x > 0 drag the mean from the sine there
 }
 
 // Every column is differentiated with one window, the widest of the columns' own choices: a noisy

@@ -103,7 +103,8 @@ struct DriveFiles {
 };
 
 DriveFiles drive_files(const test::DriveRig& rig, const std::filesystem::path& dir, double seconds, int records,
-                       test::DriveStart first_start = test::DriveStart::Tracking) {
+                       test::DriveStart first_start = test::DriveStart::Tracking,
+                       test::DriveMotion motion = test::DriveMotion::Sines) {
   DriveFiles files;
   const auto model = test::drive_model(test::source_dir(), dir, rig);
   const auto world = test::drive_world(model, dir, rig);
@@ -112,7 +113,7 @@ DriveFiles drive_files(const test::DriveRig& rig, const std::filesystem::path& d
   files.world = "'" + world.string() + "'";
   for (int record = 0; record < records; ++record) {
     const auto log = test::drive_log(world, dir, rig, seconds, 3 + static_cast<std::uint64_t>(record), record,
-                                     record == 0 ? first_start : test::DriveStart::Tracking);
+                                     record == 0 ? first_start : test::DriveStart::Tracking, motion);
     const auto out = dir / fmt::format("drive_{}.h5", record);
     const auto r = test::run_cli("data import '" + log.string() + "' --system " + files.model + " --map '" + map.string() +
                                  "' --out '" + out.string() + "'");
@@ -206,6 +207,43 @@ TEST(RealMachineCli, HeavyDriveWithEstimatedVelocitiesTakesInverseDynamicsAndPre
   const double model_rmse = by_model["ranking"][0]["heldout_rmse_before"].get<double>();
   std::printf("heavy drive, second record: held-out force rmse %.4g N (world) and %.4g N (diagnosed)%s\n", world_rmse,
               model_rmse, found_text(values).c_str());
+  EXPECT_LE(model_rmse, 1.02 * world_rmse);
+}
+
+// The heavy drive on point-to-point moves (ball_drive.hpp point_to_point: 2 m/s^2 up to 0.25 m/s between
+// random positions), at rest for 0.2 to 0.6 s between them, as drives are often excited: some 40% of
+// the record at standstill, where MuJoCo's dry friction (a soft constraint) lets the carriage creep by
+// an encoder count or two while the loop balances the constant force. A friction model's force there
+// turns with velocities far below what the estimate resolves, so the inverse-dynamics criterion leaves
+// those rows out (accelerations.hpp, standstill_rows). With the defaults the diagnosis must leave out
+// at least a fifth of the rows, name the three effects as closely as on the sines, add no proxy, and
+// predict a second record of such moves within 2% of the world's own residual.
+TEST(RealMachineCli, HeavyDriveAtRestBetweenMovesLeavesTheStandstillOutAndFindsItsConstant) {
+  const auto rig = test::DriveRig::heavy();
+  const auto dir = test::temporary_dir("moves_drive");
+  const auto files = drive_files(rig, dir, 25.0, 2, test::DriveStart::Tracking, test::DriveMotion::PointToPoint);
+  const std::string written = "'" + (dir / "diagnosed.toml").string() + "'";
+  const nlohmann::json report =
+      diagnose_json("--system " + files.model + " --data " + files.first + " --auto --write-model " + written);
+  EXPECT_EQ(report["criterion"]["name"], "inverse-dynamics-iv") << report["criterion"].dump();
+  const nlohmann::json& weights = report["criterion"]["weights"];
+  ASSERT_EQ(weights.size(), 1u) << report["criterion"].dump();
+  EXPECT_GT(weights[0]["standstill_rows"].get<long>(), report["samples"].get<long>() / 5) << weights.dump();
+  const auto values = chosen_values(report);
+  const test::DriveTruth& truth = rig.truth;
+  EXPECT_NEAR(chosen(values, kViscous), truth.damping, 0.05 * truth.damping) << found_text(values);
+  EXPECT_NEAR(chosen(values, kCoulomb), truth.friction, 0.1 * truth.friction) << found_text(values);
+  EXPECT_NEAR(chosen(values, kConstant), truth.constant, 0.35 * std::abs(truth.constant)) << found_text(values);
+  expect_no_proxy(values, rig);
+  EXPECT_EQ(values.size(), 3u) << found_text(values);
+
+  const nlohmann::json by_world = diagnose_json("--system " + files.world + " --data " + files.second);
+  const nlohmann::json by_model =
+      diagnose_json("--system " + files.model + " --model " + written + " --data " + files.second);
+  const double world_rmse = by_world["ranking"][0]["heldout_rmse_before"].get<double>();
+  const double model_rmse = by_model["ranking"][0]["heldout_rmse_before"].get<double>();
+  std::printf("heavy drive between moves, second record: held-out force rmse %.4g N (world) and %.4g N (diagnosed)%s\n",
+              world_rmse, model_rmse, found_text(values).c_str());
   EXPECT_LE(model_rmse, 1.02 * world_rmse);
 }
 

@@ -18,6 +18,8 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -96,13 +98,54 @@ enum class DriveStart {
   AtRest,    ///< the carriage at rest at 0 while the reference is not: the loop's step response first
 };
 
+/// What the loop tracks.
+enum class DriveMotion {
+  Sines,         ///< a sum of three sines: the carriage never rests
+  PointToPoint,  ///< moves between random positions, the carriage at rest between them (point_to_point)
+};
+
+/// A point-to-point reference, its position and rate at `samples` + 1 samples of step `dt`: from 0, a
+/// standstill of 0.2 to 0.6 s, then a move to a random position in [0, 0.15] m at 2 m/s^2 up to 0.25 m/s
+/// (whole samples of constant acceleration, so that each move ends at rest), and again.
+inline std::pair<std::vector<double>, std::vector<double>> point_to_point(long samples, double dt,
+                                                                          std::uint64_t seed) {
+  std::mt19937_64 random(seed);
+  std::uniform_real_distribution<double> target(0.0, 0.15), standstill(0.2, 0.6);
+  const double speed = 0.25, acceleration = 2.0;
+  std::vector<double> position, rate;
+  double p = 0.0, v = 0.0;
+  const auto push = [&](double a) {
+    position.push_back(p);
+    rate.push_back(v);
+    p += v * dt + 0.5 * a * dt * dt;
+    v += a * dt;
+  };
+  while (static_cast<long>(position.size()) <= samples) {
+    for (long n = std::lround(standstill(random) / dt); n > 0; --n) push(0.0);
+    const double distance = target(random) - p, sign = distance < 0.0 ? -1.0 : 1.0;
+    const double ramp = speed / acceleration;
+    const bool cruises = std::abs(distance) >= speed * ramp;
+    const long ramp_samples = std::lround((cruises ? ramp : std::sqrt(std::abs(distance) / acceleration)) / dt);
+    const long cruise_samples = cruises ? std::lround((std::abs(distance) - speed * ramp) / speed / dt) : 0;
+    for (long n = 0; n < ramp_samples; ++n) push(sign * acceleration);
+    for (long n = 0; n < cruise_samples; ++n) push(0.0);
+    for (long n = 0; n < ramp_samples; ++n) push(-sign * acceleration);
+    v = 0.0;  // what rounding left of the rate after as many samples down as up
+  }
+  position.resize(static_cast<std::size_t>(samples + 1));
+  rate.resize(static_cast<std::size_t>(samples + 1));
+  return {position, rate};
+}
+
 /// `seconds` of the rig's PD loop at 1 kHz, tracking a sum of three sines (5, 3 and 2 cm at 0.5, 1.3 and
-/// 2.9 Hz; `record` shifts their phases, so record 1 is a second trajectory of the same machine), with
-/// the rig's force noise on the motor, simulated by RK4 at 0.25 ms; the log is a CSV with the columns t,
-/// encoder_mm (to the count of 1 um) and command (N / gear), in `dir`.
+/// 2.9 Hz; `record` shifts their phases, so record 1 is a second trajectory of the same machine) or
+/// point-to-point moves (point_to_point, seeded by `seed`), with the rig's force noise on the motor,
+/// simulated by RK4 at 0.25 ms; the log is a CSV with the columns t, encoder_mm (to the count of 1 um)
+/// and command (N / gear), in `dir`.
 inline std::filesystem::path drive_log(const std::filesystem::path& world_file, const std::filesystem::path& dir,
                                        const DriveRig& rig, double seconds, std::uint64_t seed, int record = 0,
-                                       DriveStart start = DriveStart::Tracking) {
+                                       DriveStart start = DriveStart::Tracking,
+                                       DriveMotion motion = DriveMotion::Sines) {
   const DynamicsPtr world = find_system(world_file.string())->build(Preset::Simulator, {}, {});
   const double dt = 1e-3, count = 1e-6;
   const auto step = make_step_model(world, Integrator::RK4, dt, 4);
@@ -113,7 +156,14 @@ inline std::filesystem::path drive_log(const std::filesystem::path& world_file, 
   // the reference), as a record of a running machine does, not with a step of the loop's error.
   const double phase[3] = {0.7 * record, 1.0 + 1.9 * record, 2.0 + 2.3 * record};
   const double amplitude[3] = {0.05, 0.03, 0.02}, frequency[3] = {0.5, 1.3, 2.9};
+  const long samples = std::lround(seconds / dt);
+  const auto moves = motion == DriveMotion::PointToPoint ? point_to_point(samples, dt, seed)
+                                                          : std::pair<std::vector<double>, std::vector<double>>();
   const auto reference_at = [&](double t, bool rate) {
+    if (motion == DriveMotion::PointToPoint) {
+      const auto k = static_cast<std::size_t>(std::lround(t / dt));
+      return rate ? moves.second[k] : moves.first[k];
+    }
     double sum = 0.0;
     for (int i = 0; i < 3; ++i) {
       const double w = 2 * M_PI * frequency[i];
@@ -128,7 +178,6 @@ inline std::filesystem::path drive_log(const std::filesystem::path& world_file, 
   const auto file = dir / fmt::format("drive_log_{}.csv", record);
   std::ofstream out(file);
   out << "t,encoder_mm,command\n";
-  const long samples = std::lround(seconds / dt);
   for (long k = 0; k <= samples; ++k) {
     const double t = static_cast<double>(k) * dt;
     const double reference = reference_at(t, false);

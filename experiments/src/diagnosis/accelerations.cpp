@@ -180,6 +180,42 @@ Matrix filtered_at(const Transitions& data, const Matrix& y, const std::vector<i
   return out;
 }
 
+Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> standstill_rows(const Transitions& data,
+                                                                   const std::vector<int>& velocity_states,
+                                                                   const AccelerationFilter& filter) {
+  const auto c = static_cast<Eigen::Index>(velocity_states.size());
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> out =
+      Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(data.size(), c, false);
+  if (filter.window < 1 || data.size() == 0) return out;
+  const std::vector<RowSegment> segments = row_segments(data);
+  const int h = filter.window / 2;
+  for (Eigen::Index k = 0; k < c; ++k) {
+    std::vector<Vector> samples;
+    for (const RowSegment& s : segments) samples.push_back(column_samples(data, s, velocity_states[static_cast<std::size_t>(k)]));
+    double squares = 0.0;
+    long count = 0;
+    for (const Vector& v : samples) {
+      squares += v.squaredNorm();
+      count += v.size();
+    }
+    const double rms = std::sqrt(squares / std::max(1L, count));
+    const double band = kStandstillSpeed * rms;
+    for (std::size_t s = 0; s < segments.size(); ++s) {
+      const Vector& v = samples[s];
+      const auto n = static_cast<int>(v.size());
+      if (n < filter.window) continue;
+      // outside[j]: samples before j outside the band; a window holds none when the count does not change.
+      std::vector<int> outside(static_cast<std::size_t>(n) + 1, 0);
+      for (int j = 0; j < n; ++j) outside[static_cast<std::size_t>(j) + 1] = outside[static_cast<std::size_t>(j)] + (std::abs(v(j)) > band ? 1 : 0);
+      for (int t = segments[s].first; t < segments[s].end; ++t) {
+        const int start = std::clamp(t - segments[s].first - h, 0, n - filter.window);
+        out(t, k) = outside[static_cast<std::size_t>(start + filter.window)] == outside[static_cast<std::size_t>(start)];
+      }
+    }
+  }
+  return out;
+}
+
 Matrix filtered_controls(const Transitions& data, const Matrix& u, const AccelerationFilter& filter, ControlHold hold) {
   std::vector<int> rows(static_cast<std::size_t>(data.size()));
   for (std::size_t t = 0; t < rows.size(); ++t) rows[t] = static_cast<int>(t);

@@ -69,7 +69,8 @@ Matrix weighted_force_regressor(const ModelSpec& model, const std::vector<const 
       }
     }
   }
-  const Matrix seen = filtering ? criterion->filtered(*c.data, bases, rows) : bases;
+  Matrix seen = filtering ? criterion->filtered(*c.data, bases, rows) : bases;
+  if (!filtering) criterion->leave_out_standstill(seen, rows);
   Matrix out(static_cast<Eigen::Index>(rows.size()) * k, p);
   for (Eigen::Index i = 0; i < seen.rows(); ++i)
     for (Eigen::Index j = 0; j < p; ++j)

@@ -271,6 +271,7 @@ void score_heldout(const SetResidual& residual, const Vector& theta, const FitCo
   // Batches of consecutive samples of one episode: per channel, sums of the reduction d and of the
   // "before" term.
   std::vector<Vector> d_batches, b_batches;
+  Vector equations = Vector::Zero(n);  // per channel: the rows that are equations of the criterion (not 0 = 0)
   int previous_episode = -1, in_batch = 0;
   const int batch = heldout_batch_length(c, static_cast<int>(rows.size()));
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -278,6 +279,7 @@ void score_heldout(const SetResidual& residual, const Vector& theta, const FitCo
     const Vector rb = before.segment(seg, n), ra = after.segment(seg, n);
     fit.heldout_rmse_before += rb.cwiseQuotient(sqrt_w).cwiseAbs2();
     fit.heldout_rmse_after += ra.cwiseQuotient(sqrt_w).cwiseAbs2();
+    for (Eigen::Index i = 0; i < n; ++i) equations(i) += rb(i) != 0.0 || ra(i) != 0.0 ? 1.0 : 0.0;
     const int episode = c.data->episode[static_cast<std::size_t>(rows[k])];
     if (episode != previous_episode || in_batch == batch) {
       d_batches.push_back(Vector::Zero(n));
@@ -289,9 +291,9 @@ void score_heldout(const SetResidual& residual, const Vector& theta, const FitCo
     d_batches.back() += rb.cwiseAbs2() - ra.cwiseAbs2();
     ++in_batch;
   }
-  const double count = std::max<double>(1.0, static_cast<double>(rows.size()));
-  fit.heldout_rmse_before = (fit.heldout_rmse_before / count).cwiseSqrt();
-  fit.heldout_rmse_after = (fit.heldout_rmse_after / count).cwiseSqrt();
+  const Vector count = equations.cwiseMax(1.0);
+  fit.heldout_rmse_before = fit.heldout_rmse_before.cwiseQuotient(count).cwiseSqrt();
+  fit.heldout_rmse_after = fit.heldout_rmse_after.cwiseQuotient(count).cwiseSqrt();
   const auto K = static_cast<Eigen::Index>(b_batches.size());
   fit.heldout_channel_before.resize(K, n);
   fit.heldout_channel_reduction.resize(K, n);
@@ -340,7 +342,10 @@ std::pair<Vector, Vector> confidence_interval(const SetResidual& residual, const
   const auto n = static_cast<Eigen::Index>(c.weights.size());
   const Matrix A = Z.transpose() * J;
   const Matrix A_inverse = A.fullPivLu().inverse();
-  const double dof = std::max<double>(1.0, static_cast<double>(J.rows() - p));
+  // An equation 0 = 0 (a row a criterion leaves out: zero residual, zero regressor) is no degree of freedom.
+  Eigen::Index equations = 0;
+  for (Eigen::Index i = 0; i < J.rows(); ++i) equations += r(i) != 0.0 || J.row(i).squaredNorm() > 0.0 ? 1 : 0;
+  const double dof = std::max<double>(1.0, static_cast<double>(equations - p));
   Vector variance = (r.squaredNorm() / dof) * (A_inverse * (Z.transpose() * Z) * A_inverse.transpose()).diagonal();
   Vector quantile = Vector::Constant(p, 1.96);  // the Gauss-Newton variance's: normal
   // Delete-one-episode jackknife, each replicate one Gauss-Newton step from theta_hat.
@@ -428,6 +433,7 @@ HeldoutShare heldout_share(const EffectFit& fit, const std::vector<int>& channel
     b += B.col(i);
     d += D.col(i);
   }
+  std::tie(b, d) = batches_with_equations(b, d);
   const double before = b.sum();
   if (!(before > 0.0)) return share;
   share.explained = d.sum() / before;
@@ -439,6 +445,13 @@ HeldoutShare heldout_share(const EffectFit& fit, const std::vector<int>& channel
   share.explained_ci = batch_half_width(se, batches);
   share.z_score = se > 0.0 ? normal_equivalent(share.explained / se, batches) : (share.explained > 0.0 ? 1e6 : 0.0);
   return share;
+}
+
+std::pair<Vector, Vector> batches_with_equations(const Vector& before, const Vector& reduction) {
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index k = 0; k < before.size(); ++k)
+    if (before(k) > 0.0 || reduction(k) != 0.0) kept.push_back(k);
+  return {before(kept), reduction(kept)};
 }
 
 namespace {

@@ -104,14 +104,17 @@ HeldoutComparison compare_heldout(const EffectFit& a, const EffectFit& b) {
   if (K < 2 || b.heldout_batch_before.size() != K || a.heldout_batch_reduction.size() != K ||
       b.heldout_batch_reduction.size() != K || a.heldout_batch_before != b.heldout_batch_before)
     return c;
-  const double before = a.heldout_batch_before.sum();
-  if (!(before > 0.0)) return c;
-  const Vector d = a.heldout_batch_reduction - b.heldout_batch_reduction;
+  // The batches that hold equations: those of either fit (batches_with_equations on the difference).
+  const auto [batch_before, d] =
+      batches_with_equations(a.heldout_batch_before, a.heldout_batch_reduction - b.heldout_batch_reduction);
+  const double before = batch_before.sum();
+  const auto live = batch_before.size();
+  if (!(before > 0.0) || live < 2) return c;
   c.comparable = true;
   c.difference = d.sum() / before;
-  const double spread = (d - c.difference * a.heldout_batch_before).squaredNorm();
-  const auto k = static_cast<double>(K);
-  c.difference_ci = batch_half_width(std::sqrt(k / (k - 1.0) * spread) / before, static_cast<int>(K));
+  const double spread = (d - c.difference * batch_before).squaredNorm();
+  const auto k = static_cast<double>(live);
+  c.difference_ci = batch_half_width(std::sqrt(k / (k - 1.0) * spread) / before, static_cast<int>(live));
   return c;
 }
 

@@ -153,7 +153,7 @@ json channel_weights_json(const DiagnosisReport& r) {
   for (std::size_t i = 0; i < r.channel_names.size(); ++i) {
     const auto c = static_cast<Eigen::Index>(i);
     out.push_back({{"channel", r.channel_names[i]}, {"noise", criterion->noise()(c)}, {"left", criterion->left()(c)},
-                   {"weight", r.criterion_weights(c)}});
+                   {"weight", r.criterion_weights(c)}, {"standstill_rows", criterion->standstill_counts().at(i)}});
   }
   return out;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "gpilqg/experiments/diagnosis/whiteness.hpp"
 #include "gpilqg/gp/backend_registry.hpp"
@@ -68,7 +69,8 @@ ResidualGp fit_residual_gp(std::shared_ptr<const StepModel> simulator, const Tra
   return out;
 }
 
-Matrix gp_column_means(const Transitions& data, const Matrix& targets, const GpSettings& settings) {
+Matrix gp_column_means(const Transitions& data, const Matrix& targets, const GpSettings& settings,
+                       const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>* left_out) {
   gp::BackendSettings backend_settings;
   backend_settings.exact_points = settings.points;
   backend_settings.inducing = settings.points;
@@ -81,11 +83,18 @@ Matrix gp_column_means(const Transitions& data, const Matrix& targets, const GpS
   Matrix out(data.size(), targets.cols());
   Vector mean, variance;
   for (Eigen::Index i = 0; i < targets.cols(); ++i) {
+    const auto equation = [&](int t) { return left_out == nullptr || !(*left_out)(t, i); };
+    std::vector<int> rows;
+    std::copy_if(training.begin(), training.end(), std::back_inserter(rows), equation);
+    if (rows.empty()) {  // no equation of this column to learn: nothing is predicted
+      out.col(i).setZero();
+      continue;
+    }
     gp::TrainingSet all{z, targets.col(i)};
     options.seed = settings.seed + 7919u * static_cast<std::uint64_t>(i);
-    const gp::FitResult fit = backend->fit(backend->select_training_points(all.subset(training), settings.seed), options);
+    const gp::FitResult fit = backend->fit(backend->select_training_points(all.subset(rows), settings.seed), options);
     fit.model->predict(z, mean, variance);
-    out.col(i) = mean;
+    for (Eigen::Index t = 0; t < mean.size(); ++t) out(t, i) = equation(static_cast<int>(t)) ? mean(t) : 0.0;
   }
   return out;
 }

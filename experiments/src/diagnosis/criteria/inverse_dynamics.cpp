@@ -28,8 +28,13 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(F
   // estimate's weights (accelerations.hpp, force_residual).
   out->filter_ = estimate.filter();
   const std::vector<int> rows = all_rows(data);
+  // Both parts before the rows at standstill are known: the noise is read from every row below.
   const ForceResidualParts parts = out->force_residual_parts(c.model, data, rows);
+  out->standstill_ = std::make_shared<const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>>(
+      standstill_rows(data, components.velocity_states(), out->filter_));
+  for (Eigen::Index i = 0; i < k; ++i) out->standstill_counts_.push_back(static_cast<long>(out->standstill_->col(i).count()));
   c.residual = parts.inertial - parts.forces;
+  out->leave_out_standstill(c.residual, rows);
   // The model's own force W_v^-1 f_v, as the residual sees it.
   out->own_force_ = std::make_shared<const Matrix>(parts.forces);
   // IDIM-WLS (Gautier): w_i = 1 / sigma_i^2 with sigma_i^2 the larger of component i's white noise
@@ -53,8 +58,12 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(F
     const double rms = std::sqrt(unfiltered.col(i).squaredNorm() / std::max<double>(1.0, data.size()));
     out->noise_(i) = std::max(difference_noise_std(pieces), 1e-12 * (1.0 + rms));
     double square = 0.0;
-    for (int t : training) square += c.residual(t, i) * c.residual(t, i);
-    out->left_(i) = std::sqrt(square / std::max<double>(1.0, static_cast<double>(training.size())));
+    long moving = 0;
+    for (int t : training) {
+      square += c.residual(t, i) * c.residual(t, i);
+      moving += (*out->standstill_)(t, i) ? 0 : 1;
+    }
+    out->left_(i) = std::sqrt(square / std::max(1.0, static_cast<double>(moving)));
     const double sigma = std::max(out->noise_(i), out->left_(i));
     c.weights(i) = 1.0 / (sigma * sigma);
   }
@@ -98,11 +107,25 @@ InverseDynamicsCriterion::ForceResidualParts InverseDynamicsCriterion::force_res
 Matrix InverseDynamicsCriterion::force_residual(const ModelSpec& model, const Transitions& data,
                                                 const std::vector<int>& rows) const {
   const ForceResidualParts parts = force_residual_parts(model, data, rows);
-  return parts.inertial - parts.forces;
+  Matrix r = parts.inertial - parts.forces;
+  leave_out_standstill(r, rows);
+  return r;
 }
 
 Matrix InverseDynamicsCriterion::filtered(const Transitions& data, const Matrix& y, const std::vector<int>& rows) const {
-  return filter_.window > 0 ? filtered_at(data, y, rows, filter_) : rows_of(y, rows);
+  Matrix seen = filter_.window > 0 ? filtered_at(data, y, rows, filter_) : rows_of(y, rows);
+  leave_out_standstill(seen, rows);
+  return seen;
+}
+
+void InverseDynamicsCriterion::leave_out_standstill(Matrix& y, const std::vector<int>& rows) const {
+  if (!standstill_ || standstill_->cols() == 0 || rows.empty()) return;
+  const Eigen::Index k = standstill_->cols();
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    const int t = rows[r];
+    for (Eigen::Index j = 0; j < y.cols(); ++j)
+      if ((*standstill_)(t, j % k)) y(static_cast<Eigen::Index>(r), j) = 0.0;
+  }
 }
 
 Matrix InverseDynamicsCriterion::residual(const ModelSpec& model, const FitContext& c, int* diverged) const {
@@ -150,7 +173,10 @@ std::string InverseDynamicsCriterion::unidentifiable_reason() const {
 double InverseDynamicsCriterion::flexible_share(const ModelSpec& model, const OneStepGp*, const FitContext& c,
                                                 const GpSettings& settings) const {
   const Matrix force = residual(model, c);
-  return weighted_heldout_explained(*c.data, force, gp_column_means(*c.data, force, settings), c.weights);
+  // The GP of what the model leaves learns the equations the criterion has: not the rows at standstill,
+  // where the residual is zero by definition and a GP trained or scored there would be charged for it.
+  return weighted_heldout_explained(*c.data, force, gp_column_means(*c.data, force, settings, standstill_.get()),
+                                    c.weights);
 }
 
 std::string InverseDynamicsCriterion::description(double, int) const {
@@ -170,6 +196,12 @@ std::string InverseDynamicsCriterion::description(double, int) const {
     }
     out += fmt::format("\n   weights (IDIM-WLS): each force component by 1 / max(noise, rms left by the model as given)^2, "
                        "noise [{}], left [{}]", noise, left);
+    long still = 0;
+    for (const long n : standstill_counts_) still += n;
+    if (still > 0)
+      out += fmt::format("\n   left out where the coordinate stands still (a static friction holds it with any force up to "
+                         "its breakaway): [{}] rows of {} per component",
+                         fmt::join(standstill_counts_, ", "), standstill_ ? standstill_->rows() : 0);
   }
   if (instruments_)
     out += fmt::format("\n   instrumental variables (IDIM-IV): instruments from the model simulated over windows of {} "

@@ -136,6 +136,31 @@ Matrix filtered_controls(const Transitions& data, const Matrix& u, const Acceler
 Matrix filtered_at(const Transitions& data, const Matrix& y, const std::vector<int>& rows,
                    const AccelerationFilter& filter, ControlHold hold = ControlHold::Continuous);
 
+/// Rows at which a coordinate stands still (N x c, column k for velocity_states[k]): every velocity
+/// sample that the acceleration filter `filter` reads at the row (its window, off-centre at a segment's
+/// ends) lies within
+///
+///   |v| <= kStandstillSpeed rms(v),
+///
+/// rms(v) the column's rms about 0 over every sample: at rest, or creeping at a hundredth of the speeds
+/// it moves at, for the whole window. A dry friction there is static: it holds the coordinate with
+/// whatever force the others leave, anywhere within its breakaway force, and a creeping contact's force
+/// turns with velocities far below what an estimate from counts or a filter resolves; no model of
+/// sliding friction predicts either (a carriage at rest between two moves, held against a constant
+/// force and the loop's small error). Robot and drive identification leave such samples out of the
+/// inverse-dynamics fit. A coordinate passing through 0 at a reversal is not at rest: its velocity
+/// leaves the band within the window. A velocity whose noise exceeds the band at rest (measured with
+/// noise above a hundredth of its rms) is never taken to rest: its rows stay, as they would without
+/// this test; the band is not widened to the noise, which would take a slow but real motion for rest.
+Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> standstill_rows(const Transitions& data,
+                                                                   const std::vector<int>& velocity_states,
+                                                                   const AccelerationFilter& filter);
+
+/// The band of standstill_rows: a hundredth of the coordinate's rms speed, two decades below the
+/// speeds it moves at (the lower end of the Coulomb friction's smoothing grid, velocity_scales.hpp, is
+/// a fifth of that).
+inline constexpr double kStandstillSpeed = 0.01;
+
 /// The accelerations of every row of `data` for the velocity states `velocity_states` (file comment:
 /// from them, or from their measured positions, differentiated_columns), sampled at `dt`, with fits of
 /// degree `order`. Throws std::invalid_argument for a column outside the

@@ -174,8 +174,16 @@ struct HeldoutShare {
 /// Step 4's share on the channels `channels` of the criterion (all of them when empty): the ratio
 /// estimator R = D / B of the batches' reductions and "before" terms summed over those channels, with
 /// Var(R) ~ K / (K - 1) sum_b (d_b - R b_b)^2 / B^2 and Student's quantile on K - 1 degrees of freedom.
-/// On every channel it is the fit's own explained, explained_ci and z_score.
+/// On every channel it is the fit's own explained, explained_ci and z_score. K counts the batches
+/// that hold an equation (batches_with_equations).
 HeldoutShare heldout_share(const EffectFit& fit, const std::vector<int>& channels);
+
+/// The batches (before b_k, reduction d_k) that hold at least one equation of the criterion: those
+/// with b_k > 0 or d_k != 0. A batch whose every residual is zero before and after, whatever the
+/// model, has only equations a criterion leaves out (a coordinate at standstill under inverse
+/// dynamics, InverseDynamicsCriterion): it adds nothing to the sums B and D and is no batch of the
+/// variance's K.
+std::pair<Vector, Vector> batches_with_equations(const Vector& before, const Vector& reduction);
 
 /// `fit` with the values of `values` (one effect of its joint fit) as its own effect's: its name,
 /// parameters, start, estimate, interval and smoothing; the scores stay those of the joint fit.

@@ -60,8 +60,12 @@ ResidualGp fit_residual_gp(std::shared_ptr<const StepModel> simulator, const Tra
 /// The latent mean at every row (N x c) of one GP per column of `targets` (N x c, any residual: a
 /// generalised-force residual as well as a state residual), each fitted on the training rows with the
 /// inputs (x_t, u_t) and `settings`: the flexible model of the remainder test under the
-/// inverse-dynamics criterion (diagnosis.cpp). Throws std::invalid_argument for degenerate columns.
-Matrix gp_column_means(const Transitions& data, const Matrix& targets, const GpSettings& settings);
+/// inverse-dynamics criterion (diagnosis.cpp). `left_out` (N x c, or null): entries that are not
+/// equations of the criterion (a coordinate at standstill, InverseDynamicsCriterion): column i's GP is
+/// not trained on them and its mean there is 0, as the target is, so they add nothing to a score of
+/// target - mean. Throws std::invalid_argument for degenerate columns.
+Matrix gp_column_means(const Transitions& data, const Matrix& targets, const GpSettings& settings,
+                       const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>* left_out = nullptr);
 
 /// Held-out structure per state: 1 - sum (r - mu)^2 / sum r^2 over held-out rows (0 when r is 0).
 Vector gp_explained(const ResidualGp& gp, const Transitions& data, const Matrix& residual);

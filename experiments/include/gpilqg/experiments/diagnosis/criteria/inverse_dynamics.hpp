@@ -31,11 +31,12 @@ struct Instruments;  // instrumental_variables.hpp
 
 class InverseDynamicsCriterion final : public Criterion {
  public:
-  /// Estimates the accelerations on c.data and sets c.residual (N x k) to the force residual of
-  /// c.model and c.weights to the IDIM-WLS weights 1 / sigma_i^2 (Gautier), sigma_i = max(noise_i,
-  /// left_i): noise_i the white noise of component i's residual (its repeated differences within each
-  /// record, with the controls as applied: what a smooth missing force does not raise), left_i the
-  /// rms of its residual on the training rows (what the model as given leaves of joint i's
+  /// Estimates the accelerations on c.data, finds the rows where a coordinate stands still
+  /// (leave_out_standstill), and sets c.residual (N x k) to the force residual of c.model and
+  /// c.weights to the IDIM-WLS weights 1 / sigma_i^2 (Gautier), sigma_i = max(noise_i, left_i):
+  /// noise_i the white noise of component i's residual (its repeated differences within each record,
+  /// with the controls as applied: what a smooth missing force does not raise), left_i the rms of its
+  /// residual on the training rows where it moves (what the model as given leaves of joint i's
   /// equations). Throws std::invalid_argument on a system without a generalised-force map or records
   /// too short for the estimate.
   static std::shared_ptr<const InverseDynamicsCriterion> make(FitContext& c);
@@ -77,8 +78,17 @@ class InverseDynamicsCriterion final : public Criterion {
   /// delayed by model.input_delay.
   Matrix force_residual(const ModelSpec& model, const Transitions& data, const std::vector<int>& rows) const;
   /// A per-sample quantity of `data`'s rows (N x c: the forces of an effect at the measured states)
-  /// as force_residual sees it at `rows`: through the same weights, or as it is at w = 0.
+  /// as force_residual sees it at `rows`: through the same weights, or as it is at w = 0, and left
+  /// out where its component stands still (leave_out_standstill).
   Matrix filtered(const Transitions& data, const Matrix& y, const std::vector<int>& rows) const;
+  /// Zeroes the entries of `y` (rows.size() x c, c a multiple of the k force components, column j k + i
+  /// for component i) at the rows where component i's coordinate stands still in the measured data
+  /// (standstill_rows, accelerations.hpp): a static friction's force there is anything within its
+  /// breakaway force, so those equations are left out of every fit, score and noise level of the
+  /// criterion, as robot identification leaves them out. force_residual and filtered do it.
+  void leave_out_standstill(Matrix& y, const std::vector<int>& rows) const;
+  /// Per force component: the rows left out as standing still.
+  const std::vector<long>& standstill_counts() const { return standstill_counts_; }
 
   std::string scored_on() const override { return "the generalised-force (inverse-dynamics) residual"; }
   Matrix residual(const ModelSpec& model, const FitContext& c, int* diverged = nullptr) const override;
@@ -115,6 +125,9 @@ class InverseDynamicsCriterion final : public Criterion {
   AccelerationFilter filter_;
   std::shared_ptr<const Instruments> instruments_;
   Vector noise_, left_;
+  /// N x k, the measured data's rows at which each component's coordinate stands still (null: none).
+  std::shared_ptr<const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>> standstill_;
+  std::vector<long> standstill_counts_;
 };
 
 }  // namespace gpilqg::diagnosis
