@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <map>
 #include <string>
 
@@ -111,6 +112,53 @@ TEST(JointSmoothing, TheSetsSmoothingVelocitiesAreTheDatasAndItsLevelsHoldTheTru
                 refit.refitted[0].ci_high(0), refit.refitted[1].estimate(0), refit.training_objective_after,
                 at_truth.training_objective_after);
   }
+}
+
+// The v0 of a Coulomb candidate before any set (with_fitted_smoothing, as the ranking and the subset
+// search's screening use it) is fitted with a viscous friction of its coordinate beside it. On a cart
+// with viscous friction 4 N s/m and Coulomb friction 1.5 N at v0 = 0.006 m/s (4% of the rms speed), a
+// second implementation scores every grid point by exact fits (fit_jointly on the training rows): the
+// rule's v0 is within a grid step of the truth and at the grid point the exact fits with the viscous
+// friction prefer, while the exact fits of the Coulomb friction alone prefer the top of the grid (a
+// saturating viscous friction), the width the rule took before the viscous column.
+TEST(JointSmoothing, ACoulombCandidatesWidthIsFittedBesideItsCoordinatesViscousFriction) {
+  constexpr double kViscous = 4.0, kV0 = 0.006;  // N s/m; m/s, 4% of the rms speed
+  ModelSpec world;
+  world.system = "cartpole";
+  world.smoothing["cart_coulomb_friction"] = kV0;
+  world = world.with(find_candidate(world, "cart_coulomb_friction"), Vector::Constant(1, kCartMu));
+  world = world.with(find_candidate(world, "cart_viscous_friction"), Vector::Constant(1, kViscous));
+  const DynamicsPtr dynamics = world.build(test::actuator_noise(1, 0.02));
+  ExcitationSettings settings = default_excitation(*dynamics);
+  settings.episodes = 8;
+  settings.steps = 150;
+  settings.seed = 5;
+  DiagnosisOptions o = test::fast_options("cartpole");
+  o.rank = false;
+  const DiagnosisReport r = diagnose(simulate_measurements(dynamics, settings).set, o);
+  const FitContext context{&r.data, r.model, o.integrator, r.dt, o.substeps, r.weights, r.residual};
+  const double rms = training_rms(r.data, 1);
+  const double rule = r.model.smoothing.at("cart_coulomb_friction");
+  int with_viscous = 0, alone = 0;
+  double best_with = 0.0, best_alone = 0.0;
+  for (int i = 0; i < static_cast<int>(std::size(kSmoothingGrid)); ++i) {
+    ModelSpec m = r.model;
+    m.smoothing["cart_coulomb_friction"] = kSmoothingGrid[i] * rms;
+    FitContext c = context;
+    c.model = m;
+    const LibraryEffect coulomb = find_candidate(m, "cart_coulomb_friction");
+    const LibraryEffect viscous = find_candidate(m, "cart_viscous_friction");
+    const double pair = fit_jointly(coulomb, {{&viscous, Vector::Zero(1)}}, c).training_objective_after;
+    const double single = fit_jointly(coulomb, {}, c).training_objective_after;
+    if (i == 0 || pair < best_with) best_with = pair, with_viscous = i;
+    if (i == 0 || single < best_alone) best_alone = single, alone = i;
+  }
+  std::printf("v0 %.4f m/s (truth %.3f, rms speed %.3f); exact fits prefer %.4f with the viscous friction, %.4f alone\n", rule,
+              kV0, rms, kSmoothingGrid[with_viscous] * rms, kSmoothingGrid[alone] * rms);
+  ASSERT_LT(kV0, 0.1 * rms) << "the truth lies well inside the grid";
+  EXPECT_LT(std::abs(std::log(rule / kV0)), std::log(2.5)) << rule;
+  EXPECT_LT(std::abs(std::log(rule / (kSmoothingGrid[with_viscous] * rms))), std::log(2.5)) << rule;
+  EXPECT_EQ(alone, static_cast<int>(std::size(kSmoothingGrid)) - 1) << "alone, the switch's width takes the viscous slope";
 }
 
 // joint_smoothing moves one Coulomb member's v0 at a time and replaces only that member's columns of

@@ -268,8 +268,13 @@ ModelAsGiven model_as_given(const DiagnosisOptions& o, const FitContext& setting
   given.gp = fit_residual_gp(given.step, data, given.residual, o.gp);
   if (o.progress) o.progress("residual GP of the model fitted");
   given.weights = floor_weights(data, given.residual, given.gp);
-  given.model = with_fitted_smoothing(
-      FitContext{&data, o.model, o.integrator, settings.dt, o.substeps, given.weights, given.residual});
+  // The Coulomb candidates' widths are fitted on the error every fit below is scored on: under
+  // inverse dynamics the force residual, whose switch at qdot = 0 a one-step residual of velocity
+  // increments at kilohertz rates hides in its noise. Least squares suffices for a width (the
+  // instruments of the IV form remove a bias of the levels).
+  const FitContext criterion = criterion_context(
+      FitContext{&data, o.model, o.integrator, settings.dt, o.substeps, given.weights, given.residual}, o.criterion, o.window);
+  given.model = with_fitted_smoothing(criterion);
   return given;
 }
 

@@ -3,6 +3,8 @@
 #include "gpilqg/experiments/diagnosis/affine_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
 
+#include <Eigen/QR>
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -23,24 +25,32 @@ double training_rms(const Transitions& data, int velocity) {
 
 namespace {
 
-/// min over tau of S(tau) for `effect` at smoothing `v0` added to the model (linear least squares on
-/// the one column the effect adds: S = |r|^2 - (J'r)^2 / J'J). J is the secant of the residual over
-/// one parameter scale, or under inverse dynamics the force's own regressor (the same column, the
-/// residual being affine in the force's level there, without evaluating the model).
-double profiled_objective(const FitContext& c, const LibraryEffect& coulomb, double v0, const Vector& r0,
-                          const std::vector<int>& rows) {
+/// The column a Coulomb effect at smoothing `v0` adds to the weighted residual on `rows`: under inverse
+/// dynamics the force's own regressor (the residual is affine in the force's level there, so no model
+/// is evaluated), else the secant of the residual r0 over one parameter scale.
+Vector coulomb_column(const FitContext& c, const LibraryEffect& coulomb, double v0, const Vector& r0,
+                      const std::vector<int>& rows) {
   const LibraryEffect effect = with_smoothing(coulomb, v0);
-  Vector J;
-  if (c.criterion->inverse_dynamics() && linear_forces({&effect})) {
-    J = weighted_force_regressor(c.model, {&effect}, c, rows).col(0);  // the force's own regressor
-  } else {
-    const double h = effect.parameters[0].scale;
-    J = (r0 - weighted_residual_of(c.model.with(effect, Vector::Constant(1, h)), c, rows)) / h;
-  }
-  const double jj = J.squaredNorm();
-  if (!(jj > 0.0) || !std::isfinite(jj)) return r0.squaredNorm();
-  const double jr = J.dot(r0);
-  return r0.squaredNorm() - jr * jr / jj;
+  if (c.criterion->inverse_dynamics() && linear_forces({&effect})) return weighted_force_regressor(c.model, {&effect}, c, rows).col(0);
+  const double h = effect.parameters[0].scale;
+  return (r0 - weighted_residual_of(c.model.with(effect, Vector::Constant(1, h)), c, rows)) / h;
+}
+
+/// min over (tau, b) of S for `effect` at smoothing `v0` added to the model beside a viscous friction
+/// of its coordinate, linear least squares on the two columns: J(v0) and the viscous column `viscous`
+/// (file comment). Without the viscous column the switch's width would also stand for the slope at
+/// speed: a Coulomb friction fitted alone where both act takes the widest v0 of the grid, a saturating
+/// viscous friction, and keeps it in every set it screens in.
+double profiled_objective(const FitContext& c, const LibraryEffect& coulomb, double v0, const Vector& r0,
+                          const Vector& viscous, const std::vector<int>& rows) {
+  Matrix J(r0.size(), 2);
+  J.col(0) = coulomb_column(c, coulomb, v0, r0, rows);
+  J.col(1) = viscous;
+  if (!J.allFinite() || !(J.col(0).squaredNorm() > 0.0)) return r0.squaredNorm();
+  // Least squares by a rank-revealing QR: a viscous column of zeros (a coordinate at rest) drops out.
+  const Eigen::ColPivHouseholderQR<Matrix> qr(J);
+  const Vector theta = qr.solve(r0);
+  return (r0 - J * theta).squaredNorm();
 }
 
 /// The v0 = f s minimising `objective(v0)` over the grid f of kSmoothingGrid, refined by the vertex of
@@ -81,9 +91,13 @@ ModelSpec with_fitted_smoothing(const FitContext& c) {
                                      [&](const auto& force) { return force.first == effect.name; });
     if (present) continue;
     if (r0.size() == 0) r0 = weighted_residual_of(c.model, c, rows);
-    out.smoothing[effect.name] =
-        minimising_smoothing(training_rms(*c.data, effect.smoothing->velocity), effect.smoothing->width,
-                             [&](double v0) { return profiled_objective(c, effect, v0, r0, rows); });
+    const double rms = training_rms(*c.data, effect.smoothing->velocity);
+    // tau tanh(qdot / V) = (tau / V) qdot to 2e-4 for |qdot| below V / 50: with V a thousand times the
+    // rms speed, the same effect's column is the viscous friction of its coordinate (to 2e-4 up to 20
+    // times the rms speed), from the same machinery under every criterion.
+    const Vector viscous = rms > 0.0 ? coulomb_column(c, effect, 1e3 * rms, r0, rows) : Vector::Zero(r0.size());
+    out.smoothing[effect.name] = minimising_smoothing(
+        rms, effect.smoothing->width, [&](double v0) { return profiled_objective(c, effect, v0, r0, viscous, rows); });
   }
   return out;
 }

@@ -10,11 +10,17 @@
 /// on the noise of the measured velocity, which blurs the sign of small velocities. So v0 is fitted:
 /// with s the RMS of the coordinate's measured velocity about 0 on the training rows,
 ///
-///   v0 = argmin over f in {0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2} of min_tau S(tau, f s),
+///   v0 = argmin over f in {0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2} of min_{tau, b} S(tau, b, f s),
 ///
-/// S the weighted one-step training objective of the fit (effect_fit.hpp) with tau profiled out by
-/// linear least squares (the effect is linear in tau), refined by the vertex of the parabola through
-/// the best grid point and its neighbours in log v0. The grid spans the data's own scale, two
+/// S the weighted training objective of the fit under the criterion (effect_fit.hpp) with the
+/// Coulomb friction and a viscous friction b qdot of the same coordinate beside it, both profiled
+/// out by linear least squares (each is linear in its level), refined by the vertex of the parabola
+/// through the best grid point and its neighbours in log v0. The viscous term is there because v0 is
+/// the width of the switch at qdot = 0, not the slope at speed: fitted alone on a joint with viscous
+/// and dry friction (as every robot joint has), the Coulomb term takes the top of the grid, a
+/// saturating viscous friction, and a search that starts from it no longer sees the two terms
+/// (subset_search.hpp screens with these widths). Its column is the same effect at a width of a
+/// thousand times the rms speed, where tanh is linear over the data. The grid spans the data's own scale, two
 /// decades below its RMS speed; above 0.2 s the tanh is nearly linear over the data and the term is
 /// viscous friction, which the library has. A coordinate whose measured velocity is 0 throughout
 /// keeps the library's default (kDefaultCoulombWidth). The value is reported with the effect
