@@ -5,6 +5,7 @@
 #include <limits>
 #include <atomic>
 #include <deque>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -357,6 +358,9 @@ std::pair<Vector, Vector> confidence_interval(const SetResidual& residual, const
     it->second.first += Zk.transpose() * J.middleRows(static_cast<Eigen::Index>(k) * n, n);
     it->second.second += Zk.transpose() * r.segment(static_cast<Eigen::Index>(k) * n, n);
   }
+  // An episode whose every equation a criterion leaves out (0 = 0) is no replicate.
+  for (auto it = per_episode.begin(); it != per_episode.end();)
+    it = it->second.first.isZero(0.0) && it->second.second.isZero(0.0) ? per_episode.erase(it) : std::next(it);
   const Vector g = Z.transpose() * r;
   const auto E = static_cast<double>(per_episode.size());
   if (E >= 2.0) {

@@ -28,19 +28,20 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(F
   // estimate's weights (accelerations.hpp, force_residual).
   out->filter_ = estimate.filter();
   const std::vector<int> rows = all_rows(data);
-  // Both parts before the rows at standstill are known: the noise is read from every row below.
   const ForceResidualParts parts = out->force_residual_parts(c.model, data, rows);
   out->standstill_ = std::make_shared<const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>>(
       standstill_rows(data, components.velocity_states(), out->filter_));
   for (Eigen::Index i = 0; i < k; ++i) out->standstill_counts_.push_back(static_cast<long>(out->standstill_->col(i).count()));
   c.residual = parts.inertial - parts.forces;
   out->leave_out_standstill(c.residual, rows);
-  // The model's own force W_v^-1 f_v, as the residual sees it.
-  out->own_force_ = std::make_shared<const Matrix>(parts.forces);
+  // The model's own force W_v^-1 f_v, as the residual sees it, on the equations the criterion has.
+  Matrix own = parts.forces;
+  out->leave_out_standstill(own, rows);
+  out->own_force_ = std::make_shared<const Matrix>(std::move(own));
   // IDIM-WLS (Gautier): w_i = 1 / sigma_i^2 with sigma_i^2 the larger of component i's white noise
-  // (noise_i, from its repeated differences within each record: the noise of the torque and of the
-  // acceleration estimate) and the mean square of its residual on the training rows (left_i: what
-  // the model as given leaves of that joint's equations). Each joint's equations then count by how
+  // (noise_i, from its repeated differences within each run of rows where the coordinate moves: the
+  // noise of the torque and of the acceleration estimate) and the mean square of its residual on the
+  // training rows where it moves (left_i: what the model as given leaves of that joint's equations). Each joint's equations then count by how
   // well the model can be expected to fit them, not by how quiet its sensor is: a joint whose sensor
   // is quiet but whose model is wrong by far more does not drown the others. The noise is taken from
   // the residual with the controls and forces as they are at each row: the filter turns their white
@@ -53,8 +54,19 @@ std::shared_ptr<const InverseDynamicsCriterion> InverseDynamicsCriterion::make(F
   out->noise_ = Vector(k);
   out->left_ = Vector(k);
   for (Eigen::Index i = 0; i < k; ++i) {
+    // Runs of equations: at a standstill a dry friction of the model flips with the velocity's noise,
+    // which is no noise of the equations the criterion has. A coordinate that never moves keeps its
+    // records whole (its equations are all left out; the level only has to exist).
     std::vector<Vector> pieces;
-    for (const RowSegment& s : segments) pieces.push_back(unfiltered.col(i).segment(s.first, s.end - s.first));
+    for (const RowSegment& s : segments)
+      for (int t = s.first; t < s.end;) {
+        int end = t;
+        while (end < s.end && !(*out->standstill_)(end, i)) ++end;
+        if (end - t >= 3) pieces.push_back(unfiltered.col(i).segment(t, end - t));
+        t = std::max(end, t) + 1;
+      }
+    if (pieces.empty())
+      for (const RowSegment& s : segments) pieces.push_back(unfiltered.col(i).segment(s.first, s.end - s.first));
     const double rms = std::sqrt(unfiltered.col(i).squaredNorm() / std::max<double>(1.0, data.size()));
     out->noise_(i) = std::max(difference_noise_std(pieces), 1e-12 * (1.0 + rms));
     double square = 0.0;

@@ -22,8 +22,9 @@
 ///    is not linear in theta); this gives the final estimate theta_hat. (A derivative-free search took 30 to 200
 ///    evaluations of S per parameter; on 25,000 samples of a MuJoCo model that was most of the time.)
 /// 3. A 95% interval from the Gauss-Newton covariance at theta_hat, s^2 (J'WJ)^-1 with
-///    s^2 = S / (N n - p), widened to the delete-one-episode jackknife when that is larger: one-step
-///    residuals of one episode are correlated, so the iid interval alone is too narrow. The quantile
+///    s^2 = S / (m - p), m the equations that are not 0 = 0 (N n, less those a criterion leaves out),
+///    widened to the delete-one-episode jackknife when that is larger (over the episodes that hold an
+///    equation): one-step residuals of one episode are correlated, so the iid interval alone is too narrow. The quantile
 ///    is 1.96 for the Gauss-Newton variance and Student's t_{0.975, R - 1} for a jackknife of R
 ///    replicates (student_t.hpp).
 /// 4. On the held-out episodes: RMSE per state before and after, and the weighted fraction of
