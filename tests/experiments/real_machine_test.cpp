@@ -154,6 +154,16 @@ void expect_no_proxy(const std::map<std::string, double>& values, const test::Dr
   }
 }
 
+/// The heavy drive's three effects as the defaults must name them: viscous friction within 5%, Coulomb
+/// within 10%, the constant within 35% (1.5% of the force the loop applies), and no proxy.
+void expect_heavy_drive_frictions(const std::map<std::string, double>& values, const test::DriveRig& rig) {
+  const test::DriveTruth& truth = rig.truth;
+  EXPECT_NEAR(chosen(values, kViscous), truth.damping, 0.05 * truth.damping) << found_text(values);
+  EXPECT_NEAR(chosen(values, kCoulomb), truth.friction, 0.1 * truth.friction) << found_text(values);
+  EXPECT_NEAR(chosen(values, kConstant), truth.constant, 0.35 * std::abs(truth.constant)) << found_text(values);
+  expect_no_proxy(values, rig);
+}
+
 // A position-controlled drive at 1 kHz, as real drives are logged (ball_drive.hpp): a PD loop on an
 // encoder of 1 um, positions and the motor force only, one continuous record of 12 s. The world has
 // viscous friction, Coulomb friction (MuJoCo's frictionloss) and a constant force together; the model
@@ -193,11 +203,7 @@ TEST(RealMachineCli, HeavyDriveWithEstimatedVelocitiesTakesInverseDynamicsAndPre
   EXPECT_NE(report["criterion"]["reason"].get<std::string>().find("on the measured positions"), std::string::npos)
       << report["criterion"].dump();
   const auto values = chosen_values(report);
-  const test::DriveTruth& truth = rig.truth;
-  EXPECT_NEAR(chosen(values, kViscous), truth.damping, 0.05 * truth.damping) << found_text(values);
-  EXPECT_NEAR(chosen(values, kCoulomb), truth.friction, 0.1 * truth.friction) << found_text(values);
-  EXPECT_NEAR(chosen(values, kConstant), truth.constant, 0.35 * std::abs(truth.constant)) << found_text(values);
-  expect_no_proxy(values, rig);
+  expect_heavy_drive_frictions(values, rig);
 
   // The second record, scored by the diagnosis of each model: the same criterion, the same blocks.
   const nlohmann::json by_world = diagnose_json("--system " + files.world + " --data " + files.second);
@@ -230,11 +236,7 @@ TEST(RealMachineCli, HeavyDriveAtRestBetweenMovesLeavesTheStandstillOutAndFindsI
   ASSERT_EQ(weights.size(), 1u) << report["criterion"].dump();
   EXPECT_GT(weights[0]["standstill_rows"].get<long>(), report["samples"].get<long>() / 5) << weights.dump();
   const auto values = chosen_values(report);
-  const test::DriveTruth& truth = rig.truth;
-  EXPECT_NEAR(chosen(values, kViscous), truth.damping, 0.05 * truth.damping) << found_text(values);
-  EXPECT_NEAR(chosen(values, kCoulomb), truth.friction, 0.1 * truth.friction) << found_text(values);
-  EXPECT_NEAR(chosen(values, kConstant), truth.constant, 0.35 * std::abs(truth.constant)) << found_text(values);
-  expect_no_proxy(values, rig);
+  expect_heavy_drive_frictions(values, rig);
   EXPECT_EQ(values.size(), 3u) << found_text(values);
 
   const nlohmann::json by_world = diagnose_json("--system " + files.world + " --data " + files.second);
