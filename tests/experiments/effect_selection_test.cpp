@@ -167,6 +167,28 @@ TEST(EffectSelection, ForwardSelectionFindsThreeHiddenEffects) {
   expect_found(r, truth);
 }
 
+// Beyond the sizes searched exhaustively the subset search grows its best set one effect at a time
+// (subset_search.hpp). With only sets of one searched exhaustively, the growth alone must find the
+// three hidden effects of the cart-pole within 15%, each accepted size significant, and stop on its
+// own rule (no growth lowers the cross-validated screening score by more than its standard error)
+// before it runs out of candidates. With nothing hidden it adds nothing.
+TEST(EffectSelection, GrowingOneEffectAtATimeFindsThreeHiddenEffectsAndStops) {
+  const Truth truth{{"cart_coulomb_friction", 1.5}, {"pole_viscous_damping", 0.3}, {"external_force_x", 0.8}};
+  diagnosis::DiagnosisOptions o = auto_options("cartpole");
+  o.max_subset = 1;
+  const DiagnosisReport r = diagnosis::diagnose(data_of(world_with("cartpole", truth), 5, 8, 150, 0.02), o);
+  expect_found(r, truth);
+  const std::string& stop = r.selection->stop_reason;
+  EXPECT_NE(stop.find("then sets grown one effect at a time"), std::string::npos) << stop;
+  EXPECT_NE(stop.find("lowers the cross-validated screening score by more than its standard error"), std::string::npos)
+      << stop;
+
+  const DiagnosisReport none = diagnosis::diagnose(data_of(world_with("cartpole", {}), 7, 8, 150, 0.02), o);
+  ASSERT_TRUE(none.selection.has_value());
+  EXPECT_TRUE(none.selection->steps.empty()) << none.selection->steps.front().fit.effect;
+  EXPECT_EQ(none.verdict.status, "consistent");
+}
+
 // A force the user declares in the model file (a cubic spring on the cart, `q^3` on `x`) is a candidate
 // of the selection like a library effect, and is refitted jointly with one.
 TEST(EffectSelection, AUserDeclaredEffectIsFoundWithALibraryEffect) {

@@ -120,7 +120,8 @@ TEST(JointSmoothing, TheSetsSmoothingVelocitiesAreTheDatasAndItsLevelsHoldTheTru
 // second implementation scores every grid point by exact fits (fit_jointly on the training rows): the
 // rule's v0 is within a grid step of the truth and at the grid point the exact fits with the viscous
 // friction prefer, while the exact fits of the Coulomb friction alone prefer the top of the grid (a
-// saturating viscous friction), the width the rule took before the viscous column.
+// saturating viscous friction), the width the rule took before the viscous column. The same holds for
+// the width fitted again inside a set that has no viscous friction of the coordinate.
 TEST(JointSmoothing, ACoulombCandidatesWidthIsFittedBesideItsCoordinatesViscousFriction) {
   constexpr double kViscous = 4.0, kV0 = 0.006;  // N s/m; m/s, 4% of the rms speed
   ModelSpec world;
@@ -159,6 +160,14 @@ TEST(JointSmoothing, ACoulombCandidatesWidthIsFittedBesideItsCoordinatesViscousF
   EXPECT_LT(std::abs(std::log(rule / kV0)), std::log(2.5)) << rule;
   EXPECT_LT(std::abs(std::log(rule / (kSmoothingGrid[with_viscous] * rms))), std::log(2.5)) << rule;
   EXPECT_EQ(alone, static_cast<int>(std::size(kSmoothingGrid)) - 1) << "alone, the switch's width takes the viscous slope";
+
+  // Inside a set that lacks the viscous friction (joint_smoothing of the Coulomb friction fitted
+  // alone), the width is still the switch's: the set's fit has the viscous friction beside it too.
+  const LibraryEffect coulomb = find_candidate(r.model, "cart_coulomb_friction");
+  const double in_set = joint_smoothing(context, fit_jointly(coulomb, {}, context)).at("cart_coulomb_friction");
+  std::printf("inside a set without the viscous friction: v0 %.4f m/s\n", in_set);
+  EXPECT_LT(std::abs(std::log(in_set / kV0)), std::log(2.5)) << in_set;
+  EXPECT_LT(in_set, kSmoothingGrid[alone] * rms / 2.0) << in_set;
 }
 
 // joint_smoothing moves one Coulomb member's v0 at a time and replaces only that member's columns of

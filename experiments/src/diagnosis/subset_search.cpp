@@ -48,7 +48,7 @@ bool screens_better(const LinearisedFits& fits, const std::vector<int>& base, co
   return total > std::sqrt(K / (K - 1.0) * spread);
 }
 
-/// The `count` sets `base` + one more candidate with the least screening score, best first (the
+/// The (at most `count`) sets `base` + one more candidate with the least screening score, best first (the
 /// greedy growth of a size too large to search exhaustively: forward selection on the
 /// cross-validated linearised fits, as FROLS grows its model term by term).
 std::vector<std::vector<int>> grown_subsets(const LinearisedFits& fits, const std::vector<int>& base, int count,
@@ -153,15 +153,28 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     // lowers the cross-validated screening score. Refitted exactly against the accepted model.
     const bool exhaustive = k <= o.max_subset && binomial(static_cast<int>(n), k) <= kExhaustiveSets;
     if (!exhaustive && k > 1 && screened.empty()) break;
-    const std::vector<std::vector<int>> sets = exhaustive ? best_subsets(fits, k, kExactFitsPerSize, forbidden)
-                                                          : grown_subsets(fits, screened, 1, forbidden);
-    if (sets.empty()) break;
-    if (!exhaustive && k > 1 && !screens_better(fits, screened, sets.front())) {
-      stop_growing = fmt::format("; no set of {} grown from the best of {} lowers the cross-validated screening score by "
-                                 "more than its standard error",
-                                 k, k - 1);
-      break;
+    std::vector<std::vector<int>> sets;
+    if (exhaustive) {
+      sets = best_subsets(fits, k, kExactFitsPerSize, forbidden);
+    } else {
+      // The growth of the least screening score among those that lower it by more than its standard
+      // error: the best score alone may come from a reduction the folds disagree on, while the next
+      // one's is consistent. A candidate that fits noise does not pass by chance as often as a test at
+      // one standard error would: its fit on the other folds predicts nothing on the fold left out, so
+      // it raises the cross-validated score on most folds. A size the held-out rows do not accept does
+      // not stop the growth (a member that removes too little alone is judged again beside the next).
+      const std::vector<std::vector<int>> grown = grown_subsets(fits, screened, fits.size(), forbidden);
+      for (const std::vector<int>& set : grown)
+        if (k == 1 || screens_better(fits, screened, set)) {
+          sets.push_back(set);
+          break;
+        }
+      if (sets.empty() && !grown.empty())
+        stop_growing = fmt::format("; none of the {} sets of {} grown from the best of {} lowers the cross-validated "
+                                   "screening score by more than its standard error",
+                                   grown.size(), k, k - 1);
     }
+    if (sets.empty()) break;
     screened = sets.front();
     searched = k;
     if (o.progress && !exhaustive)

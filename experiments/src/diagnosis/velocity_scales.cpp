@@ -23,6 +23,13 @@ double training_rms(const Transitions& data, int velocity) {
   return count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
 }
 
+LibraryEffect viscous_twin(const LibraryEffect& coulomb, double rms) {
+  LibraryEffect out = with_smoothing(coulomb, kViscousWidth * rms);
+  out.name += " (viscous)";
+  out.smoothing.reset();
+  return out;
+}
+
 namespace {
 
 /// The column a Coulomb effect at smoothing `v0` adds to the weighted residual on `rows`: under inverse
@@ -92,10 +99,8 @@ ModelSpec with_fitted_smoothing(const FitContext& c) {
     if (present) continue;
     if (r0.size() == 0) r0 = weighted_residual_of(c.model, c, rows);
     const double rms = training_rms(*c.data, effect.smoothing->velocity);
-    // tau tanh(qdot / V) = (tau / V) qdot to 2e-4 for |qdot| below V / 50: with V a thousand times the
-    // rms speed, the same effect's column is the viscous friction of its coordinate (to 2e-4 up to 20
-    // times the rms speed), from the same machinery under every criterion.
-    const Vector viscous = rms > 0.0 ? coulomb_column(c, effect, 1e3 * rms, r0, rows) : Vector::Zero(r0.size());
+    // The viscous friction of the coordinate: the same effect at kViscousWidth times the rms speed.
+    const Vector viscous = rms > 0.0 ? coulomb_column(c, effect, kViscousWidth * rms, r0, rows) : Vector::Zero(r0.size());
     out.smoothing[effect.name] = minimising_smoothing(
         rms, effect.smoothing->width, [&](double v0) { return profiled_objective(c, effect, v0, r0, viscous, rows); });
   }
@@ -110,12 +115,26 @@ std::map<std::string, double> joint_smoothing(const FitContext& c, const EffectF
   const std::vector<EffectFit> members = member_fits(fit);
   std::vector<int> all(members.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  // Beside every Coulomb member, a viscous friction of its coordinate, as when it was fitted alone
+  // (with_fitted_smoothing): refitted with the set, never a member of it. Without it, in a set that
+  // lacks the coordinate's viscous friction the width would stand for the slope at speed again and
+  // take the top of the grid. Where the set has that viscous friction, the two columns are one and
+  // the fit is the same.
+  std::vector<LibraryEffect> viscous;
+  viscous.reserve(members.size());
+  for (const EffectFit& member : members) {
+    const LibraryEffect effect = find_candidate(c.model, member.effect);
+    const double rms = effect.smoothing ? training_rms(*c.data, effect.smoothing->velocity) : 0.0;
+    if (rms > 0.0) viscous.push_back(viscous_twin(effect, rms));
+  }
+  std::vector<RefitEffect> beside;
+  for (const LibraryEffect& v : viscous) beside.push_back({&v, Vector::Zero(1)});
   FitContext trial = c;
   std::map<std::string, double> out;
   // The set linearised once; a grid value replaces only the Coulomb member's own columns (its
   // smoothing moves nothing else), unless the member is a force of the model itself, whose residual
   // its smoothing then changes too.
-  LinearisedFits fits(trial, members, {}, 1, true);
+  LinearisedFits fits(trial, members, beside, 1, true);
   for (std::size_t m = 0; m < members.size(); ++m) {
     const LibraryEffect effect = find_candidate(c.model, members[m].effect);
     if (!effect.smoothing) continue;
@@ -123,7 +142,7 @@ std::map<std::string, double> joint_smoothing(const FitContext& c, const EffectF
                                       [&](const auto& force) { return force.first == effect.name; });
     const auto objective = [&](double width) {
       trial.model.smoothing[effect.name] = width;
-      if (in_model) return LinearisedFits(trial, members, {}).training_left(all);
+      if (in_model) return LinearisedFits(trial, members, beside).training_left(all);
       fits.relinearise(static_cast<int>(m), trial);
       return fits.training_left(all);
     };
@@ -131,7 +150,7 @@ std::map<std::string, double> joint_smoothing(const FitContext& c, const EffectF
                                            objective);
     trial.model.smoothing[effect.name] = v0;
     if (in_model)
-      fits = LinearisedFits(trial, members, {}, 1, true);
+      fits = LinearisedFits(trial, members, beside, 1, true);
     else
       fits.relinearise(static_cast<int>(m), trial);
     out[effect.name] = v0;

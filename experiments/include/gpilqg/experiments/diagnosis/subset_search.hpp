@@ -30,9 +30,10 @@
 /// Beyond max_subset, or where a size has more than 200,000 sets (a 7-joint arm's library of about 100
 /// candidates has 3.9 million sets of four), the best screened set of the size before is grown by the
 /// one candidate that lowers the screening score most (forward selection on the linearised fits, as
-/// FROLS grows its model term by term), refitted exactly and judged like the others; growth stops
-/// when the best growth lowers the cross-validated screening score by less than the standard error
-/// of that reduction over the folds (the one-standard-error rule), or at max_steps effects. So a set of
+/// FROLS grows its model term by term) by more than the standard error of that reduction over the
+/// folds (the one-standard-error rule; when the least score fails it, the next growth that passes),
+/// refitted exactly and judged like the others; growth stops when no growth passes that rule, or at
+/// max_steps effects. A size the held-out test does not accept does not stop it. So a set of
 /// 14 frictions on 7 joints is reachable, at the cost of one exact joint fit per size.
 ///
 /// The linearised scores cost one small solve per subset, so the exact fits (a few per size) are

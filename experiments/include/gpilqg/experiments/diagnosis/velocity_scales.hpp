@@ -36,6 +36,16 @@ namespace gpilqg::diagnosis {
 /// The grid of v0 / RMS(qdot) (see the file comment).
 inline constexpr double kSmoothingGrid[] = {0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2};
 
+/// tau tanh(qdot / V) = (tau / V) qdot to 2e-4 for |qdot| below V / 50: at V a thousand times the rms
+/// speed a Coulomb effect is the viscous friction of its coordinate (to 2e-4 up to 20 times the rms
+/// speed), from the same machinery under every criterion and for every system.
+inline constexpr double kViscousWidth = 1e3;
+
+/// `coulomb` at kViscousWidth times `rms` (the rms speed of its coordinate): the viscous friction of
+/// the coordinate, as a force of its own name ("<name> (viscous)", no smoothing), to be fitted beside
+/// a Coulomb term and never reported as an effect.
+LibraryEffect viscous_twin(const LibraryEffect& coulomb, double rms);
+
 /// The RMS of state `velocity` over the training rows of `data` (0 when there are none).
 double training_rms(const Transitions& data, int velocity);
 
@@ -47,7 +57,8 @@ ModelSpec with_fitted_smoothing(const FitContext& context);
 /// The smoothing velocities of the Coulomb effects of the joint fit `fit` (its effect and those it
 /// refitted), fitted again inside the set: for each in turn, the same grid and parabola, the objective
 /// being the training objective of the linearised joint fit of the whole set (linearised_fits.hpp)
-/// around context.model. A v0 fitted alone is biased by what the other effects do (on a cart with
+/// around context.model, with a viscous friction (viscous_twin) beside each Coulomb member, as when
+/// it was fitted alone: v0 is the switch's width, not a slope the set leaves to it. A v0 fitted alone is biased by what the other effects do (on a cart with
 /// Coulomb friction and a constant force, v0 alone came out at 0.6 times its value); the set's
 /// v0 is not. Effect name -> v0.
 std::map<std::string, double> joint_smoothing(const FitContext& context, const EffectFit& fit);
