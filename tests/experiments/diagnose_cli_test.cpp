@@ -352,7 +352,19 @@ TEST(DiagnoseCli, AutoFindsTwoEffectsWritesTheFinalModelAndPlotsThePath) {
   const json j = json::parse(result.out);
   ASSERT_TRUE(j["selection"].is_object());
   std::set<std::string> found;
-  for (const json& step : j["selection"]["steps"]) found.insert(step["effect"].get<std::string>());
+  for (const json& step : j["selection"]["steps"]) {
+    found.insert(step["effect"].get<std::string>());
+    // The share the step was accepted on (effect_test.hpp): at least 5% with z >= 3, on named channels
+    // of the criterion, its interval around it.
+    const json& judged = step["judged"];
+    EXPECT_GE(judged["explained"].get<double>(), 0.05) << judged.dump();
+    EXPECT_GE(judged["z_score"].get<double>(), 3.0) << judged.dump();
+    EXPECT_LT(judged["explained_ci95"][0].get<double>(), judged["explained"].get<double>());
+    EXPECT_GT(judged["explained_ci95"][1].get<double>(), judged["explained"].get<double>());
+    ASSERT_FALSE(judged["channels"].empty());
+    for (const json& channel : judged["channels"])
+      EXPECT_TRUE(step["heldout_rmse_after_by_state"].contains(channel.get<std::string>())) << channel;
+  }
   EXPECT_EQ(found, (std::set<std::string>{"cart_coulomb_friction", "external_force_x"})) << j["selection"].dump(1);
   EXPECT_TRUE(has_no_nan(j));
   const ModelSpec written = diagnosis::read_model_file(model, "cartpole");

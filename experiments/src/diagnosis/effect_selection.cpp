@@ -52,6 +52,18 @@ std::vector<std::string> names_of_effects(const std::vector<RefitEffect>& effect
   return out;
 }
 
+std::vector<JudgedShare> judged_step_shares(const Selection& selection, const ModelSpec& model_as_given,
+                                            const std::string& residual) {
+  std::vector<std::string> before = names_of_effects(model_effects(model_as_given, candidate_effects(model_as_given)));
+  std::vector<JudgedShare> out;
+  for (const SelectionStep& step : selection.steps) {
+    out.push_back(judged_share(step.fit, before, residual));
+    before = {step.fit.effect};
+    for (const EffectValues& v : step.fit.refitted) before.push_back(v.effect);
+  }
+  return out;
+}
+
 /// The backward check after a step. A member of the joint fit (the lead or a refitted one) that M_0
 /// does not have and whose joint 95% interval contains its value in M_0 (a force of 0, a gain of 1,
 /// the preset's parameter, no delay) is no longer needed: another member explains what it had soaked

@@ -46,7 +46,7 @@ JudgedShare judged_share(const EffectFit& fit, const std::vector<std::string>& k
   // On every channel the share is the fit's own (heldout_share of all channels, step 4).
   JudgedShare out{channels.empty() ? HeldoutShare{fit.explained, fit.explained_ci, fit.z_score}
                                    : heldout_share(fit, channels),
-                  residual};
+                  residual, channels};
   if (!channels.empty())
     out.what = fmt::format("{} on the {} of {} channels {} act{} on", residual, channels.size(), all,
                            fit.refitted.empty() ? "it" : "the new members", fit.refitted.empty() ? "s" : "");

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -257,11 +258,24 @@ nlohmann::json report_json(const DiagnosisReport& r) {
   json selection = nullptr;
   if (r.selection) {
     json steps = json::array();
-    for (const SelectionStep& step : r.selection->steps) {
+    const std::vector<JudgedShare> judged_shares = judged_step_shares(*r.selection, r.model, "");
+    for (std::size_t k = 0; k < r.selection->steps.size(); ++k) {
+      const SelectionStep& step = r.selection->steps[k];
       json entry = fit_json(step.fit, r, state);
       json joint = json::array();
       for (const EffectValues& v : step.fit.refitted) joint.push_back(values_json(v));
       entry["refitted"] = joint;
+      // The share the step was accepted on: on the channels its new members act on (effect_test.hpp).
+      const JudgedShare& judged = judged_shares[k];
+      json channels = json::array();
+      for (std::size_t i = 0; i < r.channel_names.size(); ++i)
+        if (judged.channels.empty() || std::binary_search(judged.channels.begin(), judged.channels.end(), static_cast<int>(i)))
+          channels.push_back(r.channel_names[i]);
+      entry["judged"] = {{"explained", judged.share.explained},
+                         {"explained_ci95", {judged.share.explained - judged.share.explained_ci,
+                                             judged.share.explained + judged.share.explained_ci}},
+                         {"z_score", judged.share.z_score},
+                         {"channels", channels}};
       entry["removed"] = step.removed;
       entry["heldout_rmse_after_by_state"] = by_name(r.channel_names, step.fit.heldout_rmse_after);
       entry["model"] = model_file_text(step.model);

@@ -258,14 +258,13 @@ void selection_section(const DiagnosisReport& r, std::string& out) {
              ? "\n3b. Several effects (--auto): the best set of each size on the held-out episodes, every set fitted jointly\n"
              : "\n3b. Several effects (--auto): forward selection, every step refitting the chosen effects jointly\n";
   int k = 1;
+  // Judged on the channels of what the step adds (effect_test.hpp, test 3).
+  const std::vector<JudgedShare> judged_shares = judged_step_shares(*r.selection, r.model, "the held-out residual left");
   // The effects of the step before (the model's own at first): a step may bring several new ones.
-  std::vector<std::string> before;
-  const std::vector<LibraryEffect> candidates = candidate_effects(r.model);
-  for (const RefitEffect& e : model_effects(r.model, candidates)) before.push_back(e.effect->name);
+  std::vector<std::string> before = names_of_effects(model_effects(r.model, candidate_effects(r.model)));
   for (const SelectionStep& step : r.selection->steps) {
     const EffectFit& f = step.fit;
-    // Judged on the channels of what the step adds (effect_test.hpp, test 3).
-    const JudgedShare judged = judged_share(f, before, "the held-out residual left");
+    const JudgedShare& judged = judged_shares[static_cast<std::size_t>(k - 1)];
     out += fmt::format("   step {}: + {}: {}\n", k++, f.effect, parameter_text(f, true));
     for (const EffectValues& v : f.refitted) {
       const bool had = std::find(before.begin(), before.end(), v.effect) != before.end();

@@ -42,6 +42,7 @@
 #include <vector>
 
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
+#include "gpilqg/experiments/diagnosis/effect_test.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -90,6 +91,12 @@ struct Selection {
 
 /// The names of `effects`.
 std::vector<std::string> names_of_effects(const std::vector<RefitEffect>& effects);
+
+/// The share each step of `selection` was accepted on: judged_share against the effects of the step
+/// before (those `model_as_given` has, at the first step), so on the channels the step's new members act
+/// on. What the text report's section 3b prints and the JSON's `steps[].judged` holds.
+std::vector<JudgedShare> judged_step_shares(const Selection& selection, const ModelSpec& model_as_given,
+                                            const std::string& residual);
 
 /// M_0 (`base`) with the effect of `fit` and those it refitted at their joint estimates.
 ModelSpec model_after(const ModelSpec& base, const EffectFit& fit, const std::vector<LibraryEffect>& candidates);

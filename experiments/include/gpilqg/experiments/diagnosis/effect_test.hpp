@@ -76,6 +76,7 @@ EffectTestResult test_effect(const EffectFit& fit, const EffectTestThresholds& t
 struct JudgedShare {
   HeldoutShare share;
   std::string what;
+  std::vector<int> channels;  ///< the channels judged, ascending; empty: every channel
 };
 JudgedShare judged_share(const EffectFit& fit, const std::vector<std::string>& known, const std::string& residual);
 
