@@ -33,12 +33,14 @@ double binomial(int n, int k) {
   return out;
 }
 
-/// Whether `grown` screens better than `base` by more than the noise of the cross-validation: the
-/// fold-by-fold reduction sum_f (left_f(base) - left_f(grown)) must exceed its standard error,
-/// sqrt(K / (K - 1) sum_f (d_f - mean d)^2) (the one-standard-error rule of cross-validated model
-/// selection, Breiman et al.; Hastie, Tibshirani and Friedman, 7.10). Without folds: any reduction.
-bool screens_better(const LinearisedFits& fits, const std::vector<int>& base, const std::vector<int>& grown) {
-  const std::vector<double> before = fits.screening_folds(base), after = fits.screening_folds(grown);
+/// Whether `grown` screens better than the set whose screening folds are `before`
+/// (LinearisedFits::screening_folds, computed once for every growth of it) by more than the noise of
+/// the cross-validation: the fold-by-fold reduction sum_f (left_f(base) - left_f(grown)) must exceed
+/// its standard error, sqrt(K / (K - 1) sum_f (d_f - mean d)^2) (the one-standard-error rule of
+/// cross-validated model selection, Breiman et al.; Hastie, Tibshirani and Friedman, 7.10). Without
+/// folds: any reduction.
+bool screens_better(const LinearisedFits& fits, const std::vector<double>& before, const std::vector<int>& grown) {
+  const std::vector<double> after = fits.screening_folds(grown);
   const auto K = static_cast<double>(before.size());
   double total = 0.0;
   for (std::size_t f = 0; f < before.size(); ++f) total += before[f] - after[f];
@@ -164,8 +166,9 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
       // it raises the cross-validated score on most folds. A size the held-out rows do not accept does
       // not stop the growth (a member that removes too little alone is judged again beside the next).
       const std::vector<std::vector<int>> grown = grown_subsets(fits, screened, fits.size(), forbidden);
+      const std::vector<double> before = fits.screening_folds(screened);
       for (const std::vector<int>& set : grown)
-        if (k == 1 || screens_better(fits, screened, set)) {
+        if (k == 1 || screens_better(fits, before, set)) {
           sets.push_back(set);
           break;
         }
