@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -134,15 +138,36 @@ Vector acceleration_weights(const SavitzkyGolayDerivative& filter, int position,
   return m;
 }
 
+namespace {
+
+/// acceleration_weights of every position of the window of `filter` (index: the sample's place in
+/// its window), made once per filter and hold: for a second derivative over w samples they cost
+/// O(w^3), and a diagnosis filters thousands of times with one filter.
+std::shared_ptr<const std::vector<Vector>> window_weights(const AccelerationFilter& filter, ControlHold hold) {
+  static std::mutex mutex;
+  static std::map<std::tuple<int, int, int, ControlHold>, std::shared_ptr<const std::vector<Vector>>> made;
+  const auto key = std::make_tuple(filter.window, filter.order, filter.derivative, hold);
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (const auto found = made.find(key); found != made.end()) return found->second;
+  }
+  const SavitzkyGolayDerivative fit(filter.window, filter.order, filter.derivative);
+  auto weights = std::make_shared<std::vector<Vector>>();
+  for (int p = 0; p < filter.window; ++p) weights->push_back(acceleration_weights(fit, p, hold));
+  const std::lock_guard<std::mutex> lock(mutex);
+  return made.emplace(key, std::move(weights)).first->second;
+}
+
+}  // namespace
+
 Matrix filtered_at(const Transitions& data, const Matrix& y, const std::vector<int>& rows,
                    const AccelerationFilter& acceleration_filter, ControlHold hold) {
   if (y.rows() != data.size())
     throw std::invalid_argument(fmt::format(
         "filtered signal: {} rows for {} transitions; expected one per transition", y.rows(), data.size()));
   const int window = acceleration_filter.window;
-  const SavitzkyGolayDerivative filter(window, acceleration_filter.order, acceleration_filter.derivative);
-  std::vector<Vector> weights;
-  for (int p = 0; p < window; ++p) weights.push_back(acceleration_weights(filter, p, hold));
+  const std::shared_ptr<const std::vector<Vector>> made = window_weights(acceleration_filter, hold);
+  const std::vector<Vector>& weights = *made;
   const int h = window / 2;
   // The segment of every row, and each segment's samples of every column: its rows' values and, for
   // the last sample (x_next of its last row), the last row's value again.

@@ -186,7 +186,11 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     std::vector<EffectFit> exact(sets.size());
     std::atomic<std::size_t> next{0};
     ForkJoin workers;
-    workers.run(std::max(1, std::min<int>(o.threads, static_cast<int>(sets.size()))), [&](int, int) {
+    const int at_once = std::max(1, std::min<int>(o.threads, static_cast<int>(sets.size())));
+    // The threads the sets leave idle evaluate each fit's model at once (a grown size fits one set,
+    // and so do the backward check and the widths' refit below).
+    accepted_context.threads = std::max(1, o.threads / at_once);
+    workers.run(at_once, [&](int, int) {
       for (std::size_t s = next++; s < sets.size(); s = next++) {
         const std::vector<int>& subset = sets[s];
         const EffectFit& lead = singles[static_cast<std::size_t>(subset.front())];
@@ -236,7 +240,9 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     best = without_redundant(best, context, accepted_context, candidates, removed);
     // The Coulomb members' smoothing velocities, fitted inside the set; the set refitted at them.
     bool rescaled = false;
-    for (const auto& [name, v0] : joint_smoothing(context, best)) {
+    FitContext widths_context = context;
+    widths_context.threads = o.threads;
+    for (const auto& [name, v0] : joint_smoothing(widths_context, best)) {
       for (LibraryEffect& e : candidates)
         if (e.name == name && e.smoothing && e.smoothing->width != v0) {
           e = with_smoothing(e, v0);

@@ -134,7 +134,7 @@ std::map<std::string, double> joint_smoothing(const FitContext& c, const EffectF
   // The set linearised once; a grid value replaces only the Coulomb member's own columns (its
   // smoothing moves nothing else), unless the member is a force of the model itself, whose residual
   // its smoothing then changes too.
-  LinearisedFits fits(trial, members, beside, 1, true);
+  LinearisedFits fits(trial, members, beside, c.threads, true);
   for (std::size_t m = 0; m < members.size(); ++m) {
     const LibraryEffect effect = find_candidate(c.model, members[m].effect);
     if (!effect.smoothing) continue;
@@ -142,7 +142,7 @@ std::map<std::string, double> joint_smoothing(const FitContext& c, const EffectF
                                       [&](const auto& force) { return force.first == effect.name; });
     const auto objective = [&](double width) {
       trial.model.smoothing[effect.name] = width;
-      if (in_model) return LinearisedFits(trial, members, beside).training_left(all);
+      if (in_model) return LinearisedFits(trial, members, beside, c.threads).training_left(all);
       fits.relinearise(static_cast<int>(m), trial);
       return fits.training_left(all);
     };
@@ -150,7 +150,7 @@ std::map<std::string, double> joint_smoothing(const FitContext& c, const EffectF
                                            objective);
     trial.model.smoothing[effect.name] = v0;
     if (in_model)
-      fits = LinearisedFits(trial, members, beside, 1, true);
+      fits = LinearisedFits(trial, members, beside, c.threads, true);
     else
       fits.relinearise(static_cast<int>(m), trial);
     out[effect.name] = v0;

@@ -89,6 +89,9 @@ struct FitContext {
   /// probes it, and checks it again at the estimate). False: the rebuilt model at every theta, the
   /// general path, which gives the same fit to rounding where the closed form holds.
   bool probe_affine = true;
+  /// Evaluations of the model one fit runs at once (its regressor's columns by differences, the
+  /// probes of the closed form): set by the searches to the threads their own loops leave idle.
+  int threads = 1;
 };
 
 /// The model integrated as configured.

@@ -60,7 +60,8 @@ ModelSpec with_fitted_smoothing(const FitContext& context);
 /// around context.model, with a viscous friction (viscous_twin) beside each Coulomb member, as when
 /// it was fitted alone: v0 is the switch's width, not a slope the set leaves to it. A v0 fitted alone
 /// is biased by what the other effects do (on a cart with Coulomb friction and a constant force, v0
-/// alone came out at 0.6 times its value); the set's v0 is not. Effect name -> v0.
+/// alone came out at 0.6 times its value); the set's v0 is not. The set's columns are computed
+/// context.threads at once. Effect name -> v0.
 std::map<std::string, double> joint_smoothing(const FitContext& context, const EffectFit& fit);
 
 }  // namespace gpilqg::diagnosis
