@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <atomic>
-#include <deque>
 #include <iterator>
 #include <map>
 #include <mutex>

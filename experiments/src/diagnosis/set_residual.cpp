@@ -37,6 +37,16 @@ ModelSpec EffectSet::model_at(const ModelSpec& base, const VectorCRef& theta) co
   return model;
 }
 
+EffectSet::Columns EffectSet::columns(bool with_forces) const {
+  Columns out;
+  for (std::size_t e = 0; e < effects.size(); ++e) {
+    const bool force = with_forces && linear_forces({effects[e]});
+    if (force) out.forces.push_back(effects[e]);
+    for (Eigen::Index j = offset[e]; j < offset[e + 1]; ++j) (force ? out.force_columns : out.others).push_back(j);
+  }
+  return out;
+}
+
 namespace {
 
 /// True when `actual` and `predicted`, residuals at some theta, agree to rounding: their difference
@@ -91,29 +101,22 @@ Matrix SetResidual::regressor(const VectorCRef& theta, const std::vector<int>& r
   for (const Evaluation& e : regressors_)
     if (e.theta == theta && e.rows == rows) return e.value;
   Matrix J(static_cast<Eigen::Index>(rows.size()) * c_.weights.size(), theta.size());
-  std::vector<const LibraryEffect*> forces;
-  std::vector<Eigen::Index> force_columns, differenced;
-  std::vector<Vector> points;  // theta - h e_j, theta + h e_j of every differenced column j
+  const EffectSet::Columns columns = set_.columns(c_.criterion->inverse_dynamics() != nullptr);
+  std::vector<Vector> points;  // theta - h e_j, theta + h e_j of every other column j
   std::vector<double> inverse_widths;
-  for (std::size_t e = 0; e < set_.effects.size(); ++e) {
-    if (c_.criterion->inverse_dynamics() && linear_forces({set_.effects[e]})) {
-      forces.push_back(set_.effects[e]);
-      for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) force_columns.push_back(j);
-      continue;
-    }
-    for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) {
-      const DifferenceStep d = difference_step(set_.parameter(j), theta, j);
-      differenced.push_back(j);
-      points.push_back(d.minus);
-      points.push_back(d.plus);
-      inverse_widths.push_back(d.inverse_width());
-    }
+  for (Eigen::Index j : columns.others) {
+    const DifferenceStep d = difference_step(set_.parameter(j), theta, j);
+    points.push_back(d.minus);
+    points.push_back(d.plus);
+    inverse_widths.push_back(d.inverse_width());
   }
   const std::vector<Vector> r = rebuilt(points, rows);
   // The residual is x' - phi, so d phi / d theta = -(d residual / d theta).
-  for (std::size_t i = 0; i < differenced.size(); ++i) J.col(differenced[i]) = (r[2 * i] - r[2 * i + 1]) * inverse_widths[i];
-  if (!forces.empty())
-    J(Eigen::all, force_columns) = weighted_force_regressor(set_.model_at(c_.model, theta), forces, c_, rows);
+  for (std::size_t i = 0; i < columns.others.size(); ++i)
+    J.col(columns.others[i]) = (r[2 * i] - r[2 * i + 1]) * inverse_widths[i];
+  if (!columns.forces.empty())
+    J(Eigen::all, columns.force_columns) =
+        weighted_force_regressor(set_.model_at(c_.model, theta), columns.forces, c_, rows);
   return remember(regressors_, Evaluation{theta, rows, std::move(J), true}).value;
 }
 
@@ -145,29 +148,22 @@ std::optional<AffineForceResidual> SetResidual::probed_affine_residual(const Vec
   try {
     // theta0, each parameter that is not a linear force's moved by its scale, and every parameter
     // moved by two scales: one batch of independent evaluations.
-    std::vector<const LibraryEffect*> forces;
-    std::vector<Eigen::Index> force_columns, probed;
+    const EffectSet::Columns columns = set_.columns(true);
     std::vector<Vector> points{theta0};
-    for (std::size_t e = 0; e < set_.effects.size(); ++e) {
-      if (linear_forces({set_.effects[e]})) {
-        forces.push_back(set_.effects[e]);
-        for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) force_columns.push_back(j);
-        continue;
-      }
-      for (Eigen::Index j = set_.offset[e]; j < set_.offset[e + 1]; ++j) {
-        probed.push_back(j);
-        points.push_back(theta0);
-        points.back()(j) += step(j);
-      }
+    for (Eigen::Index j : columns.others) {
+      points.push_back(theta0);
+      points.back()(j) += step(j);
     }
     const Vector far = theta0 + 2.0 * step;
     points.push_back(far);
     const std::vector<Vector> r = rebuilt(points, rows);
     const Vector& r0 = r.front();
     Matrix G(r0.size(), p);
-    for (std::size_t i = 0; i < probed.size(); ++i) G.col(probed[i]) = (r0 - r[i + 1]) / step(probed[i]);
-    if (!forces.empty())
-      G(Eigen::all, force_columns) = weighted_force_regressor(set_.model_at(c_.model, theta0), forces, c_, rows);
+    for (std::size_t i = 0; i < columns.others.size(); ++i)
+      G.col(columns.others[i]) = (r0 - r[i + 1]) / step(columns.others[i]);
+    if (!columns.forces.empty())
+      G(Eigen::all, columns.force_columns) =
+          weighted_force_regressor(set_.model_at(c_.model, theta0), columns.forces, c_, rows);
     if (!affine_to_rounding(r.back(), r0 - G * (far - theta0), r0)) return std::nullopt;
     return AffineForceResidual(theta0, c_.weights.size(), r0, std::move(G));
   } catch (const std::invalid_argument&) {  // a probe outside the physical range, or a singular model

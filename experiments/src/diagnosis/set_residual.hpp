@@ -40,6 +40,16 @@ struct EffectSet {
   Vector null_values(const ModelSpec& base) const;
   /// `base` with every effect of the set at its slice of theta (ModelSpec::with, which validates).
   ModelSpec model_at(const ModelSpec& base, const VectorCRef& theta) const;
+
+  /// The stacked parameters split by how their regressor columns are found: those of the forces
+  /// linear in their parameters (their bases, weighted_force_regressor) and the others (the model
+  /// evaluated at a moved theta).
+  struct Columns {
+    std::vector<const LibraryEffect*> forces;
+    std::vector<Eigen::Index> force_columns, others;
+  };
+  /// `with_forces` false: every parameter is among the others (no criterion with the forces' bases).
+  Columns columns(bool with_forces) const;
 };
 
 /// The residual of a set of effects and its regressor (file comment). One per fit; not to be shared

@@ -145,6 +145,8 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
   S.method = SearchMethod::Subsets;
   S.model = context.model;
   FitContext accepted_context = context;  // model stays M_0; residual becomes the accepted model's
+  FitContext widths_context = context;    // the widths of a set's Coulomb members: on every thread
+  widths_context.threads = o.threads;
   std::vector<std::string> accepted;      // the members of the accepted set
   std::string last_rejection, stop_growing;
   std::vector<int> screened;  // the best screened set of the size before
@@ -240,8 +242,6 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     best = without_redundant(best, context, accepted_context, candidates, removed);
     // The Coulomb members' smoothing velocities, fitted inside the set; the set refitted at them.
     bool rescaled = false;
-    FitContext widths_context = context;
-    widths_context.threads = o.threads;
     for (const auto& [name, v0] : joint_smoothing(widths_context, best)) {
       for (LibraryEffect& e : candidates)
         if (e.name == name && e.smoothing && e.smoothing->width != v0) {
