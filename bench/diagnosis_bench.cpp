@@ -6,7 +6,8 @@
 // samples, one continuous record; tests/support/ball_drive.hpp), imported from encoder counts. And the
 // ranking of every candidate on the inverse-dynamics criterion on the 7-joint arm stand-in
 // (tests/support/arm7_log.hpp; 78 of the library's 92, the actuators' gains and gears not being
-// candidates there), 5 s and 20 s at 1 kHz, with or without --auto.
+// candidates there), 5 s and 20 s at 1 kHz, with or without --auto; and --auto on 20 s of the same arm as
+// built (link masses off the model's) with biased torque sensors.
 //
 //   build/bench/gpilqg_diagnosis_bench --benchmark_min_time=1
 
@@ -101,28 +102,35 @@ void BM_DiagnoseAutoDrive(benchmark::State& state) {
   state.counters["samples"] = static_cast<double>(state.range(0));
 }
 
-/// The arm's record of `milliseconds` (one sample per millisecond), made once per length.
-const test::Arm7Log& arm7_record(long milliseconds) {
-  static std::map<long, test::Arm7Log> made;
-  auto it = made.find(milliseconds);
+/// The arm's record of `milliseconds` (one sample per millisecond), made once per length and kind:
+/// the model with friction, or (`as_built`) the arm as built with friction and torque-sensor offsets.
+const test::Arm7Log& arm7_record(long milliseconds, bool as_built = false) {
+  static std::map<std::pair<long, bool>, test::Arm7Log> made;
+  auto it = made.find({milliseconds, as_built});
   if (it != made.end()) return it->second;
   test::Arm7Options o;
   o.seconds = static_cast<double>(milliseconds) / 1000.0;
   o.seed = 3;
-  return made.emplace(milliseconds, test::arm7_log(GPILQG_BENCH_SOURCE_DIR, o)).first->second;
+  if (as_built) {
+    o.as_built = true;
+    o.sensor_offsets = (Vector(test::kArm7Joints) << 0.12, -0.2, 0.08, 0.15, -0.05, 0.03, -0.06).finished();
+  }
+  return made.emplace(std::pair{milliseconds, as_built}, test::arm7_log(GPILQG_BENCH_SOURCE_DIR, o)).first->second;
 }
 
 /// The whole diagnosis with the command line's defaults (the criterion chosen by the data: inverse
 /// dynamics on this record; the label names it): every candidate ranked (the counter `candidates`),
-/// and with --auto the search for several effects (the counter `effects_found`).
-void diagnose_arm7(benchmark::State& state, bool auto_select) {
-  const test::Arm7Log& log = arm7_record(state.range(0));
+/// and with --auto the search for several effects (the counter `effects_found`, of which
+/// `friction_found` are joint friction, `offsets_found` constant joint torques and `others_found` the
+/// rest: body forces, masses, springs, armatures, a delay).
+void diagnose_arm7(benchmark::State& state, bool auto_select, bool as_built = false) {
+  const test::Arm7Log& log = arm7_record(state.range(0), as_built);
   diagnosis::DiagnoseRequest request;
   request.system = log.model.system;
   request.auto_select = auto_select;
   const diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(request);
   std::string first, criterion;
-  std::size_t candidates = 0, found = 0;
+  std::size_t candidates = 0, found = 0, friction = 0, offsets = 0;
   for (auto _ : state) {
     const diagnosis::DiagnosisReport report = diagnosis::diagnose(log.measured, options);
     first = report.ranking.empty() ? "none" : report.ranking.front().fit.effect;
@@ -130,21 +138,38 @@ void diagnose_arm7(benchmark::State& state, bool auto_select) {
     candidates = 0;
     for (const auto& entry : report.ranking) candidates += 1 + entry.aliases.size();
     found = report.verdict.effects.size();
+    friction = offsets = 0;
+    for (const std::string& e : report.verdict.effects) {
+      if (e.starts_with("joint_viscous_damping:") || e.starts_with("joint_coulomb_friction:") ||
+          e.ends_with(".damping") || e.ends_with(".frictionloss"))
+        ++friction;
+      else if (e.starts_with("constant_force:"))
+        ++offsets;
+    }
     benchmark::DoNotOptimize(candidates);
   }
   state.SetLabel(criterion + ", first " + first);
   state.counters["candidates"] = static_cast<double>(candidates);
   state.counters["effects_found"] = static_cast<double>(found);
+  if (auto_select) {
+    state.counters["friction_found"] = static_cast<double>(friction);
+    state.counters["offsets_found"] = static_cast<double>(offsets);
+    state.counters["others_found"] = static_cast<double>(found - friction - offsets);
+  }
   state.counters["samples"] = static_cast<double>(state.range(0) + 1);
 }
 
 void BM_RankArm7InverseDynamics(benchmark::State& state) { diagnose_arm7(state, false); }
 void BM_DiagnoseAutoArm7InverseDynamics(benchmark::State& state) { diagnose_arm7(state, true); }
+/// The arm as built (masses and a centre of mass off the model's) with biased torque sensors: the
+/// friction, the offsets and what else the search adds to the model.
+void BM_DiagnoseAutoArm7AsBuilt(benchmark::State& state) { diagnose_arm7(state, true, true); }
 
 BENCHMARK(BM_DiagnoseOneEffect)->Unit(benchmark::kSecond)->Iterations(3);
 BENCHMARK(BM_DiagnoseAutoThreeEffects)->Unit(benchmark::kSecond)->Iterations(3);
 BENCHMARK(BM_DiagnoseAutoDrive)->Args({25000, 0})->Args({25000, 1})->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_RankArm7InverseDynamics)->Arg(5000)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_DiagnoseAutoArm7InverseDynamics)->Arg(5000)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_DiagnoseAutoArm7AsBuilt)->Arg(20000)->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace

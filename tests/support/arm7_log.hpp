@@ -96,6 +96,13 @@ struct Arm7Options {
   /// well inside RK4's accurate range (h lambda below 0.7).
   int substeps = 10;
   Arm7Truth truth = arm7_truth();
+  /// The world is the arm as built, tests/experiments/models/arm7_as_built.xml (link masses 6% to 15%
+  /// and one centre of mass 7 mm off the model's), not the model itself: every real arm's masses differ
+  /// from the values its model holds. The controller's gravity compensation stays the model's.
+  bool as_built = false;
+  /// [N m] per joint: the constant bias of each torque sensor, added to the recorded torques (empty:
+  /// none). Joint torque sensors drift by a few tenths of a N m between calibrations.
+  Vector sensor_offsets;
 };
 
 /// A stand-in record and everything it was made from.
@@ -106,12 +113,17 @@ struct Arm7Log {
   Matrix reference;         ///< T x 7: the reference joint positions
   Arm7Truth truth;
   ModelSpec model;          ///< arm7.xml as it is (rigid-body dynamics only)
-  ModelSpec world;          ///< the model with the truth's friction
+  ModelSpec world;          ///< the model (or the arm as built) with the truth's friction
   double dt = 1e-3;
 };
 
 inline std::filesystem::path arm7_model(const std::filesystem::path& source_dir) {
   return source_dir / "tests" / "experiments" / "models" / "arm7.xml";
+}
+
+/// The arm as built (Arm7Options::as_built).
+inline std::filesystem::path arm7_as_built(const std::filesystem::path& source_dir) {
+  return source_dir / "tests" / "experiments" / "models" / "arm7_as_built.xml";
 }
 
 /// `model` with the friction of `truth` on every joint, by the library's effect names.
@@ -206,7 +218,9 @@ inline Arm7Log arm7_log(const std::filesystem::path& source_dir, const Arm7Optio
   Arm7Log log;
   log.truth = options.truth;
   log.model.system = file.string();
-  log.world = arm7_world(log.model, log.truth);
+  ModelSpec built = log.model;
+  if (options.as_built) built.system = arm7_as_built(source_dir).string();
+  log.world = arm7_world(built, log.truth);
   const DynamicsPtr world = log.world.build();
   const auto workspace = world->make_workspace();
   Arm7Gravity gravity(file);
@@ -261,6 +275,7 @@ inline Arm7Log arm7_log(const std::filesystem::path& source_dir, const Arm7Optio
       measured.x(i, j) += options.position_noise * gauss(random);
       measured.x(i, n + j) += options.velocity_noise * gauss(random);
       measured.u(i, j) += options.torque_noise * gauss(random);
+      if (options.sensor_offsets.size() > 0) measured.u(i, j) += options.sensor_offsets(j);
     }
   }
   log.clean.system = system_signature(file.string());

@@ -12,6 +12,7 @@
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/linearised_fits.hpp"
+#include "gpilqg/experiments/diagnosis/subset_exchange.hpp"
 #include "gpilqg/experiments/diagnosis/velocity_scales.hpp"
 
 namespace gpilqg::diagnosis {
@@ -31,23 +32,6 @@ double binomial(int n, int k) {
   double out = 1.0;
   for (int i = 1; i <= k; ++i) out = out * static_cast<double>(n - k + i) / static_cast<double>(i);
   return out;
-}
-
-/// Whether `grown` screens better than the set whose screening folds are `before`
-/// (LinearisedFits::screening_folds, computed once for every growth of it) by more than the noise of
-/// the cross-validation: the fold-by-fold reduction sum_f (left_f(base) - left_f(grown)) must exceed
-/// its standard error, sqrt(K / (K - 1) sum_f (d_f - mean d)^2) (the one-standard-error rule of
-/// cross-validated model selection, Breiman et al.; Hastie, Tibshirani and Friedman, 7.10). Without
-/// folds: any reduction.
-bool screens_better(const LinearisedFits& fits, const std::vector<double>& before, const std::vector<int>& grown) {
-  const std::vector<double> after = fits.screening_folds(grown);
-  const auto K = static_cast<double>(before.size());
-  double total = 0.0;
-  for (std::size_t f = 0; f < before.size(); ++f) total += before[f] - after[f];
-  if (before.size() < 2) return total > 0.0;
-  double spread = 0.0;
-  for (std::size_t f = 0; f < before.size(); ++f) spread += std::pow(before[f] - after[f] - total / K, 2);
-  return total > std::sqrt(K / (K - 1.0) * spread);
 }
 
 /// The (at most `count`) sets `base` + one more candidate with the least screening score, best first (the
@@ -141,6 +125,10 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     for (std::size_t b = 0; b < n; ++b)
       forbidden[a][b] = a == b ? !singles[a].identifiable : declared_same(*system, singles[a].effect, singles[b].effect);
 
+  const MayJoin may_join = [&](int a, int b) {
+    return !forbidden[static_cast<std::size_t>(a)][static_cast<std::size_t>(b)];
+  };
+
   Selection S;
   S.method = SearchMethod::Subsets;
   S.model = context.model;
@@ -158,6 +146,7 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     const bool exhaustive = k <= o.max_subset && binomial(static_cast<int>(n), k) <= kExhaustiveSets;
     if (!exhaustive && k > 1 && screened.empty()) break;
     std::vector<std::vector<int>> sets;
+    std::vector<Exchange> exchanges;
     if (exhaustive) {
       sets = best_subsets(fits, k, kExactFitsPerSize, forbidden);
     } else {
@@ -170,10 +159,15 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
       const std::vector<std::vector<int>> grown = grown_subsets(fits, screened, fits.size(), forbidden);
       const std::vector<double> before = fits.screening_folds(screened);
       for (const std::vector<int>& set : grown)
-        if (k == 1 || screens_better(fits, before, set)) {
+        if (k == 1 || lowers_by_more_than_its_error(before, fits.screening_folds(set))) {
           sets.push_back(set);
           break;
         }
+      // Then members taken earlier as proxies of effects now in the set are exchanged for the
+      // candidates the data prefer in their place (sequential replacement, subset_exchange.hpp).
+      if (!sets.empty())
+        sets.front() = exchanged([&](const std::vector<int>& set) { return fits.screening_folds(set); }, fits.size(),
+                                 sets.front(), may_join, k, &exchanges);
       if (sets.empty() && !grown.empty())
         stop_growing = fmt::format("; none of the {} sets of {} grown from the best of {} lowers the cross-validated "
                                    "screening score by more than its standard error",
@@ -183,7 +177,12 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     screened = sets.front();
     searched = k;
     if (o.progress && !exhaustive)
-      o.progress(fmt::format("sets of {}: grown from the best set of {} (too many to search them all)", k, k - 1));
+      o.progress(fmt::format("sets of {}: grown from the best set of {} (too many to search them all){}", k, k - 1,
+                             exchanges.empty() ? "" : ", then members exchanged:"));
+    for (const Exchange& e : exchanges)
+      if (o.progress)
+        o.progress(fmt::format("  {} for {}", singles[static_cast<std::size_t>(e.in)].effect,
+                               singles[static_cast<std::size_t>(e.out)].effect));
     // The sets' exact fits are independent: o.threads at once, then compared in the order of `sets`.
     std::vector<EffectFit> exact(sets.size());
     std::atomic<std::size_t> next{0};
