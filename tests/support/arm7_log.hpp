@@ -218,6 +218,8 @@ inline Arm7Log arm7_log(const std::filesystem::path& source_dir, const Arm7Optio
   Arm7Log log;
   log.truth = options.truth;
   log.model.system = file.string();
+  if (options.sensor_offsets.size() != 0 && options.sensor_offsets.size() != kArm7Joints)
+    throw std::invalid_argument("Arm7Options::sensor_offsets: expected 0 or 7 values, one per joint");
   ModelSpec built = log.model;
   if (options.as_built) built.system = arm7_as_built(source_dir).string();
   log.world = arm7_world(built, log.truth);

@@ -4,10 +4,16 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 namespace gpilqg::diagnosis {
 
 bool lowers_by_more_than_its_error(const std::vector<double>& before, const std::vector<double>& after) {
+  if (before.size() != after.size())
+    throw std::invalid_argument(fmt::format("screening scores of {} folds compared with scores of {} folds",
+                                            before.size(), after.size()));
   const auto K = static_cast<double>(before.size());
   double total = 0.0, score = 0.0;
   for (std::size_t f = 0; f < before.size(); ++f) {
@@ -23,13 +29,15 @@ bool lowers_by_more_than_its_error(const std::vector<double>& before, const std:
 
 std::vector<int> exchanged(const FoldScores& folds, int candidates, std::vector<int> set, const MayJoin& may_join,
                            int max_rounds, std::vector<Exchange>* made) {
-  const auto sum = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); };
+  struct Trial {
+    double total;
+    std::size_t where;
+    int in;
+    std::vector<double> folds;
+  };
   for (int round = 0; round < max_rounds; ++round) {
     const std::vector<double> now = folds(set);
-    double least = std::numeric_limits<double>::infinity();
-    std::vector<double> least_folds;
-    std::size_t where = 0;
-    int in = -1;
+    std::vector<Trial> trials;
     for (std::size_t i = 0; i < set.size(); ++i) {
       for (int c = 0; c < candidates; ++c) {
         if (std::find(set.begin(), set.end(), c) != set.end() || !may_join(c, c)) continue;
@@ -39,18 +47,17 @@ std::vector<int> exchanged(const FoldScores& folds, int candidates, std::vector<
         std::vector<int> trial = set;
         trial[i] = c;
         std::vector<double> scores = folds(trial);
-        const double total = sum(scores);
-        if (total < least) {
-          least = total;
-          least_folds = std::move(scores);
-          where = i;
-          in = c;
-        }
+        const double total = std::accumulate(scores.begin(), scores.end(), 0.0);
+        trials.push_back({total, i, c, std::move(scores)});
       }
     }
-    if (in < 0 || !lowers_by_more_than_its_error(now, least_folds)) break;
-    if (made != nullptr) made->push_back({set[where], in});
-    set[where] = in;
+    // The least score first; stable, so ties go to the earlier member and candidate.
+    std::stable_sort(trials.begin(), trials.end(), [](const Trial& x, const Trial& y) { return x.total < y.total; });
+    const auto passing = std::find_if(trials.begin(), trials.end(),
+                                      [&](const Trial& t) { return lowers_by_more_than_its_error(now, t.folds); });
+    if (passing == trials.end()) break;
+    if (made != nullptr) made->push_back({set[passing->where], passing->in});
+    set[passing->where] = passing->in;
   }
   return set;
 }

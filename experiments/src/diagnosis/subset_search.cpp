@@ -178,11 +178,14 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     searched = k;
     if (o.progress && !exhaustive)
       o.progress(fmt::format("sets of {}: grown from the best set of {} (too many to search them all){}", k, k - 1,
-                             exchanges.empty() ? "" : ", then members exchanged:"));
+                             exchanges.empty() ? ""
+                             : static_cast<int>(exchanges.size()) == k
+                                 ? fmt::format(", then members exchanged (the most at this size, {}):", k)
+                                 : std::string(", then members exchanged:")));
     for (const Exchange& e : exchanges)
       if (o.progress)
-        o.progress(fmt::format("  {} for {}", singles[static_cast<std::size_t>(e.in)].effect,
-                               singles[static_cast<std::size_t>(e.out)].effect));
+        o.progress(fmt::format("  {} -> {}", singles[static_cast<std::size_t>(e.out)].effect,
+                               singles[static_cast<std::size_t>(e.in)].effect));
     // The sets' exact fits are independent: o.threads at once, then compared in the order of `sets`.
     std::vector<EffectFit> exact(sets.size());
     std::atomic<std::size_t> next{0};

@@ -28,7 +28,8 @@ using MayJoin = std::function<bool(int, int)>;
 /// than the noise of the cross-validation: the reduction summed over the K folds, D = sum_f d_f with
 /// d_f = before_f - after_f, must exceed its standard error sqrt(K / (K - 1) sum_f (d_f - D / K)^2) (the
 /// one-standard-error rule of cross-validated model selection: Breiman, Friedman, Olshen and Stone;
-/// Hastie, Tibshirani and Friedman, 7.10). With one fold, any reduction. A reduction below
+/// Hastie, Tibshirani and Friedman, 7.10). With one fold, any reduction. Throws std::invalid_argument
+/// when the two have different numbers of folds. A reduction below
 /// sqrt(machine epsilon) = 1.5e-8 of the score is rounding, not a reduction: two candidates with the same
 /// column (MuJoCo's joint damping and the library's viscous friction under inverse dynamics) differ in
 /// score by 1e-14 of it, with folds that agree exactly.
@@ -42,11 +43,12 @@ struct Exchange {
 
 /// `set` improved by sequential replacement among the candidates 0 .. candidates - 1: each round scores
 /// every set that differs from it in one member (each member in turn for each candidate outside the set
-/// that may join the others) and makes the exchange of the least score when that lowers the score by
-/// more than its standard error (lowers_by_more_than_its_error); rounds go on until none does. The score
-/// falls strictly at each exchange, so no set comes back; at most `max_rounds` rounds. `made`, when
-/// given, receives the exchanges in order. The members keep their positions (the first stays first
-/// unless it is exchanged).
+/// that may join the others) and makes, of the exchanges that lower the score by more than its standard
+/// error (lowers_by_more_than_its_error), the one of the least score, as a growth takes the least
+/// growth that passes (the least score alone may be a reduction the folds disagree on); rounds go on
+/// until none passes. The score falls strictly at each exchange, so no set comes back; at most
+/// `max_rounds` rounds. `made`, when given, receives the exchanges in order. The members keep their
+/// positions (the first stays first unless it is exchanged).
 std::vector<int> exchanged(const FoldScores& folds, int candidates, std::vector<int> set, const MayJoin& may_join,
                            int max_rounds, std::vector<Exchange>* made = nullptr);
 

@@ -33,9 +33,10 @@
 /// FROLS grows its model term by term) by more than the standard error of that reduction over the
 /// folds (the one-standard-error rule; when the least score fails it, the next growth that passes),
 /// then every member is open to exchange for a candidate outside the set while an exchange lowers the
-/// score by more than its standard error (sequential replacement, subset_exchange.hpp: a member grown
-/// in early as the proxy of effects not yet in the set gives way to them), refitted exactly and judged
-/// like the others; growth stops when no growth passes that rule, or at max_steps effects. A size the held-out test does not accept does not stop it. So a set of
+/// score by more than its standard error, at most k exchanges at size k (sequential replacement,
+/// subset_exchange.hpp: a member grown in early as the proxy of effects not yet in the set gives way to
+/// them), refitted exactly and judged like the others; growth stops when no growth passes that rule,
+/// or at max_steps effects. A size the held-out test does not accept does not stop it. So a set of
 /// 14 frictions on 7 joints is reachable, at the cost of one exact joint fit per size.
 ///
 /// The linearised scores cost one small solve per subset, so the exact fits (a few per size) are
