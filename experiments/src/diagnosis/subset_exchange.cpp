@@ -35,18 +35,19 @@ std::vector<int> exchanged(const FoldScores& folds, int candidates, std::vector<
     int in;
     std::vector<double> folds;
   };
+  std::vector<double> now = folds(set);
   for (int round = 0; round < max_rounds; ++round) {
-    const std::vector<double> now = folds(set);
     std::vector<Trial> trials;
     for (std::size_t i = 0; i < set.size(); ++i) {
+      const int member = set[i];
       for (int c = 0; c < candidates; ++c) {
         if (std::find(set.begin(), set.end(), c) != set.end() || !may_join(c, c)) continue;
         bool allowed = true;
         for (std::size_t j = 0; j < set.size() && allowed; ++j) allowed = j == i || may_join(set[j], c);
         if (!allowed) continue;
-        std::vector<int> trial = set;
-        trial[i] = c;
-        std::vector<double> scores = folds(trial);
+        set[i] = c;  // the trial, in place
+        std::vector<double> scores = folds(set);
+        set[i] = member;
         const double total = std::accumulate(scores.begin(), scores.end(), 0.0);
         trials.push_back({total, i, c, std::move(scores)});
       }
@@ -58,6 +59,7 @@ std::vector<int> exchanged(const FoldScores& folds, int candidates, std::vector<
     if (passing == trials.end()) break;
     if (made != nullptr) made->push_back({set[passing->where], passing->in});
     set[passing->where] = passing->in;
+    now = std::move(passing->folds);  // the scores of the set it is now
   }
   return set;
 }
