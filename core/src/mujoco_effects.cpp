@@ -87,6 +87,18 @@ double typical_scale(const std::string& field, double value) {
   return std::max(std::abs(value), floor);
 }
 
+/// The length of body `b`: the larger of its centre's distance from the body's origin and its radius of
+/// gyration sqrt((I1 + I2 + I3) / (2 m)) (the rms distance of its mass from the centre). A shift of the
+/// centre of mass is measured against it.
+double body_length(const mjModel* m, int b) {
+  const double* c = m->body_ipos + 3 * b;
+  const double* inertia = m->body_inertia + 3 * b;
+  const double offset = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+  const double gyration =
+      m->body_mass[b] > 0.0 ? std::sqrt((inertia[0] + inertia[1] + inertia[2]) / (2.0 * m->body_mass[b])) : 0.0;
+  return std::max({offset, gyration, 1e-3});
+}
+
 }  // namespace
 
 std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
@@ -143,6 +155,12 @@ std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
     LibraryEffect e = recalibration_entry("param:" + p.name, p, non_negative, false);
     e.parameters[0].scale = typical_scale(p.name, p.value);
     if (p.name.ends_with(".gear")) e.parameters[0].lower = -std::numeric_limits<double>::infinity();
+    if (const auto at = p.name.rfind(".com_"); at != std::string::npos && p.name.size() == at + 6) {
+      // A centre-of-mass coordinate has either sign, and may be zero in the file.
+      e.parameters[0].lower = -std::numeric_limits<double>::infinity();
+      e.parameters[0].strictly_positive = false;
+      e.parameters[0].scale = body_length(m, mj_name2id(m, mjOBJ_BODY, p.name.substr(0, at).c_str()));
+    }
     out.push_back(std::move(e));
   }
   return out;

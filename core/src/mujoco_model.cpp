@@ -238,7 +238,14 @@ std::vector<MujocoModel::Field> MujocoModel::fields() const {
   constexpr double kZero = 0.0;
   for (int b = 1; b < m_->nbody; ++b) {
     const std::string name = object_name(m_, mjOBJ_BODY, b);
-    if (!name.empty()) out.push_back({name + ".mass", "kg", &m_->body_mass[b], kZero, true});
+    if (name.empty()) continue;
+    out.push_back({name + ".mass", "kg", &m_->body_mass[b], kZero, true});
+    // The centre of mass in the body's frame (MuJoCo's body_ipos): moving it keeps the mass and the
+    // inertia about the centre, and changes the first moment m c that rigid-body dynamics is linear in.
+    const char* axes[] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k)
+      out.push_back({fmt::format("{}.com_{}", name, axes[k]), "m", &m_->body_ipos[3 * b + k],
+                     -std::numeric_limits<double>::infinity(), false});
   }
   for (int j = 0; j < m_->njnt; ++j) {
     const std::string name = object_name(m_, mjOBJ_JOINT, j);

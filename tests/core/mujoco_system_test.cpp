@@ -214,6 +214,34 @@ std::string write_model(const std::string& label, const std::string& text) {
   return path.string();
 }
 
+// A centre-of-mass override moves the body's inertial frame (body_ipos) and nothing else: the arm with
+// forearm.com_x = 0.03 and forearm.com_z = -0.23 moves as the file whose forearm has
+// <inertial pos="0.03 0 -0.23"> with the same mass and inertia about its centre.
+TEST(MujocoSystem, ACentreOfMassOverrideIsTheFileWithTheBodysInertialFrameMoved) {
+  const auto arm = MujocoSystem::load(arm_path());
+  double com_z = 1.0;
+  for (const auto& p : arm->parameters())
+    if (p.name == "forearm.com_z") com_z = p.value;
+  EXPECT_DOUBLE_EQ(com_z, -0.2);
+  const auto moved = arm->with_parameters({{"forearm.com_x", 0.03}, {"forearm.com_z", -0.23}});
+  std::string text;
+  {
+    std::ifstream in(arm_path());
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string from = R"(<inertial pos="0 0 -0.2" mass="0.6")";
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, from.size(), R"(<inertial pos="0.03 0 -0.23" mass="0.6")");
+  const auto file = MujocoSystem::load(write_model("com_moved", text));
+  for (const Vector& x : {Vector((Vector(4) << 0.7, -0.4, 0.3, 0.1).finished()),
+                          Vector((Vector(4) << -1.2, 0.9, -0.5, 2.0).finished())}) {
+    const Vector u = (Vector(2) << 0.4, -0.3).finished();
+    EXPECT_TRUE(test::matrices_near(moved->f(x, u), file->f(x, u), 1e-12, 1e-12));
+    EXPECT_FALSE(test::matrices_near(arm->f(x, u), file->f(x, u), 1e-3, 1e-3)) << "the shift changes the motion";
+  }
+}
+
 TEST(MujocoSystem, TheLibraryHasTheGenericEffectsWithAliases) {
   const auto& library = effect_library(arm_path());
   std::vector<std::string> names;

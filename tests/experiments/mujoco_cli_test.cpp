@@ -74,12 +74,14 @@ TEST_P(MujocoDiagnosisCli, NamesTheChangedFieldWithItsValue) {
   EXPECT_NEAR(fitted, c.value, c.tolerance * c.value) << verdict.dump();
 }
 
-// Friction loss within 30%: MuJoCo's is a constraint, the library's Coulomb friction a tanh.
+// Friction loss within 30%: MuJoCo's is a constraint, the library's Coulomb friction a tanh. The
+// forearm's centre of mass 3 cm off the link's line, in the plane of motion.
 INSTANTIATE_TEST_SUITE_P(TwoLinkArm, MujocoDiagnosisCli,
                          ::testing::Values(HiddenField{"elbow.damping", 0.35, 0.15},
                                            HiddenField{"forearm.mass", 0.75, 0.15},
                                            HiddenField{"elbow_motor.gear", 1.25, 0.15},
-                                           HiddenField{"shoulder.frictionloss", 0.3, 0.30}),
+                                           HiddenField{"shoulder.frictionloss", 0.3, 0.30},
+                                           HiddenField{"forearm.com_x", 0.03, 0.15}),
                          [](const auto& info) {
                            std::string name = info.param.field;
                            std::replace(name.begin(), name.end(), '.', '_');

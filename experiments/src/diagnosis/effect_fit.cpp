@@ -372,7 +372,10 @@ Vector data_scales(const Matrix& J, const FitContext& c, const std::vector<int>&
   return scale;
 }
 
-/// Test 1 of effect_test.hpp on a finished fit: a covariance that is not finite, a quantity that must
+/// Test 1 of effect_test.hpp on a finished fit: a covariance that is not finite, a parameter whose
+/// typical size (EffectParameter::scale) moves the predictions less than kRoundingLevel of the model's
+/// own motion (a regressor of finite-difference rounding: a centre of mass moved along the only axis
+/// its body turns about), a quantity that must
 /// stay positive (a mass: EffectParameter::strictly_positive) whose scale on the data exceeds kRunawayFactor times its
 /// own value, or a parameter further than kRunawayFactor times its scale from its value without the
 /// effect.
@@ -384,6 +387,12 @@ void check_identifiable(const EffectSet& set, const Vector& theta_hat, const Vec
       fit.identifiable = false;
       fit.not_identifiable = fmt::format("the covariance of {} = {:.4g} {} is not finite: the data do not see it there",
                                          spec.name, theta_hat(j), spec.unit);
+    } else if (fit.scale(j) * kRoundingLevel > spec.scale) {
+      fit.identifiable = false;
+      fit.not_identifiable = fmt::format(
+          "it does not change the predictions beyond rounding: a change of {} by its typical size of {:.3g} {} moves "
+          "them by {:.2g} of what the model itself moves them",
+          spec.name, spec.scale, spec.unit, spec.scale / fit.scale(j));
     } else if (spec.strictly_positive && null(j) > 0.0 && fit.scale(j) > kRunawayFactor * null(j)) {
       fit.identifiable = false;
       fit.not_identifiable = fmt::format(

@@ -7,7 +7,9 @@
 ///
 /// An effect (or a set) is accepted when all three hold:
 ///
-///  1. **Identifiable.** The data determine its parameters: the regressor is not zero, the
+///  1. **Identifiable.** The data determine its parameters: the regressor is not zero (nor at the
+///     level of rounding: a change of the parameter's typical size moves the predictions by more than
+///     kRoundingLevel of the model's own motion), the
 ///     Gauss-Newton covariance is finite, and no parameter moved further from its value without the
 ///     effect than kRunawayFactor (100) times its scale on these data (EffectFit::scale). An
 ///     armature of 2.7e21 kg m^2 on a wrist, or a link of 318 kg on an arm of 3 kg links, is a fit
@@ -46,6 +48,11 @@ namespace gpilqg::diagnosis {
 
 /// A parameter that moved further than this many times its scale on the data is not identifiable.
 inline constexpr double kRunawayFactor = 100.0;
+
+/// sqrt(machine epsilon): a parameter whose change by its typical size moves the predictions by less
+/// than this share of the model's own motion has a regressor of rounding (central differences of
+/// quantities that do not depend on it are ~eps relative), not of data.
+inline constexpr double kRoundingLevel = 1.4901161193847656e-08;
 
 /// The thresholds of test 3.
 struct EffectTestThresholds {
