@@ -89,7 +89,7 @@ double typical_scale(const std::string& field, double value) {
 
 /// The length of body `b`: the larger of its centre's distance from the body's origin and its radius of
 /// gyration sqrt((I1 + I2 + I3) / (2 m)) (the rms distance of its mass from the centre). A shift of the
-/// centre of mass is measured against it.
+/// centre of mass is measured against it, and stays within it.
 double body_length(const mjModel* m, int b) {
   const double* c = m->body_ipos + 3 * b;
   const double* inertia = m->body_inertia + 3 * b;
@@ -156,10 +156,15 @@ std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
     e.parameters[0].scale = typical_scale(p.name, p.value);
     if (p.name.ends_with(".gear")) e.parameters[0].lower = -std::numeric_limits<double>::infinity();
     if (const auto at = p.name.rfind(".com_"); at != std::string::npos && p.name.size() == at + 6) {
-      // A centre-of-mass coordinate has either sign, and may be zero in the file.
-      e.parameters[0].lower = -std::numeric_limits<double>::infinity();
+      // A centre-of-mass coordinate has either sign and may be zero in the file. It moves by at most the
+      // body's length: a centre further from the model's is not the same body. (Moved at a fixed inertia
+      // about the centre, it also adds m (c'^2 - c^2) to the inertia about the body's origin; unbounded,
+      // a centre 0.24 m off a 0.08 m link stood in for a joint's inertia about a vertical axis.)
+      const double length = body_length(m, mj_name2id(m, mjOBJ_BODY, p.name.substr(0, at).c_str()));
+      e.parameters[0].lower = p.value - length;
+      e.parameters[0].upper = p.value + length;
       e.parameters[0].strictly_positive = false;
-      e.parameters[0].scale = body_length(m, mj_name2id(m, mjOBJ_BODY, p.name.substr(0, at).c_str()));
+      e.parameters[0].scale = length;
     }
     out.push_back(std::move(e));
   }

@@ -71,7 +71,7 @@ TEST_P(MujocoDiagnosisCli, NamesTheChangedFieldWithItsValue) {
     for (const auto& a : report["ranking"][0]["alias_fits"])
       if (a["effect"] == target) fitted = a["parameters"][c.field].get<double>();
   }
-  EXPECT_NEAR(fitted, c.value, c.tolerance * c.value) << verdict.dump();
+  EXPECT_NEAR(fitted, c.value, c.tolerance * std::abs(c.value)) << verdict.dump();
 }
 
 // Friction loss within 30%: MuJoCo's is a constraint, the library's Coulomb friction a tanh. The
