@@ -123,6 +123,16 @@ mjModel* load_urdf(const std::string& path, const std::string& text, char* error
   return m;
 }
 
+/// True when body `b` can turn: a hinge, ball or free joint on it or on a body between it and the
+/// world. A body that only slides (or is welded to the world) moves its whole mass alike, wherever its
+/// centre is.
+bool turns(const mjModel* m, int b) {
+  for (; b > 0; b = m->body_parentid[b])
+    for (int j = m->body_jntadr[b]; j >= 0 && j < m->body_jntadr[b] + m->body_jntnum[b]; ++j)
+      if (m->jnt_type[j] != mjJNT_SLIDE) return true;
+  return false;
+}
+
 }  // namespace
 
 MujocoModel::MujocoModel(mjModel* m, std::string path) : m_(m), path_(std::move(path)) {}
@@ -240,6 +250,7 @@ std::vector<MujocoModel::Field> MujocoModel::fields() const {
     const std::string name = object_name(m_, mjOBJ_BODY, b);
     if (name.empty()) continue;
     out.push_back({name + ".mass", "kg", &m_->body_mass[b], kZero, true});
+    if (m_->body_mass[b] <= 0.0 || !turns(m_, b)) continue;  // a centre that cannot move anything
     // The centre of mass in the body's frame (MuJoCo's body_ipos): moving it keeps the mass and the
     // inertia about the centre, and changes the first moment m c that rigid-body dynamics is linear in.
     const char* axes[] = {"x", "y", "z"};
@@ -289,6 +300,21 @@ std::shared_ptr<const MujocoModel> MujocoModel::with_parameters(const std::map<s
     if (!std::isfinite(value) || value < it->lower || (it->positive && value <= it->lower))
       throw std::invalid_argument(fmt::format("parameter '{}' of {} = {}; expected a finite value {} {}", key, path_,
                                               value, it->positive ? ">" : ">=", it->lower));
+    if (const auto offset = it->value - copy->body_ipos; offset >= 0 && offset < 3 * copy->nbody) {
+      // A centre of mass moved off the body's frame: the compiler's shortcuts for a centre in that frame
+      // (the inertial frame taken as the body's; a diagonal mass-matrix block) no longer hold, and
+      // mj_setConst does not recompute them.
+      const auto body = static_cast<int>(offset / 3);
+      copy->body_sameframe[body] = 0;
+      copy->body_simple[body] = 0;
+      for (int g = 0; g < copy->ngeom; ++g)
+        if (copy->geom_bodyid[g] == body && copy->geom_sameframe[g] == 2) copy->geom_sameframe[g] = 0;
+      for (int s = 0; s < copy->nsite; ++s)
+        if (copy->site_bodyid[s] == body && copy->site_sameframe[s] == 2) copy->site_sameframe[s] = 0;
+      for (int i = copy->nv - 1; i >= 0; --i)
+        copy->dof_simplenum[i] =
+            copy->body_simple[copy->dof_bodyid[i]] ? (i + 1 < copy->nv ? copy->dof_simplenum[i + 1] : 0) + 1 : 0;
+    }
     if (key.ends_with(".mass")) {
       // The body's rotational inertia scales with its mass (a uniformly denser body).
       const auto body = static_cast<int>(it->value - copy->body_mass);

@@ -242,6 +242,25 @@ TEST(MujocoSystem, ACentreOfMassOverrideIsTheFileWithTheBodysInertialFrameMoved)
   }
 }
 
+// A body whose file puts its centre at the body's origin: MuJoCo's compiler marks its inertial frame as
+// the body's own, a shortcut the override must undo. A bob on a hinge with its centre at the hinge
+// swings under gravity once com_z = -0.1, as the file with <inertial pos="0 0 -0.1"> does.
+TEST(MujocoSystem, ACentreOfMassOverrideMovesACentreTheFileHasAtTheBodysOrigin) {
+  const auto model = [](const std::string& pos) {
+    return "<mujoco><option gravity=\"0 0 -9.81\"/><worldbody><body name=\"bob\"><joint name=\"hinge\" "
+           "type=\"hinge\" axis=\"0 1 0\"/><inertial pos=\"" + pos +
+           "\" mass=\"1\" diaginertia=\"0.01 0.01 0.01\"/></body></worldbody></mujoco>";
+  };
+  const auto at_origin = MujocoSystem::load(write_model("com_at_origin", model("0 0 0")));
+  const auto below = MujocoSystem::load(write_model("com_below", model("0 0 -0.1")));
+  const auto moved = at_origin->with_parameters({{"bob.com_z", -0.1}});
+  const Vector x = (Vector(2) << 0.4, 0.0).finished();
+  const Vector u = Vector::Zero(0);
+  EXPECT_NEAR(at_origin->f(x, u)(1), 0.0, 1e-12) << "no lever, no swing";
+  EXPECT_TRUE(test::matrices_near(moved->f(x, u), below->f(x, u), 1e-12, 1e-12));
+  EXPECT_LT(below->f(x, u)(1), -1.0);
+}
+
 TEST(MujocoSystem, TheLibraryHasTheGenericEffectsWithAliases) {
   const auto& library = effect_library(arm_path());
   std::vector<std::string> names;
@@ -249,8 +268,19 @@ TEST(MujocoSystem, TheLibraryHasTheGenericEffectsWithAliases) {
   for (const char* expected :
        {"joint_viscous_damping:shoulder", "joint_coulomb_friction:elbow", "actuator_gain:elbow_motor",
         "external_force_x:forearm", "external_force_z:upper_arm", "param:forearm.mass", "param:elbow.damping",
-        "param:elbow.armature", "param:elbow.frictionloss", "param:shoulder.stiffness", "param:shoulder_motor.gear"})
+        "param:elbow.armature", "param:elbow.frictionloss", "param:shoulder.stiffness", "param:shoulder_motor.gear",
+        "param:forearm.com_x", "param:upper_arm.com_z"})
     EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
+  // A centre of mass moves by at most its body's length: for the forearm the larger of its centre's
+  // 0.2 m from the elbow and its radius of gyration sqrt((0.008 + 0.008 + 0.0005) / 1.2) = 0.117 m.
+  for (const auto& e : library)
+    if (e.name == "param:forearm.com_x") {
+      ASSERT_EQ(e.parameters.size(), 1u);
+      EXPECT_DOUBLE_EQ(e.parameters[0].scale, 0.2);
+      EXPECT_DOUBLE_EQ(e.parameters[0].lower, -0.2);
+      EXPECT_DOUBLE_EQ(e.parameters[0].upper, 0.2);
+      EXPECT_FALSE(e.parameters[0].strictly_positive);
+    }
   const auto entry = find_system(arm_path());
   bool damping_alias = false;
   for (const auto& group : entry->same_physics)

@@ -373,21 +373,27 @@ Vector data_scales(const Matrix& J, const FitContext& c, const std::vector<int>&
 }
 
 /// Test 1 of effect_test.hpp on a finished fit: a covariance that is not finite, a parameter whose
-/// typical size (EffectParameter::scale) moves the predictions less than kRoundingLevel of the model's
-/// own motion (a regressor of finite-difference rounding: a centre of mass moved along the only axis
-/// its body turns about), a quantity that must
+/// regressor is a finite difference of the model (not a linear force's basis) and whose typical size
+/// (EffectParameter::scale) moves the predictions less than kRoundingLevel of the model's own motion (a
+/// regressor of rounding: a centre of mass moved along the only axis its body turns about), a quantity
+/// that must
 /// stay positive (a mass: EffectParameter::strictly_positive) whose scale on the data exceeds kRunawayFactor times its
 /// own value, or a parameter further than kRunawayFactor times its scale from its value without the
 /// effect.
 void check_identifiable(const EffectSet& set, const Vector& theta_hat, const Vector& ci_low, const Vector& ci_high,
                         const Vector& null, EffectFit& fit) {
+  // The columns of forces linear in their parameters are their exact bases, never rounding.
+  const std::vector<Eigen::Index> differences = set.columns(true).others;
+  const auto from_differences = [&](Eigen::Index j) {
+    return std::find(differences.begin(), differences.end(), j) != differences.end();
+  };
   for (Eigen::Index j = 0; j < theta_hat.size() && fit.identifiable; ++j) {
     const EffectParameter& spec = set.parameter(j);
     if (!std::isfinite(ci_low(j)) || !std::isfinite(ci_high(j))) {
       fit.identifiable = false;
       fit.not_identifiable = fmt::format("the covariance of {} = {:.4g} {} is not finite: the data do not see it there",
                                          spec.name, theta_hat(j), spec.unit);
-    } else if (fit.scale(j) * kRoundingLevel > spec.scale) {
+    } else if (from_differences(j) && fit.scale(j) * kRoundingLevel > spec.scale) {
       fit.identifiable = false;
       fit.not_identifiable = fmt::format(
           "it does not change the predictions beyond rounding: a change of {} by its typical size of {:.3g} {} moves "

@@ -7,9 +7,9 @@
 ///
 /// An effect (or a set) is accepted when all three hold:
 ///
-///  1. **Identifiable.** The data determine its parameters: the regressor is not zero (nor at the
-///     level of rounding: a change of the parameter's typical size moves the predictions by more than
-///     kRoundingLevel of the model's own motion), the
+///  1. **Identifiable.** The data determine its parameters: the regressor is not zero (nor, where it
+///     is a finite difference of the model, at the level of rounding: a change of the parameter's
+///     typical size moves the predictions by more than kRoundingLevel of the model's own motion), the
 ///     Gauss-Newton covariance is finite, and no parameter moved further from its value without the
 ///     effect than kRunawayFactor (100) times its scale on these data (EffectFit::scale). An
 ///     armature of 2.7e21 kg m^2 on a wrist, or a link of 318 kg on an arm of 3 kg links, is a fit
