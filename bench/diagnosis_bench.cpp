@@ -5,7 +5,7 @@
 // to. And `--auto` on a real-machine-sized log: 25 s of a position-controlled drive at 1 kHz (25,000
 // samples, one continuous record; tests/support/ball_drive.hpp), imported from encoder counts. And the
 // ranking of every candidate on the inverse-dynamics criterion on the 7-joint arm stand-in
-// (tests/support/arm7_log.hpp; 78 of the library's 92, the actuators' gains and gears not being
+// (tests/support/arm7_log.hpp; 99 of the library's 113, the actuators' gains and gears not being
 // candidates there), 5 s and 20 s at 1 kHz, with or without --auto; and --auto on 20 s of the same arm as
 // built (link masses off the model's) with biased torque sensors.
 //

@@ -72,6 +72,14 @@ TEST_P(MujocoDiagnosisCli, NamesTheChangedFieldWithItsValue) {
       if (a["effect"] == target) fitted = a["parameters"][c.field].get<double>();
   }
   EXPECT_NEAR(fitted, c.value, c.tolerance * std::abs(c.value)) << verdict.dump();
+  // Both hinges turn about y: a centre moved along y moves nothing, and is never a finding.
+  int along_axis = 0;
+  for (const auto& entry : report["ranking"])
+    if (entry["effect"] == "param:forearm.com_y" || entry["effect"] == "param:upper_arm.com_y") {
+      ++along_axis;
+      EXPECT_FALSE(entry["identifiable"].get<bool>()) << entry.dump();
+    }
+  EXPECT_EQ(along_axis, 2);
 }
 
 // Friction loss within 30%: MuJoCo's is a constraint, the library's Coulomb friction a tanh. The
