@@ -179,6 +179,7 @@ TEST(EffectSelection, GrowingOneEffectAtATimeFindsThreeHiddenEffectsAndStops) {
   const DiagnosisReport r = diagnosis::diagnose(data_of(world_with("cartpole", truth), 5, 8, 150, 0.02), o);
   expect_found(r, truth);
   const std::string& stop = r.selection->stop_reason;
+  EXPECT_EQ(stop.rfind("every set of up to 1 of the ", 0), 0u) << stop;
   EXPECT_NE(stop.find("then sets grown one effect at a time"), std::string::npos) << stop;
   EXPECT_NE(stop.find("lowers the cross-validated screening score by more than its standard error"), std::string::npos)
       << stop;

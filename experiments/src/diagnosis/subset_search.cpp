@@ -138,7 +138,7 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
   std::vector<std::string> accepted;      // the members of the accepted set
   std::string last_rejection, stop_growing;
   std::vector<int> screened;  // the best screened set of the size before
-  int searched = 0;
+  int searched = 0, exhaustive_up_to = 0;
   for (int k = 1; k <= std::min<int>(o.max_steps, static_cast<int>(n)); ++k) {
     // 2. The best linearised subsets of size k: all of them up to max_subset while a size has at most
     // kExhaustiveSets sets, else the best set of size k - 1 grown by one candidate, as long as that
@@ -176,6 +176,7 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     if (sets.empty()) break;
     screened = sets.front();
     searched = k;
+    if (exhaustive) exhaustive_up_to = k;
     if (o.progress && !exhaustive)
       o.progress(fmt::format("sets of {}: grown from the best set of {} (too many to search them all){}", k, k - 1,
                              exchanges.empty() ? ""
@@ -300,11 +301,12 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     S.model = step.model;
     S.steps.push_back(std::move(step));
   }
-  S.stop_reason = searched <= o.max_subset
+  // A size is grown instead of searched when it is beyond max_subset or has too many sets (kExhaustiveSets).
+  S.stop_reason = searched == exhaustive_up_to
                       ? fmt::format("every set of up to {} of the {} candidates searched", searched, n)
                       : fmt::format("every set of up to {} of the {} candidates searched, then sets grown one effect at a "
                                     "time up to {}",
-                                    o.max_subset, n, searched);
+                                    exhaustive_up_to, n, searched);
   S.stop_reason += stop_growing;
   if (!last_rejection.empty()) S.stop_reason += "; " + last_rejection;
   if (S.steps.empty()) S.rejected = std::move(ranking);
