@@ -51,6 +51,13 @@ using diagnosis::HeldoutComparison;
 using diagnosis::EffectValues;
 using diagnosis::test_effect;
 
+/// The fit of the ranked entry named `effect` (not an alias), or null.
+const EffectFit* ranked_fit(const diagnosis::DiagnosisReport& r, const std::string& effect) {
+  for (const diagnosis::RankedEffect& g : r.ranking)
+    if (g.fit.effect == effect) return &g.fit;
+  return nullptr;
+}
+
 /// A fit of one parameter that passes every test: 50% explained, z = 10, interval [0.9, 1.1] away from 0.
 EffectFit passing_fit(const std::string& name = "cart_coulomb_friction") {
   EffectFit f;
@@ -162,9 +169,7 @@ TEST(EffectTest, AnArmatureThatRunsAwayIsNotIdentifiable) {
   const MeasurementSet data = simulate_measurements(dynamics, settings).set;
 
   const diagnosis::DiagnosisReport r = diagnosis::diagnose(data, test::fast_options(drive));
-  const EffectFit* armature = nullptr;
-  for (const diagnosis::RankedEffect& g : r.ranking)
-    if (g.fit.effect == "param:slide.armature") armature = &g.fit;
+  const EffectFit* armature = ranked_fit(r, "param:slide.armature");
   ASSERT_NE(armature, nullptr) << "the armature is in no alias group and ranked on its own";
   EXPECT_FALSE(armature->identifiable) << armature->estimate(0);
   EXPECT_NE(armature->not_identifiable.find("times its scale on these data"), std::string::npos)
@@ -234,9 +239,7 @@ TEST(EffectTest, AMassThatDoesNotChangeThePredictionsIsNotIdentifiable) {
   const MeasurementSet data = test::free_decay(dir / "damped.xml", 4, 11);
   diagnosis::DiagnosisOptions o = test::fast_options((dir / "pendulum.xml").string());
   const diagnosis::DiagnosisReport r = diagnosis::diagnose(data, o);
-  const EffectFit* mass = nullptr;
-  for (const diagnosis::RankedEffect& g : r.ranking)
-    if (g.fit.effect == "param:bob.mass") mass = &g.fit;
+  const EffectFit* mass = ranked_fit(r, "param:bob.mass");
   ASSERT_NE(mass, nullptr);
   EXPECT_FALSE(mass->identifiable) << mass->estimate(0);
   EXPECT_NE(mass->not_identifiable.find("beyond rounding"), std::string::npos) << mass->not_identifiable;
@@ -256,9 +259,7 @@ TEST(EffectTest, AMassTheDataCannotWeighIsNotIdentifiable) {
   test::write_pendulum(dir / "pendulum.xml", 1e-3);
   const MeasurementSet data = test::free_decay(dir / "pendulum.xml", 4, 11);
   const diagnosis::DiagnosisReport r = diagnosis::diagnose(data, test::fast_options((dir / "pendulum.xml").string()));
-  const EffectFit* mass = nullptr;
-  for (const diagnosis::RankedEffect& g : r.ranking)
-    if (g.fit.effect == "param:bob.mass") mass = &g.fit;
+  const EffectFit* mass = ranked_fit(r, "param:bob.mass");
   ASSERT_NE(mass, nullptr);
   EXPECT_FALSE(mass->identifiable) << mass->estimate(0);
   EXPECT_NE(mass->not_identifiable.find("cannot weigh"), std::string::npos) << mass->not_identifiable;
