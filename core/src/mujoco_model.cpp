@@ -223,6 +223,12 @@ void MujocoModel::read_names() {
     states_.push_back({object_name(m_, mjOBJ_JOINT, j) + "_dot", m_->jnt_type[j] == mjJNT_SLIDE ? "m/s" : "rad/s"});
   for (int a = 0; a < m_->nu; ++a) controls_.push_back({object_name(m_, mjOBJ_ACTUATOR, a), actuator_control_unit(m_, a)});
   if (gains_.size() != m_->nu) gains_ = Vector::Ones(m_->nu);
+  second_moments_.resize(3 * m_->nbody);
+  for (int b = 0; b < m_->nbody; ++b)
+    for (int k = 0; k < 3; ++k) {
+      const double* I = m_->body_inertia + 3 * b;
+      second_moments_(3 * b + k) = 0.5 * (I[(k + 1) % 3] + I[(k + 2) % 3] - I[k]);
+    }
 }
 
 std::vector<std::string> MujocoModel::body_names() const {
@@ -257,6 +263,13 @@ std::vector<MujocoModel::Field> MujocoModel::fields() const {
     for (int k = 0; k < 3; ++k)
       out.push_back({fmt::format("{}.com_{}", name, axes[k]), "m", &m_->body_ipos[3 * b + k],
                      -std::numeric_limits<double>::infinity(), false});
+    // The spread of the mass about the centre along each axis of the inertial frame (MuJoCo's
+    // body_iquat; for a diaginertia, the body's axes): S_k = integral of r_k^2 dm >= 0, which is what
+    // makes the moments I_1 = S_2 + S_3, ... those of a body (the triangle inequality). The inertia
+    // about the body's origin, which rigid-body dynamics is linear in, is linear in each.
+    for (int k = 0; k < 3; ++k)
+      out.push_back({fmt::format("{}.second_moment_{}", name, k + 1), "kg m^2",
+                     const_cast<double*>(&second_moments_(3 * b + k)), kZero, false});
   }
   for (int j = 0; j < m_->njnt; ++j) {
     const std::string name = object_name(m_, mjOBJ_JOINT, j);
@@ -323,11 +336,27 @@ std::shared_ptr<const MujocoModel> MujocoModel::with_parameters(const std::map<s
     }
     *it->value = value;
   }
+  // The principal moments of the bodies whose second moments were given, from the second moments
+  // (those not given follow the body's mass, scaled above).
+  for (int b = 1; b < copy->nbody; ++b) {
+    const std::string prefix = object_name(copy, mjOBJ_BODY, b) + ".second_moment_";
+    bool given = false;
+    double S[3];
+    for (int k = 0; k < 3; ++k) {
+      const double* I = copy->body_inertia + 3 * b;
+      const auto it = overrides.find(prefix + std::to_string(k + 1));
+      given = given || it != overrides.end();
+      S[k] = it != overrides.end() ? it->second : 0.5 * (I[(k + 1) % 3] + I[(k + 2) % 3] - I[k]);
+    }
+    if (!given) continue;
+    for (int k = 0; k < 3; ++k) copy->body_inertia[3 * b + k] = S[(k + 1) % 3] + S[(k + 2) % 3];
+  }
   if (!overrides.empty()) {
     // Derived constants (subtree masses, the constraint solver's inverse weights) follow the new fields.
     mjData* d = mj_makeData(copy);
     mj_setConst(copy, d);
     mj_deleteData(d);
+    out->read_names();  // the second moments of the new moments
   }
   return out;
 }

@@ -65,7 +65,7 @@ class MujocoModel {
   struct Field {
     std::string name;
     std::string unit;
-    double* value;   ///< in m_
+    double* value;   ///< in m_ (a second moment: in second_moments_, written back by with_parameters)
     double lower;    ///< physical range
     bool positive;   ///< strictly above lower
   };
@@ -77,6 +77,9 @@ class MujocoModel {
   std::string name_;
   std::vector<Quantity> states_, controls_, forces_;
   Vector gains_;
+  /// Each body's principal second moments of mass about its centre, S_k = integral of r_k^2 dm along
+  /// the axes of its inertial frame (3 per body, from body_inertia: S_1 = (I_2 + I_3 - I_1) / 2, ...).
+  Vector second_moments_;
 };
 
 /// A MujocoSystem's workspace: the caller's own mjData.

@@ -165,7 +165,7 @@ py::object diagnose(const py::object& system, const py::object& data, const std:
                     const std::string& search, const std::vector<int>& horizons, const std::string& integrator,
                     double heldout, int gp_points, int gp_restarts, const std::string& backend, std::uint64_t seed,
                     const std::string& criterion, std::optional<long> window, const std::vector<std::string>& exclude,
-                    const py::object& progress) {
+                    const std::vector<std::string>& include, const py::object& progress) {
   diagnosis::DiagnoseRequest request;
   request.system = py::isinstance<py::str>(system) ? system.cast<std::string>() : system_from_python(system, "diagnose")->name();
   request.model_file = model;
@@ -183,6 +183,7 @@ py::object diagnose(const py::object& system, const py::object& data, const std:
   request.criterion = criterion;
   request.window = window;
   request.exclude = exclude;
+  request.include = include;
   diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(request);
   LongCall call(progress);
   options.progress = [&call](const std::string& line) { call.throwing_checkpoint(line); };
@@ -300,14 +301,15 @@ Call it as policy(t, x). Arrays have one row per time step: x_bar (T+1, n), u_ba
         py::arg("gp_points") = defaults.gp_points, py::arg("gp_restarts") = defaults.gp_restarts,
         py::arg("backend") = defaults.backend, py::arg("seed") = defaults.seed,
         py::arg("criterion") = defaults.criterion, py::arg("window") = py::none(), py::arg("exclude") = std::vector<std::string>{},
-        py::arg("progress") = py::none(), R"(
+        py::arg("include") = std::vector<std::string>{}, py::arg("progress") = py::none(), R"(
 Compares the model with the measurements and names the missing physical effect: the same dict as
 `gpilqg diagnose --json` (docs/formats.md), with the same options (model: a model file; add:
 ["EFFECT", "EFFECT=VALUE", ...]; auto: --auto, several effects, the path under "selection"; search:
 --search, "subsets" or "forward"; horizons: --horizons, the k of the k-step predictions; criterion and
 window: --criterion and --window, "simulation" with window=N fits and scores the effects on the
 simulation error over windows of N samples started from measured states; exclude: --exclude, names or
-patterns of candidates never ranked or proposed, e.g. ["param:*.armature"]). system: a registry name or gpilqg.Dynamics registered by name;
+patterns of candidates never ranked or proposed, e.g. ["param:*.armature"]; include: --include, names or
+patterns of candidates searched only on request, e.g. ["param:*.second_moment_*"]). system: a registry name or gpilqg.Dynamics registered by name;
 data: a MeasurementSet or a file. progress(line): one line after the residual GP and after every fitted
 effect; Ctrl-C stops the call at the next of these points.)");
 }

@@ -261,6 +261,40 @@ TEST(MujocoSystem, ACentreOfMassOverrideMovesACentreTheFileHasAtTheBodysOrigin) 
   EXPECT_LT(below->f(x, u)(1), -1.0);
 }
 
+// A second-moment override is the file with the moments of that spread: a bob on a hinge about y whose
+// centre is at the hinge (MuJoCo's shortcut of a centre in the body's frame) and one 0.1 m below it,
+// with moments (0.01, 0.02, 0.015), i.e. second moments S = (0.0125, 0.0025, 0.0075); S_1 = 0.0225
+// makes the moments (0.01, 0.03, 0.025). A mass override scales the spreads the overrides do not give,
+// whatever the order of the names: mass 2 with S_1 = 0.0225 makes (0.02, 0.0375, 0.0275).
+TEST(MujocoSystem, ASecondMomentOverrideIsTheFileWithTheMomentsOfThatSpread) {
+  const auto model = [](const std::string& pos, const std::string& mass, const std::string& moments) {
+    return "<mujoco><option gravity=\"0 0 -9.81\"/><worldbody><body name=\"bob\"><joint name=\"hinge\" "
+           "type=\"hinge\" axis=\"0 1 0\" damping=\"0.3\"/><inertial pos=\"" + pos + "\" mass=\"" + mass +
+           "\" diaginertia=\"" + moments + "\"/></body></worldbody></mujoco>";
+  };
+  for (const std::string pos : {"0 0 0", "0 0 -0.1"}) {
+    const auto file = MujocoSystem::load(write_model("moment_file", model(pos, "1", "0.01 0.02 0.015")));
+    double s1 = 0.0;
+    for (const auto& p : file->parameters())
+      if (p.name == "bob.second_moment_1") s1 = p.value;
+    EXPECT_NEAR(s1, 0.0125, 1e-15);
+    const auto changed = MujocoSystem::load(write_model("moment_changed", model(pos, "1", "0.01 0.03 0.025")));
+    const auto heavier = MujocoSystem::load(write_model("moment_heavier", model(pos, "2", "0.02 0.0375 0.0275")));
+    const auto spread = file->with_parameters({{"bob.second_moment_1", 0.0225}});
+    const auto both = file->with_parameters({{"bob.second_moment_1", 0.0225}, {"bob.mass", 2.0}});
+    for (const Vector& x : {Vector((Vector(2) << 0.4, 1.5).finished()), Vector((Vector(2) << -1.1, -0.7).finished())}) {
+      const Vector u = Vector::Zero(0);
+      EXPECT_TRUE(test::matrices_near(spread->f(x, u), changed->f(x, u), 1e-12, 1e-12)) << pos;
+      EXPECT_TRUE(test::matrices_near(both->f(x, u), heavier->f(x, u), 1e-12, 1e-12)) << pos;
+      EXPECT_FALSE(test::matrices_near(file->f(x, u), changed->f(x, u), 1e-3, 1e-3)) << "the spread changes the motion";
+    }
+    for (const auto& p : both->parameters())
+      if (p.name == "bob.second_moment_1") {
+        EXPECT_NEAR(p.value, 0.0225, 1e-15) << "read back as given";
+      }
+  }
+}
+
 TEST(MujocoSystem, TheLibraryHasTheGenericEffectsWithAliases) {
   const auto& library = effect_library(arm_path());
   std::vector<std::string> names;
@@ -281,6 +315,19 @@ TEST(MujocoSystem, TheLibraryHasTheGenericEffectsWithAliases) {
       EXPECT_DOUBLE_EQ(e.parameters[0].upper, 0.2);
       EXPECT_FALSE(e.parameters[0].strictly_positive);
     }
+  // A second moment is >= 0 and grows by at most m L^2: the forearm's moments (0.008, 0.008, 0.0005)
+  // kg m^2 are the spreads S = (0.00025, 0.00025, 0.00775), m L^2 = 0.6 * 0.2^2 = 0.024, and the
+  // typical size is the mean spread, 0.0165 / 6 = 0.00275.
+  int moments = 0;
+  for (const auto& e : library)
+    if (e.name == "param:forearm.second_moment_1" || e.name == "param:forearm.second_moment_3") {
+      ++moments;
+      const bool first = e.name.back() == '1';
+      EXPECT_EQ(e.parameters[0].lower, 0.0);
+      EXPECT_NEAR(e.parameters[0].upper, (first ? 0.00025 : 0.00775) + 0.024, 1e-15);
+      EXPECT_NEAR(e.parameters[0].scale, 0.00275, 1e-15);
+    }
+  EXPECT_EQ(moments, 2);
   const auto entry = find_system(arm_path());
   bool damping_alias = false;
   for (const auto& group : entry->same_physics)

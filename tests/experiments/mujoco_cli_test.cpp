@@ -48,6 +48,7 @@ struct HiddenField {
   std::string field;     ///< the model field changed in the world
   double value;          ///< its value there
   double tolerance;      ///< relative
+  std::string options = "";  ///< further options of the diagnosis
 };
 
 class MujocoDiagnosisCli : public ::testing::TestWithParam<HiddenField> {};
@@ -55,7 +56,7 @@ class MujocoDiagnosisCli : public ::testing::TestWithParam<HiddenField> {};
 TEST_P(MujocoDiagnosisCli, NamesTheChangedFieldWithItsValue) {
   const HiddenField& c = GetParam();
   const fs::path dir = test::temporary_dir("mujoco_diagnosis");
-  const json report = diagnose(simulate(dir, "--param " + c.field + "=" + std::to_string(c.value)));
+  const json report = diagnose(simulate(dir, "--param " + c.field + "=" + std::to_string(c.value)), c.options);
   const json& verdict = report["verdict"];
   ASSERT_EQ(verdict["status"], "explained") << verdict.dump();
   // The verdict is param:<field> itself, or an effect whose alias group holds it.
@@ -83,13 +84,17 @@ TEST_P(MujocoDiagnosisCli, NamesTheChangedFieldWithItsValue) {
 }
 
 // Friction loss within 30%: MuJoCo's is a constraint, the library's Coulomb friction a tanh. The
-// forearm's centre of mass 3 cm off the link's line, in the plane of motion.
+// forearm's centre of mass 3 cm off the link's line, in the plane of motion. Its mass spread along its
+// length, S_3 = 0.00775 -> 0.012 kg m^2 (its moment about the elbow's axis 0.008 -> 0.01225), a
+// candidate searched only on request.
 INSTANTIATE_TEST_SUITE_P(TwoLinkArm, MujocoDiagnosisCli,
                          ::testing::Values(HiddenField{"elbow.damping", 0.35, 0.15},
                                            HiddenField{"forearm.mass", 0.75, 0.15},
                                            HiddenField{"elbow_motor.gear", 1.25, 0.15},
                                            HiddenField{"shoulder.frictionloss", 0.3, 0.30},
-                                           HiddenField{"forearm.com_x", 0.03, 0.15}),
+                                           HiddenField{"forearm.com_x", 0.03, 0.15},
+                                           HiddenField{"forearm.second_moment_3", 0.012, 0.15,
+                                                       " --include 'param:forearm.second_moment_*'"}),
                          [](const auto& info) {
                            std::string name = info.param.field;
                            std::replace(name.begin(), name.end(), '.', '_');
@@ -101,6 +106,15 @@ TEST(MujocoCli, TheUnchangedModelIsConsistent) {
   const json report = diagnose(simulate(dir, ""));
   EXPECT_EQ(report["verdict"]["status"], "consistent") << report["verdict"].dump();
   EXPECT_TRUE(report["verdict"]["effect"].is_null());
+  // The bodies' second moments are searched only on request: listed, never ranked.
+  EXPECT_EQ(report["on_request"].size(), 6u) << report["on_request"].dump();
+  EXPECT_NE(std::find(report["on_request"].begin(), report["on_request"].end(), "param:upper_arm.second_moment_2"),
+            report["on_request"].end());
+  for (const auto& entry : report["ranking"]) {
+    EXPECT_EQ(entry["effect"].get<std::string>().find("second_moment"), std::string::npos) << entry["effect"];
+    for (const auto& alias : entry["aliases"])
+      EXPECT_EQ(alias.get<std::string>().find("second_moment"), std::string::npos) << alias;
+  }
 }
 
 TEST(MujocoCli, AddWriteModelAndModelRoundTrip) {
@@ -279,6 +293,21 @@ TEST(MujocoCli, BadInputGetsExitTwoWithWhatIsWrong) {
   const auto param = test::run_cli("simulate --system " + arm() + " --param elbow.weight=2 --out " + quote(odd));
   EXPECT_EQ(param.status, 2);
   EXPECT_NE(param.err.find("elbow.damping"), std::string::npos) << param.err;
+
+  // --include names candidates searched only on request: a pattern over the others, or one that is
+  // also excluded, is refused with what is expected.
+  const auto data = simulate(dir, "");
+  const auto not_on_request =
+      test::run_cli("diagnose --system " + arm() + " --data " + quote(data) + " --include 'param:*.mass'");
+  EXPECT_EQ(not_on_request.status, 2);
+  EXPECT_NE(not_on_request.err.find("--include 'param:*.mass': matches no candidate searched only on request"),
+            std::string::npos)
+      << not_on_request.err;
+  EXPECT_NE(not_on_request.err.find("param:forearm.second_moment_3"), std::string::npos) << not_on_request.err;
+  const auto both = test::run_cli("diagnose --system " + arm() + " --data " + quote(data) +
+                                  " --include 'param:forearm.second_moment_1' --exclude 'param:*.second_moment_*'");
+  EXPECT_EQ(both.status, 2);
+  EXPECT_NE(both.err.find("param:forearm.second_moment_1 is also excluded by --exclude"), std::string::npos) << both.err;
 }
 
 }  // namespace

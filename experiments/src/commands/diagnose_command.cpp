@@ -69,12 +69,13 @@ std::string plugin_option(const std::string& system) {
   return origin == "built-in" ? "" : " --plugin " + origin;
 }
 
-/// " --criterion C [--window N]" and " --exclude P" when the request has them, so that the next call
-/// uses the same criterion and candidates.
+/// " --criterion C [--window N]", " --exclude P" and " --include P" when the request has them, so that
+/// the next call uses the same criterion and candidates.
 std::string criterion_options(const diagnosis::DiagnoseRequest& r) {
   std::string out = r.window ? fmt::format(" --criterion {} --window {}", r.criterion, *r.window)
                   : r.criterion != diagnosis::DiagnoseRequest{}.criterion ? " --criterion " + r.criterion : "";
   for (const std::string& pattern : r.exclude) out += " --exclude '" + pattern + "'";
+  for (const std::string& pattern : r.include) out += " --include '" + pattern + "'";
   return out;
 }
 
@@ -162,6 +163,9 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--exclude", r.exclude,
                   "Leave candidate effects out of the ranking and the search: a name or a pattern (*, ?), e.g. "
                   "'param:*.armature' (repeatable)");
+  cmd->add_option("--include", r.include,
+                  "Rank and search candidates offered only on request too, e.g. 'param:*.second_moment_*' (the "
+                  "bodies' second moments of mass; repeatable)");
   cmd->add_option("--search", r.search, "How --auto searches: subsets (every set of up to 4 effects) or forward")
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the report");

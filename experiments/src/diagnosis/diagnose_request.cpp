@@ -44,6 +44,34 @@ std::vector<std::string> excluded_effects(const std::vector<std::string>& patter
   return ordered;
 }
 
+std::vector<std::string> included_effects(const std::vector<std::string>& patterns, const ModelSpec& model,
+                                          const std::vector<std::string>& excluded) {
+  std::vector<std::string> on_request, out;
+  for (const LibraryEffect& effect : candidate_effects(model))
+    if (effect.on_request) on_request.push_back(effect.name);
+  std::vector<bool> included(on_request.size(), false);
+  for (const std::string& pattern : patterns) {
+    bool matched = false;
+    for (std::size_t i = 0; i < on_request.size(); ++i) {
+      if (::fnmatch(pattern.c_str(), on_request[i].c_str(), 0) != 0) continue;
+      matched = true;
+      if (std::find(excluded.begin(), excluded.end(), on_request[i]) != excluded.end())
+        throw InputError(fmt::format("--include '{}': {} is also excluded by --exclude; expected an effect that is "
+                                     "not excluded",
+                                     pattern, on_request[i]));
+      included[i] = true;
+    }
+    if (!matched)
+      throw InputError(fmt::format("--include '{}': matches no candidate searched only on request; expected a name or "
+                                   "a pattern (*, ?) over: {}",
+                                   pattern, on_request.empty() ? std::string("(none for this system)")
+                                                               : fmt::format("{}", fmt::join(on_request, ", "))));
+  }
+  for (std::size_t i = 0; i < on_request.size(); ++i)
+    if (included[i]) out.push_back(on_request[i]);
+  return out;
+}
+
 DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   DiagnosisOptions d;
   if (!o.model_file.empty()) {
@@ -58,6 +86,7 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   std::vector<std::string> added;
   for (const EffectRequest& e : d.add) added.push_back(e.effect);
   d.exclude = excluded_effects(o.exclude, d.model, added);
+  d.include = included_effects(o.include, d.model, d.exclude);
   const auto integrator = parse_integrator(o.integrator);
   if (!integrator) throw InputError("--integrator '" + o.integrator + "': expected 'rk4' or 'euler'");
   d.integrator = *integrator;

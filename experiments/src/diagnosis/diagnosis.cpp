@@ -406,6 +406,15 @@ void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidat
   R.criterion = context.criterion;
   context.excluded = o.exclude;
   R.excluded = o.exclude;
+  const auto named = [](const std::vector<std::string>& names, const std::string& name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  for (const LibraryEffect& effect : candidates)
+    if (effect.on_request && !named(o.include, effect.name) && !named(o.exclude, effect.name) &&
+        std::none_of(o.add.begin(), o.add.end(), [&](const EffectRequest& a) { return a.effect == effect.name; })) {
+      context.excluded.push_back(effect.name);
+      R.on_request.push_back(effect.name);
+    }
   // Candidates the criterion cannot identify on any data (under inverse dynamics the actuators' gains).
   for (const std::string& name : R.criterion->unidentifiable(candidates))
     if (std::find(context.excluded.begin(), context.excluded.end(), name) == context.excluded.end()) {

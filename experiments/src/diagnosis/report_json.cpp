@@ -337,6 +337,7 @@ nlohmann::json report_json(const DiagnosisReport& r) {
           {"ranking", ranking},
           {"verdict", verdict},
           {"excluded", r.excluded},
+          {"on_request", r.on_request},
           {"model", model_file_text(r.model)},
           {"added", added},
           {"refitted", refitted},

@@ -211,6 +211,9 @@ void which_section(const DiagnosisReport& r, std::string& out) {
                      fmt::join(r.heldout_episode_ids, ", "));
   if (!r.excluded.empty())
     out += fmt::format("   excluded by --exclude (never ranked, searched or proposed): {}\n", fmt::join(r.excluded, ", "));
+  if (!r.on_request.empty())
+    out += fmt::format("   searched only on request (--include PATTERN), not ranked: {} candidates ({})\n",
+                       r.on_request.size(), fmt::join(r.on_request, ", "));
   if (!r.criterion_reason.empty()) out += "   criterion chosen by the data (--criterion auto): " + r.criterion_reason + "\n";
   if (const std::string line = r.criterion->description(r.dt, r.window_restarts); !line.empty())
     out += "   " + line + "\n";

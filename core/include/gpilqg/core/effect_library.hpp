@@ -72,6 +72,10 @@ struct LibraryEffect {
     std::function<ForceEffectPtr(double v0)> at;
   };
   std::optional<Smoothing> smoothing;      ///< Coulomb friction only (coulomb_friction_entry)
+  /// A candidate the diagnosis ranks and searches only when asked to (`--include`, or named by
+  /// `--add`): a freedom that, offered by default, the search spends on fitting what other effects
+  /// are (a body's second moments of mass).
+  bool on_request = false;
 };
 
 /// `effect` (which has a smoothing) at the smoothing velocity `v0`: its force and formula rebuilt.

@@ -36,6 +36,9 @@ struct DiagnoseRequest {
   /// `param:*.armature` (every armature), `*:wrist*` (every effect of the wrist's joints, actuators and
   /// bodies), `actuator_gain:*`.
   std::vector<std::string> exclude;
+  /// --include: candidates searched only on request (LibraryEffect::on_request, e.g. the bodies'
+  /// second moments) to rank and search too, each a name or a pattern as for --exclude.
+  std::vector<std::string> include;
 };
 
 /// The candidate effects of `model` that the --exclude patterns name, in the candidates' order.
@@ -43,6 +46,12 @@ struct DiagnoseRequest {
 /// effect when an --add effect (`add`) is excluded.
 std::vector<std::string> excluded_effects(const std::vector<std::string>& patterns, const ModelSpec& model,
                                           const std::vector<std::string>& add = {});
+
+/// The candidates of `model` searched only on request (LibraryEffect::on_request) that the --include
+/// patterns name, in the candidates' order. Throws InputError naming the pattern when it matches no
+/// such candidate (listing them), and naming the effect when it is also excluded (`excluded`).
+std::vector<std::string> included_effects(const std::vector<std::string>& patterns, const ModelSpec& model,
+                                          const std::vector<std::string>& excluded);
 
 /// At most this many k-step horizons (each stores its windows' predictions in the report).
 inline constexpr std::size_t kMaxHorizonCount = 32;

@@ -104,6 +104,10 @@ struct DiagnosisOptions {
   bool rank = true;                       ///< false: skip the ranking (faster; verdict from the GP only)
   /// Candidates never ranked, searched or proposed (`--exclude`, resolved to names: excluded_effects).
   std::vector<std::string> exclude;
+  /// Candidates searched only on request (LibraryEffect::on_request) that are ranked and searched too
+  /// (`--include`, resolved to names: included_effects). The others are left out like `exclude`
+  /// unless `add` names them, and reported apart from it (DiagnosisReport::on_request).
+  std::vector<std::string> include;
   /// --auto: add several effects by forward selection with joint refits (effect_selection.hpp); the
   /// final model becomes model_next.
   bool auto_select = false;
@@ -233,6 +237,7 @@ struct DiagnosisReport {
   int window_restarts = 0;
   std::vector<RankedEffect> ranking;
   std::vector<std::string> excluded;     ///< candidates left out by the user (DiagnosisOptions::exclude)
+  std::vector<std::string> on_request;   ///< candidates searched only on request, not requested (DiagnosisOptions::include)
   /// Candidates the criterion cannot identify and leaves out: under inverse dynamics the actuators'
   /// gains and gears (the force residual is homogeneous in them and the inertias).
   std::vector<std::string> criterion_excluded;
