@@ -169,7 +169,7 @@ std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system) {
     if (const auto at = p.name.rfind(".second_moment_"); at != std::string::npos && p.name.size() == at + 16) {
       // A second moment S_k = integral of r_k^2 dm is >= 0 (the moments then satisfy the triangle
       // inequality: a body), and grows by at most m L^2, the body's mass at its length. Its typical
-      // size is the mean of the three, (I_1 + I_2 + I_3) / 6; one may be zero (a rod across its axis).
+      // size is the mean of the three, (I_1 + I_2 + I_3) / 6; two may be zero (a thin rod's, across it).
       const int body = mj_name2id(m, mjOBJ_BODY, p.name.substr(0, at).c_str());
       const double* moments = m->body_inertia + 3 * body;
       const double length = body_length(m, body);

@@ -123,6 +123,11 @@ mjModel* load_urdf(const std::string& path, const std::string& text, char* error
   return m;
 }
 
+/// The second moment S_k = (I_j + I_l - I_k) / 2 of principal moments `I` ({j, k, l} = {0, 1, 2}): the
+/// spread of the mass along axis k, never below 0 (a body on the triangle inequality's boundary, a
+/// plate, gives -1e-18 after its moments are scaled one by one).
+double second_moment(const double* I, int k) { return std::max(0.0, 0.5 * (I[(k + 1) % 3] + I[(k + 2) % 3] - I[k])); }
+
 /// True when body `b` can turn: a hinge, ball or free joint on it or on a body between it and the
 /// world. A body that only slides (or is welded to the world) moves its whole mass alike, wherever its
 /// centre is.
@@ -223,12 +228,13 @@ void MujocoModel::read_names() {
     states_.push_back({object_name(m_, mjOBJ_JOINT, j) + "_dot", m_->jnt_type[j] == mjJNT_SLIDE ? "m/s" : "rad/s"});
   for (int a = 0; a < m_->nu; ++a) controls_.push_back({object_name(m_, mjOBJ_ACTUATOR, a), actuator_control_unit(m_, a)});
   if (gains_.size() != m_->nu) gains_ = Vector::Ones(m_->nu);
+  read_second_moments();
+}
+
+void MujocoModel::read_second_moments() {
   second_moments_.resize(3 * m_->nbody);
   for (int b = 0; b < m_->nbody; ++b)
-    for (int k = 0; k < 3; ++k) {
-      const double* I = m_->body_inertia + 3 * b;
-      second_moments_(3 * b + k) = 0.5 * (I[(k + 1) % 3] + I[(k + 2) % 3] - I[k]);
-    }
+    for (int k = 0; k < 3; ++k) second_moments_(3 * b + k) = second_moment(m_->body_inertia + 3 * b, k);
 }
 
 std::vector<std::string> MujocoModel::body_names() const {
@@ -346,7 +352,7 @@ std::shared_ptr<const MujocoModel> MujocoModel::with_parameters(const std::map<s
       const double* I = copy->body_inertia + 3 * b;
       const auto it = overrides.find(prefix + std::to_string(k + 1));
       given = given || it != overrides.end();
-      S[k] = it != overrides.end() ? it->second : 0.5 * (I[(k + 1) % 3] + I[(k + 2) % 3] - I[k]);
+      S[k] = it != overrides.end() ? it->second : second_moment(I, k);
     }
     if (!given) continue;
     for (int k = 0; k < 3; ++k) copy->body_inertia[3 * b + k] = S[(k + 1) % 3] + S[(k + 2) % 3];
@@ -356,7 +362,7 @@ std::shared_ptr<const MujocoModel> MujocoModel::with_parameters(const std::map<s
     mjData* d = mj_makeData(copy);
     mj_setConst(copy, d);
     mj_deleteData(d);
-    out->read_names();  // the second moments of the new moments
+    out->read_second_moments();
   }
   return out;
 }

@@ -61,6 +61,7 @@ class MujocoModel {
  private:
   explicit MujocoModel(mjModel* m, std::string path);
   void read_names();
+  void read_second_moments();  ///< second_moments_ from body_inertia
 
   struct Field {
     std::string name;

@@ -4,6 +4,7 @@
 // docs/formats.md#systems-and-their-names.
 
 #include <fstream>
+#include <map>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -264,8 +265,9 @@ TEST(MujocoSystem, ACentreOfMassOverrideMovesACentreTheFileHasAtTheBodysOrigin) 
 // A second-moment override is the file with the moments of that spread: a bob on a hinge about y whose
 // centre is at the hinge (MuJoCo's shortcut of a centre in the body's frame) and one 0.1 m below it,
 // with moments (0.01, 0.02, 0.015), i.e. second moments S = (0.0125, 0.0025, 0.0075); S_1 = 0.0225
-// makes the moments (0.01, 0.03, 0.025). A mass override scales the spreads the overrides do not give,
-// whatever the order of the names: mass 2 with S_1 = 0.0225 makes (0.02, 0.0375, 0.0275).
+// makes the moments (0.01, 0.03, 0.025). A mass override scales the spreads the overrides do not give:
+// mass 2 with S_1 = 0.0225 makes S = (0.0225, 0.005, 0.015), the moments (0.02, 0.0375, 0.0275). The
+// hinge sees only I_2; the three spreads are read back.
 TEST(MujocoSystem, ASecondMomentOverrideIsTheFileWithTheMomentsOfThatSpread) {
   const auto model = [](const std::string& pos, const std::string& mass, const std::string& moments) {
     return "<mujoco><option gravity=\"0 0 -9.81\"/><worldbody><body name=\"bob\"><joint name=\"hinge\" "
@@ -288,10 +290,11 @@ TEST(MujocoSystem, ASecondMomentOverrideIsTheFileWithTheMomentsOfThatSpread) {
       EXPECT_TRUE(test::matrices_near(both->f(x, u), heavier->f(x, u), 1e-12, 1e-12)) << pos;
       EXPECT_FALSE(test::matrices_near(file->f(x, u), changed->f(x, u), 1e-3, 1e-3)) << "the spread changes the motion";
     }
-    for (const auto& p : both->parameters())
-      if (p.name == "bob.second_moment_1") {
-        EXPECT_NEAR(p.value, 0.0225, 1e-15) << "read back as given";
-      }
+    std::map<std::string, double> read;
+    for (const auto& p : both->parameters()) read[p.name] = p.value;
+    EXPECT_NEAR(read["bob.second_moment_1"], 0.0225, 1e-15) << "as given";
+    EXPECT_NEAR(read["bob.second_moment_2"], 0.005, 1e-15) << "scaled with the mass";
+    EXPECT_NEAR(read["bob.second_moment_3"], 0.015, 1e-15) << "scaled with the mass";
   }
 }
 
@@ -326,6 +329,7 @@ TEST(MujocoSystem, TheLibraryHasTheGenericEffectsWithAliases) {
       EXPECT_EQ(e.parameters[0].lower, 0.0);
       EXPECT_NEAR(e.parameters[0].upper, (first ? 0.00025 : 0.00775) + 0.024, 1e-15);
       EXPECT_NEAR(e.parameters[0].scale, 0.00275, 1e-15);
+      EXPECT_TRUE(e.on_request) << "ranked only on request";
     }
   EXPECT_EQ(moments, 2);
   const auto entry = find_system(arm_path());

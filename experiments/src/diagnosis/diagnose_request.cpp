@@ -52,15 +52,21 @@ std::vector<std::string> included_effects(const std::vector<std::string>& patter
   std::vector<bool> included(on_request.size(), false);
   for (const std::string& pattern : patterns) {
     bool matched = false;
+    std::vector<std::string> excluded_matches;
     for (std::size_t i = 0; i < on_request.size(); ++i) {
       if (::fnmatch(pattern.c_str(), on_request[i].c_str(), 0) != 0) continue;
-      matched = true;
-      if (std::find(excluded.begin(), excluded.end(), on_request[i]) != excluded.end())
-        throw InputError(fmt::format("--include '{}': {} is also excluded by --exclude; expected an effect that is "
-                                     "not excluded",
-                                     pattern, on_request[i]));
-      included[i] = true;
+      // --exclude wins: `--include 'param:*.second_moment_*' --exclude 'param:link1.*'` leaves link 1 out.
+      if (std::find(excluded.begin(), excluded.end(), on_request[i]) != excluded.end()) {
+        excluded_matches.push_back(on_request[i]);
+      } else {
+        matched = true;
+        included[i] = true;
+      }
     }
+    if (!matched && !excluded_matches.empty())
+      throw InputError(fmt::format("--include '{}': every effect it names is excluded by --exclude ({}); expected "
+                                   "an effect that is not excluded",
+                                   pattern, fmt::join(excluded_matches, ", ")));
     if (!matched)
       throw InputError(fmt::format("--include '{}': matches no candidate searched only on request; expected a name or "
                                    "a pattern (*, ?) over: {}",

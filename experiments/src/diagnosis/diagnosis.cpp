@@ -397,6 +397,24 @@ void where(const DiagnosisOptions& o, const MeasurementSet& set, DiagnosisReport
   R.gp_explained_total = weighted_heldout_explained(data, R.residual, R.gp.mean, R.weights);
 }
 
+/// The candidates searched only on request (LibraryEffect::on_request) that nothing asked for: neither
+/// `--include` nor `--add` names them, `--exclude` does not already leave them out, and `model` does
+/// not already hold them (a model file written by a run that included them).
+std::vector<std::string> not_requested(const DiagnosisOptions& o, const ModelSpec& model,
+                                       const std::vector<LibraryEffect>& candidates) {
+  const auto named = [](const std::vector<std::string>& names, const std::string& name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  const std::vector<RefitEffect> held = model_effects(model, candidates);
+  std::vector<std::string> out;
+  for (const LibraryEffect& effect : candidates)
+    if (effect.on_request && !named(o.include, effect.name) && !named(o.exclude, effect.name) &&
+        std::none_of(o.add.begin(), o.add.end(), [&](const EffectRequest& a) { return a.effect == effect.name; }) &&
+        std::none_of(held.begin(), held.end(), [&](const RefitEffect& r) { return r.effect->name == effect.name; }))
+      out.push_back(effect.name);
+  return out;
+}
+
 /// 3. Which effect is missing: every effect of the library ranked under the criterion (unless the
 /// model diverges), the verdict (decide), and with --auto the forward selection of several, judged
 /// as a set (judge_selection).
@@ -406,15 +424,8 @@ void which(const DiagnosisOptions& o, const std::vector<LibraryEffect>& candidat
   R.criterion = context.criterion;
   context.excluded = o.exclude;
   R.excluded = o.exclude;
-  const auto named = [](const std::vector<std::string>& names, const std::string& name) {
-    return std::find(names.begin(), names.end(), name) != names.end();
-  };
-  for (const LibraryEffect& effect : candidates)
-    if (effect.on_request && !named(o.include, effect.name) && !named(o.exclude, effect.name) &&
-        std::none_of(o.add.begin(), o.add.end(), [&](const EffectRequest& a) { return a.effect == effect.name; })) {
-      context.excluded.push_back(effect.name);
-      R.on_request.push_back(effect.name);
-    }
+  R.on_request = not_requested(o, R.model, candidates);
+  context.excluded.insert(context.excluded.end(), R.on_request.begin(), R.on_request.end());
   // Candidates the criterion cannot identify on any data (under inverse dynamics the actuators' gains).
   for (const std::string& name : R.criterion->unidentifiable(candidates))
     if (std::find(context.excluded.begin(), context.excluded.end(), name) == context.excluded.end()) {

@@ -48,8 +48,8 @@ std::vector<std::string> excluded_effects(const std::vector<std::string>& patter
                                           const std::vector<std::string>& add = {});
 
 /// The candidates of `model` searched only on request (LibraryEffect::on_request) that the --include
-/// patterns name, in the candidates' order. Throws InputError naming the pattern when it matches no
-/// such candidate (listing them), and naming the effect when it is also excluded (`excluded`).
+/// patterns name and `excluded` does not, in the candidates' order. Throws InputError naming the
+/// pattern when it matches no such candidate (listing them), or only excluded ones.
 std::vector<std::string> included_effects(const std::vector<std::string>& patterns, const ModelSpec& model,
                                           const std::vector<std::string>& excluded);
 
