@@ -316,6 +316,10 @@ def test_diagnose_a_passive_pendulum_equals_the_command_line(tmp_path):
     assert {report["verdict"]["effect"], *report["verdict"]["aliases"]} & {"param:swing.damping",
                                                                           "joint_viscous_damping:swing"}
     assert all(not e["effect"].startswith(("input_delay", "actuator_gain")) for e in report["ranking"])
+    # The bob's second moments are candidates only on request: listed, not ranked; include= asks for them.
+    assert report["on_request"] == ["param:bob.second_moment_%d" % k for k in (1, 2, 3)] == expected["on_request"]
+    with pytest.raises(gpilqg.InputError, match="--include 'param:bob.mass': matches no candidate searched only"):
+        gpilqg.diagnose(str(pendulum), data, gp_points=100, include=["param:bob.mass"])
     config = tmp_path / "solve.toml"
     config.write_text('[system]\nname = "%s"\ndt = 0.02\n[problem]\nhorizon = 10\nx0 = [0, 0]\ngoal = [0, 0]\n'
                       'Q = [1, 1]\nR = []\nQf = [1, 1]\n' % pendulum)
