@@ -307,6 +307,7 @@ std::shared_ptr<const MujocoModel> MujocoModel::with_parameters(const std::map<s
   out->gains_ = gains_;
   out->read_names();
   const std::vector<Field> fields = out->fields();
+  std::vector<bool> spread_given(static_cast<std::size_t>(3 * copy->nbody), false);  // second moments overridden
   for (const auto& [key, value] : overrides) {
     const std::string& name = key;  // (clang 14 cannot capture a structured binding)
     const auto it = std::find_if(fields.begin(), fields.end(), [&](const Field& f) { return f.name == name; });
@@ -340,21 +341,18 @@ std::shared_ptr<const MujocoModel> MujocoModel::with_parameters(const std::map<s
       const double ratio = value / *it->value;
       for (int k = 0; k < 3; ++k) copy->body_inertia[3 * body + k] *= ratio;
     }
+    if (const auto spread = it->value - out->second_moments_.data(); spread >= 0 && spread < 3 * copy->nbody)
+      spread_given[static_cast<std::size_t>(spread)] = true;
     *it->value = value;
   }
-  // The principal moments of the bodies whose second moments were given, from the second moments
-  // (those not given follow the body's mass, scaled above).
+  // The principal moments of the bodies whose second moments were given (now in out->second_moments_),
+  // from the second moments; those not given follow the body's mass, scaled above.
   for (int b = 1; b < copy->nbody; ++b) {
-    const std::string prefix = object_name(copy, mjOBJ_BODY, b) + ".second_moment_";
-    bool given = false;
+    const auto first = static_cast<std::size_t>(3 * b);
+    if (!spread_given[first] && !spread_given[first + 1] && !spread_given[first + 2]) continue;
     double S[3];
-    for (int k = 0; k < 3; ++k) {
-      const double* I = copy->body_inertia + 3 * b;
-      const auto it = overrides.find(prefix + std::to_string(k + 1));
-      given = given || it != overrides.end();
-      S[k] = it != overrides.end() ? it->second : second_moment(I, k);
-    }
-    if (!given) continue;
+    for (int k = 0; k < 3; ++k)
+      S[k] = spread_given[first + k] ? out->second_moments_(3 * b + k) : second_moment(copy->body_inertia + 3 * b, k);
     for (int k = 0; k < 3; ++k) copy->body_inertia[3 * b + k] = S[(k + 1) % 3] + S[(k + 2) % 3];
   }
   if (!overrides.empty()) {
