@@ -97,6 +97,23 @@ std::vector<std::vector<int>> best_subsets(const LinearisedFits& fits, int k, in
   return out;
 }
 
+/// The screening columns of Coulomb candidate `name` at the smoothing velocity `v0` an accepted set
+/// fitted for it (joint_smoothing). A candidate's own fit alone puts its width at the top of the grid
+/// when the effects still missing (a sensor's offset, a link's mass) leave a residual that grows with
+/// the speed: a saturating viscous friction. Screened at that width, the Coulomb member already
+/// stands for its joint's viscous friction, and the growth never takes the viscous term, even after
+/// the set has found the switch's own width. Not for an effect of the model itself, whose width also
+/// changes the base residual the columns are taken around.
+void follow_width(LinearisedFits& fits, FitContext& screening, const std::vector<RefitEffect>& present,
+                  const std::string& name, double v0) {
+  const auto width = screening.model.smoothing.find(name);
+  if (width != screening.model.smoothing.end() && width->second == v0) return;
+  if (std::any_of(present.begin(), present.end(), [&](const RefitEffect& r) { return r.effect->name == name; })) return;
+  screening.model.smoothing[name] = v0;
+  for (int c = 0; c < fits.size(); ++c)
+    if (fits.names()[static_cast<std::size_t>(c)] == name) fits.relinearise(c, screening);
+}
+
 }  // namespace
 
 Selection select_subsets(const FitContext& context, const SelectionOptions& o, std::vector<RankedEffect> first) {
@@ -115,7 +132,9 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
     singles.push_back(r.fit);
     singles.insert(singles.end(), r.aliases.begin(), r.aliases.end());
   }
-  const LinearisedFits fits(context, singles, present, o.threads);
+  // Columns kept: the screening follows the smoothing velocities the accepted sets fit (below).
+  LinearisedFits fits(context, singles, present, o.threads, true);
+  FitContext screening_context = context;  // its model holds the smoothing velocities the columns have
   const auto n = static_cast<std::size_t>(fits.size());
   std::vector<std::vector<bool>> forbidden(n, std::vector<bool>(n, false));
   // forbidden[a][b]: a and b never in one set (declared the same physics); forbidden[a][a]: a in no set
@@ -251,6 +270,7 @@ Selection select_subsets(const FitContext& context, const SelectionOptions& o, s
           e = with_smoothing(e, v0);
           rescaled = true;
         }
+      follow_width(fits, screening_context, present, name, v0);
     }
     if (rescaled) {
       std::vector<RefitEffect> rest;

@@ -19,12 +19,13 @@
 /// the width of the switch at qdot = 0, not the slope at speed: fitted alone on a joint with viscous
 /// and dry friction (as every robot joint has), the Coulomb term takes the top of the grid, a
 /// saturating viscous friction, and a search that starts from it no longer sees the two terms
-/// (subset_search.hpp screens with these widths). Its column is the same effect at a width of a
-/// thousand times the rms speed, where tanh is linear over the data. The grid spans the data's own scale, two
-/// decades below its RMS speed; above 0.2 s the tanh is nearly linear over the data and the term is
-/// viscous friction, which the library has. A coordinate whose measured velocity is 0 throughout
-/// keeps the library's default (kDefaultCoulombWidth). The value is reported with the effect
-/// (`v0 = ...`) and written into model files, so a model keeps the smoothing it was fitted with.
+/// (subset_search.hpp screens with these widths until a set fits its own). Its column is the same
+/// effect at a width of a thousand times the rms speed, where tanh is linear over the data. The grid
+/// spans the data's own scale, two decades below its RMS speed; above 0.2 s the tanh is nearly linear
+/// over the data and the term is viscous friction, which the library has. A coordinate whose measured
+/// velocity is 0 throughout keeps the library's default (kDefaultCoulombWidth). The value is reported
+/// with the effect (`v0 = ...`) and written into model files, so a model keeps the smoothing it was
+/// fitted with.
 
 #include <map>
 #include <string>
