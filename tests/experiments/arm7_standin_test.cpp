@@ -375,7 +375,7 @@ std::pair<std::string, std::string> body_and_field(const std::string& effect) {
 // removing all but 1% of the held-out residual. A 10 s record pins down what the torques see of a
 // link's inertia (its first moments, combinations over the links), not each mass and centre: over noise
 // seeds 1, 7 and 11 the masses found are within 10% of the world's and the centres within 11 mm, and the
-// test bounds them at 15% and 1.5 cm (the links' centres lie 4 to 11 cm from their joints), which a
+// test bounds them at 15% and 1.5 cm (the centres of links 3 to 7 lie 6 to 12 cm from their frames), which a
 // runaway value or a centre outside its link fails. And nothing an arm with link-side torque sensors
 // cannot have: no armature (a rotor's inertia those sensors do not see), no spring, no delay, no
 // horizontal force at a body, nothing on links 1 and 2, which are as modelled. A vertical force at a
