@@ -113,7 +113,7 @@ const test::Arm7Log& arm7_record(long milliseconds, bool as_built = false) {
   o.seed = 3;
   if (as_built) {
     o.as_built = true;
-    o.sensor_offsets = (Vector(test::kArm7Joints) << 0.12, -0.2, 0.08, 0.15, -0.05, 0.03, -0.06).finished();
+    o.sensor_offsets = test::arm7_sensor_offsets();
   }
   return made.emplace(std::pair{milliseconds, as_built}, test::arm7_log(GPILQG_BENCH_SOURCE_DIR, o)).first->second;
 }

@@ -385,7 +385,7 @@ TEST(Arm7StandInCli, TheDefaultsOnTheArmAsBuiltFindItsFrictionSensorOffsetsAndLi
   o.seconds = 10.0;
   o.seed = 7;
   o.as_built = true;
-  o.sensor_offsets = (Vector(test::kArm7Joints) << 0.12, -0.2, 0.08, 0.15, -0.05, 0.03, -0.06).finished();
+  o.sensor_offsets = test::arm7_sensor_offsets();
   const test::Arm7Log log = test::arm7_log(test::source_dir(), o);
   const std::map<std::string, BodyInertia> world = body_inertias(test::arm7_as_built(test::source_dir()));
   const std::map<std::string, BodyInertia> model = body_inertias(test::arm7_model(test::source_dir()));

@@ -85,6 +85,12 @@ inline Arm7Truth arm7_truth() {
   return t;
 }
 
+/// The torque sensors' offsets [N m] of the arm as built (Arm7Options::sensor_offsets), a few tenths of
+/// a N m of either sign, as joint torque sensors drift between calibrations.
+inline Vector arm7_sensor_offsets() {
+  return (Vector(kArm7Joints) << 0.12, -0.2, 0.08, 0.15, -0.05, 0.03, -0.06).finished();
+}
+
 struct Arm7Options {
   double seconds = 20.0;       ///< record length; samples = round(seconds * 1000) + 1
   std::uint64_t seed = 1;      ///< of the measurement noise
