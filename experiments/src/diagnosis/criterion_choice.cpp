@@ -168,6 +168,9 @@ struct StateRatio {
   /// sqrt((mean a_s^2 + mean a_h^2) / mean |b_v u|^2): the filter's misfit on the model against the
   /// force the controls apply (infinite when they apply none)
   double misfit = 0.0;
+  /// kappa = sqrt(mean_t (sum_r m_r f_v,r)^2 / mean_t f_v,t^2): how much of the model's acceleration the
+  /// window's mean keeps (1 when there is none)
+  double kept = 1.0;
 };
 
 /// The white-noise level of a sampled signal robust to isolated corners and steps: for each order
@@ -221,11 +224,44 @@ std::vector<Matrix> model_derivatives(const Dynamics& model, const MeasurementSe
   return out;
 }
 
+/// The model's generalised force at every sample, F_t = W_v(x_t)^-1 f_v(x_t, u_t) (T x k each, column i
+/// for `coordinates[i]`), from its derivatives `own` (model_derivatives): what the inverse-dynamics
+/// criterion filters (criteria/inverse_dynamics.hpp). A singular W_v leaves the row at zero (why_not_forces
+/// has refused the data when W_v was singular at the states it compared).
+std::vector<Matrix> model_forces(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own,
+                                 const std::vector<GeneralisedCoordinate>& coordinates) {
+  const GeneralisedForceInput* input = force_input(model);
+  const auto k = static_cast<Eigen::Index>(coordinates.size());
+  std::vector<Matrix> out;
+  Matrix W;
+  Matrix Wv(k, k);
+  Vector fv(k);
+  for (std::size_t episode = 0; episode < data.episodes.size(); ++episode) {
+    const Episode& e = data.episodes[episode];
+    Matrix F = Matrix::Zero(e.length(), k);
+    for (Eigen::Index t = 0; t < e.length(); ++t) {
+      input->generalised_force_map(e.x.row(t).transpose(), W, nullptr);
+      for (Eigen::Index c = 0; c < k; ++c) {
+        const int v = coordinates[static_cast<std::size_t>(c)].velocity;
+        Wv.row(c) = W.row(v);
+        fv(c) = own[episode](t, v);
+      }
+      const Eigen::PartialPivLU<Matrix> lu(Wv);
+      const Vector force = lu.solve(fv);
+      if (force.allFinite()) F.row(t) = force.transpose();
+    }
+    out.push_back(std::move(F));
+  }
+  return out;
+}
+
 /// rho of velocity state `state` with the acceleration estimate `estimate` (the one filter of every
 /// coordinate, accelerations.hpp) of the column `differentiated` (the state itself or its measured
-/// position); `own` the model's derivatives at the samples (model_derivatives).
-StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own, int state,
-                       int differentiated, double dt, const AccelerationFilter& estimate) {
+/// position); `own` the model's derivatives at the samples (model_derivatives) and `forces` its
+/// generalised forces there (model_forces).
+StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own,
+                       const std::vector<Matrix>& forces, int state, int differentiated, double dt,
+                       const AccelerationFilter& estimate) {
   const std::vector<Vector> segments = state_segments(data, state);
   const int window = estimate.window;
   StateRatio out;
@@ -257,7 +293,9 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
   DynamicsJacobians jac;
   Vector xdot(model.state_dim());
   const auto workspace = model.make_workspace();
-  double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0, applied = 0.0;
+  const GeneralisedForceInput* input = force_input(model);
+  Matrix W;
+  double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0, applied = 0.0, kept = 0.0, motion = 0.0;
   long count = 0, position = 0;
   for (std::size_t episode = 0; episode < data.episodes.size(); ++episode) {
     const Episode& e = data.episodes[episode];
@@ -271,13 +309,19 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
       const auto u = e.u.middleRows(start, window).transpose();
       // The two holds' filtered controls differ by what the data cannot tell apart.
       const Vector du = u * (continuous[p] - held[p]);
-      // What the filter smears: the window's mean of the model's acceleration against the model's
-      // acceleration at x_t under the window's mean control (0 when nothing but the control changes).
-      const Vector filtered_u = u * continuous[p];
-      model.evaluate(e.x.row(t).transpose(), filtered_u, xdot, &jac, *workspace);
-      smear += std::pow(own[episode].col(state).segment(start, window).dot(continuous[p]) - xdot(state), 2);
+      // What the filter smears: the window's mean of the model's acceleration against the window's
+      // mean of its generalised force seen through the inertia at x_t (0 when the inertia does not
+      // change over the window, however sharply the forces do).
+      model.evaluate(e.x.row(t).transpose(), e.u.row(t).transpose(), xdot, &jac, *workspace);
+      input->generalised_force_map(e.x.row(t).transpose(), W, nullptr);
+      const Vector mean_force = forces[episode].middleRows(start, window).transpose() * continuous[p];
+      smear += std::pow(own[episode].col(state).segment(start, window).dot(continuous[p]) - W.row(state).dot(mean_force),
+                        2);
       hold += std::pow(jac.fu.row(state).dot(du), 2);
       applied += std::pow(jac.fu.row(state).dot(e.u.row(t)), 2);
+      // How much of the model's acceleration the window's mean keeps.
+      kept += std::pow(own[episode].col(state).segment(start, window).dot(continuous[p]), 2);
+      motion += std::pow(own[episode](t, state), 2);
       const double noise = jac.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
       shared += noise;
       filtered_noise += noise * continuous[p].squaredNorm();
@@ -299,6 +343,7 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
                                 : (e1_squared > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
   out.control_error = eid_squared > 0.0 ? std::sqrt(hold_mse / eid_squared) : 0.0;
   out.smear_error = eid_squared > 0.0 ? std::sqrt(smear_mse / eid_squared) : 0.0;
+  out.kept = motion > 0.0 ? std::sqrt(kept / motion) : 1.0;
   out.misfit = applied > 0.0 ? std::sqrt((smear + hold) / applied) : std::numeric_limits<double>::infinity();
   return out;
 }
@@ -477,10 +522,12 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
   facts.acceleration_derivative = filter.derivative;
   facts.ratio = std::numeric_limits<double>::infinity();
   const std::vector<Matrix> own = filter.window > 0 ? model_derivatives(*dynamics, data) : std::vector<Matrix>();
+  const std::vector<Matrix> forces =
+      filter.window > 0 ? model_forces(*dynamics, data, own, coordinates) : std::vector<Matrix>();
   for (std::size_t i = 0; i < coordinates.size(); ++i) {
     if (filter.window == 0) break;
     const GeneralisedCoordinate& c = coordinates[i];
-    const StateRatio r = state_ratio(*dynamics, data, own, c.velocity, columns.states[i], facts.dt, filter);
+    const StateRatio r = state_ratio(*dynamics, data, own, forces, c.velocity, columns.states[i], facts.dt, filter);
     const std::string name = data.system.states[static_cast<std::size_t>(c.velocity)].name;
     if (r.ratio < facts.ratio || facts.ratio_state.empty()) {
       facts.ratio = r.ratio;
@@ -493,10 +540,15 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
       facts.misfit = r.misfit;
       facts.misfit_state = name;
     }
+    if (r.kept < facts.motion_kept || facts.motion_kept_state.empty()) {
+      facts.motion_kept = r.kept;
+      facts.motion_kept_state = name;
+    }
   }
   if (facts.acceleration_window == 0) {
     facts.ratio = 0.0;
     facts.misfit = 0.0;
+    facts.motion_kept = 0.0;
     const std::string too_short = fmt::format(
         "every episode is shorter than the {} samples an acceleration estimate needs", shortest_differentiable_segment(2));
     if (estimated) return estimated_simulation(too_short);
@@ -513,18 +565,31 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
       "hold) is {:.2g}% of the force the controls apply on {} (at most {:g}%)",
       facts.acceleration_window, facts.acceleration_derivative == 2 ? " on the measured positions" : "",
       100.0 * facts.misfit, facts.misfit_state, 100.0 * kFilterMisfit);
+  const std::string kept = fmt::format(
+      "the acceleration window of {} samples keeps {:.0f}% of the model's acceleration on {} (rms; at least {:g}%)",
+      facts.acceleration_window, 100.0 * facts.motion_kept, facts.motion_kept_state, 100.0 * kMotionKept);
+  // The filter follows the model: it keeps the motion and leaves little of a true model's equation.
+  const bool follows = facts.motion_kept >= kMotionKept && facts.misfit <= kFilterMisfit;
+  const std::string not_following = facts.motion_kept < kMotionKept ? kept : misfit;
   if (estimated) {
-    if (facts.misfit <= kFilterMisfit) {
+    if (follows) {
       choice.criterion = FitCriterion::InverseDynamics;
       choice.instruments = true;
       choice.reason = fmt::format(
           "inverse-dynamics in its instrumental-variable form (IDIM-IV): the controls are generalised forces, {}, "
-          "and {}; the estimates' noise is filtered, so the bias it gives least squares cannot be bounded from the "
-          "data, and the instruments, the model simulated with the measured controls, do not share it",
-          estimated_why, misfit);
+          "{} and {}; the estimates' noise is filtered, so the bias it gives least squares cannot be bounded from "
+          "the data, and the instruments, the model simulated with the measured controls, do not share it",
+          estimated_why, kept, misfit);
       return choice;
     }
-    return estimated_simulation("the controls are generalised forces, but " + misfit);
+    return estimated_simulation("the controls are generalised forces, but " + not_following);
+  }
+  if (facts.ratio >= kInverseDynamicsRatio && !follows) {
+    choice.reason = fmt::format(
+        "one-step: the controls are generalised forces, the velocities are measured and the inverse-dynamics "
+        "residual's error per sample would be {:.3g} times below the one-step residual's ({}), but {}",
+        facts.ratio, measured, not_following);
+    return choice;
   }
   if (facts.ratio >= kInverseDynamicsRatio) {
     choice.criterion = FitCriterion::InverseDynamics;
@@ -547,8 +612,8 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
     choice.reason = fmt::format(
         "inverse-dynamics: the controls are generalised forces, the velocities are measured, and the "
         "inverse-dynamics residual's error per sample is {:.3g} times below the one-step residual's ({}; {:.0f} "
-        "needed){}",
-        facts.ratio, measured, kInverseDynamicsRatio, form);
+        "needed), {} and {}{}",
+        facts.ratio, measured, kInverseDynamicsRatio, kept, misfit, form);
     return choice;
   }
   choice.reason = fmt::format(

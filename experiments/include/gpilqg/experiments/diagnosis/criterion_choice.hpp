@@ -10,14 +10,16 @@
 ///     for light damping.
 ///
 ///  2. Inverse-dynamics when the controls are generalised forces and the accelerations can be estimated
-///     well enough; what "well enough" means depends on whether the velocities were measured:
+///     well enough. Always: the filter follows the model, i.e. its window keeps the motion (kappa >=
+///     kMotionKept = 0.9, below) and its misfit on the model is small against the force the controls
+///     apply (eps <= kFilterMisfit = 0.03, below), a residual the criterion leaves on a true model and
+///     that therefore biases the fit; and, depending on whether the velocities were measured:
 ///      - measured velocities: the inverse-dynamics residual's error per sample is at most a third of
 ///        the one-step residual's (rho >= kInverseDynamicsRatio = 3), else one-step (rule 4);
 ///      - velocities estimated from positions (MeasurementSet::estimated_states, e.g. differentiated
 ///        by `gpilqg data import`: an encoder drive or a robot logged as positions and motor
-///        commands, which robot and drive identification fits by IDIM): the filter's misfit on the
-///        model is small against the force the controls apply (eps <= kFilterMisfit = 0.03), and always
-///        in the instrumental-variable form; else simulation (rule 3). The per-sample noise of rho
+///        commands, which robot and drive identification fits by IDIM): eps alone, and always in the
+///        instrumental-variable form; else simulation (rule 3). The per-sample noise of rho
 ///        means nothing here: an estimated velocity is already filtered, so its differences (E_1) are
 ///        far smoother than its errors, and one-step is no alternative anyway (rule 3).
 ///
@@ -51,11 +53,16 @@
 ///                                           (when the accelerations come from the measured positions,
 ///                                           accelerations.hpp, sigma_q^2 mean_t |c_t|^2 / dt^4 for the
 ///                                           first term, sigma_q the positions' noise);
-///       a_s,t  = sum_r m_r f_v(x_r, u_r) - f_v(x_t, sum_r m_r u_r), the window's mean of the model's
-///                                           acceleration against the model's acceleration at x_t
-///                                           under the window's mean control: the residual the
-///                                           filtered criterion would leave on a true model, zero when
-///                                           only the control changes within the window;
+///       a_s,t  = sum_r m_r f_v,r - W_v(x_t) sum_r m_r W_v(x_r)^-1 f_v,r,  f_v,r = f_v(x_r, u_r):
+///                                           the window's mean of the model's acceleration against the
+///                                           window's mean of its generalised force seen through the
+///                                           inertia at x_t. This is the residual the filtered criterion
+///                                           (criteria/inverse_dynamics.hpp: M(q_t) qdd_t - sum_r m_r g_r)
+///                                           leaves on a true model, in acceleration units: zero while
+///                                           the inertia does not change over the window, however
+///                                           sharply the forces do (a Coulomb friction's switch, a
+///                                           control's step), since both sides are the same window's
+///                                           mean;
 ///       a_h,t  = b_v(x_t) ((m - m_0) * u)_t,  m and m_0 the weights of acceleration_weights for a
 ///                                           continuous control and for one held over each step, at
 ///                                           the window's centre.
@@ -67,13 +74,35 @@
 ///     torques; a command held over each step differs from that by half a sample at every change).
 ///     sigma_v is estimated from the velocity column itself and a_s, a_h from the model at the
 ///     measured states, so rho depends on the noise, the sampling rate and the motion only through
-///     the data. On the two-link arm at 1 kHz with smooth measured torques rho = 10.9, and the actual
-///     ratio of the two residuals' errors under the true model is 11.5; with the torques held for
-///     20 ms rho = 2.23 (actual 2.0); on the two-link arm's 50 Hz command-line data (held commands,
-///     a window of 173 samples) the motion within the window gives 0.46; the cart-pole test data
-///     (50 Hz, held 5 samples) give 0.21; the cart-pole loop's rollouts of 16 samples at 20 Hz, where
-///     most samples lie within a window of an end, 2.76 (tests/experiments/criterion_choice_test.cpp,
-///     loop_diagnosis_test.cpp).
+///     the data. On the two-link arm at 1 kHz with smooth measured torques rho = 17.7, and the actual
+///     ratio of the two residuals' errors under the true model (the criterion's residual, filtered as
+///     it filters) is 20.5; the same arm with a Coulomb friction that switches within 0.03 rad/s in the
+///     model and the data, 22.4 (actual 18.1); with the torques held for 20 ms rho = 2.24 (actual
+///     2.05); the cart-pole test data (50 Hz, held 5 samples) give 0.21; the cart-pole loop's
+///     rollouts of 16 samples at 20 Hz, where most samples lie within a window of an end, 2.76
+///     (tests/experiments/criterion_choice_test.cpp, loop_diagnosis_test.cpp). On the two-link arm's
+///     50 Hz command-line data (held commands, a window of 173 samples of the 200 of an episode) rho
+///     is 3.38 (actual 3.63), all of it the arm's inertia changing over the window, which is no noise:
+///     kappa = 0.06 and eps = 0.14 keep one-step there (with inverse dynamics the unchanged model was
+///     "explained" by a forearm 30% lighter, mujoco_cli_test.cpp).
+///
+///     kappa, per velocity state v, the smallest over them, at the window w above:
+///
+///       kappa^2 = mean_t (sum_r m_r f_v,r)^2 / mean_t f_v,t^2
+///
+///     how much of the model's acceleration the window's mean keeps. The criterion compares the
+///     window's means of both sides of the equation (parallel filtering): what the window averages
+///     away is neither fitted nor scored, so a window as long as the motion leaves equations whose
+///     signal is mostly gone, against which the rest (the noise, the smear and the hold above) is
+///     large. IDIM sets its filters' cutoff well above the bandwidth of the motion (Gautier 1997);
+///     kappa >= 0.9 asks the window to keep 90% of the acceleration's rms, for a uniform window's mean
+///     of a sinusoid (sin x / x = 0.9 at x = 0.79 = pi f T) a window of a quarter of its period.
+///     Measured: 0.93 to 0.997 on the 1 kHz two-link arm's cases above, at least 0.955 on the 7-joint
+///     stand-ins (145 samples at 1 kHz), 0.985 on the Staubli TX40 (431 samples at 1 kHz), 1.0 on the
+///     light drive; 0.06 and 0.14 on the two-link arm's 50 Hz command-line data without and with an
+///     elbow damping of 0.35 N m s (173 samples of the 200 of an episode). With the damping rho = 26 and
+///     eps = 0.023 would take inverse dynamics, which fitted the damping as 0.69 N m s, twice its
+///     value (criterion_choice_test.cpp, mujoco_cli_test.cpp).
 ///
 ///     eps, per velocity state v, the largest over them, at the window w above:
 ///
@@ -89,10 +118,14 @@
 ///     Measured (tests/support/ball_drive.hpp, tests/experiments/duffing_diagnosis_test.cpp), with
 ///     the accelerations from the measured positions (accelerations.hpp): 0.0088 and 0.0083 on the
 ///     heavy and light stand-in drives at 1 kHz (the controls' hold, a command that jitters with the
-///     encoder's counts, is nearly all of it), where inverse dynamics finds all three true effects;
-///     0.067 on the Duffing stand-in, where it adds a stiffness and an input delay the data do not
-///     hold and simulation does not; 0.15 on an imported cart-pole log (criterion_choice_test.cpp);
-///     0.45 on the Silverbox at 610 Hz (a 70 Hz resonance: 9 samples a period).
+///     encoder's counts: a carriage's inertia does not change), where inverse dynamics finds all three
+///     true effects; 0.031 on the Duffing stand-in (100 Hz, the command held over each step: all of it
+///     the hold), where the instrumental-variable form finds the cubic spring beside an input delay of
+///     half a step, which is the hold; 0.096 on an imported cart-pole log (criterion_choice_test.cpp);
+///     0.39 on the Silverbox at 610 Hz (a 70 Hz resonance: 9 samples a period). With measured
+///     velocities: 0.0077 on the two-link arm with smooth torques, 0.005 with the sharp Coulomb
+///     friction, 0.091 with velocity noise of 0.5 rad/s (a window of 85 samples) and 0.011 at a
+///     quarter of its torques and noise.
 ///
 ///     Why 3: the pure noise ratio of the shortest window (w = 3) is sqrt(2) / (dt G(3)) = 2, so rho >= 3
 ///     needs a longer window, i.e. a signal smooth over several samples; and a factor 3 in error
@@ -164,6 +197,8 @@ namespace gpilqg::diagnosis {
 inline constexpr double kInverseDynamicsRatio = 3.0;
 /// eps at or below which estimated velocities take inverse dynamics (file comment).
 inline constexpr double kFilterMisfit = 0.03;
+/// kappa at or above which the acceleration window keeps the motion (file comment).
+inline constexpr double kMotionKept = 0.9;
 /// lambda at or above which inverse dynamics takes its instrumental-variable form (file comment).
 inline constexpr double kInstrumentAttenuation = 0.01;
 /// The shortest simulation window [samples].
@@ -186,6 +221,8 @@ struct CriterionFacts {
   double smear_error = 0.0;                   ///< sqrt(mean a_s^2) / E_ID there: the motion's share
   double misfit = 0.0;                        ///< eps = max over velocity states (0: not measured)
   std::string misfit_state;                   ///< the velocity state of the maximum
+  double motion_kept = 0.0;                   ///< kappa = min over velocity states (0: not measured)
+  std::string motion_kept_state;              ///< the velocity state of the minimum
   double slowest_period = 0.0;                ///< P of the slowest velocity state [s] (inf: slower than the episodes)
   std::string slowest_state;                  ///< that state
   int window_cap = 0;                         ///< the cap on W [samples]
