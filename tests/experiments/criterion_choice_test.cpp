@@ -419,8 +419,8 @@ TEST(CriterionChoice, NoisyMeasuredVelocitiesChooseTheInstrumentalVariableForm) 
 
 // The two-link arm's command-line data (mujoco_cli_test.cpp): `gpilqg simulate` at 50 Hz, 8 episodes of
 // 200 samples with held commands and actuator noise, velocities measured with noise 0.001. The
-// acceleration window the data call for is 173 samples, nearly an episode: its mean keeps 6% of the
-// model's acceleration on the bare arm and 14% with an elbow damping of 0.35 N m s, which also slows the
+// acceleration window the data call for is 173 samples, nearly an episode: its mean keeps 8% of the
+// velocities' motion on the bare arm and 12% with an elbow damping of 0.35 N m s, which also slows the
 // arm so much that the filter's misfit (2.3%) and rho (26) would let inverse dynamics in. What the
 // window averages away is neither fitted nor scored: with the damping, inverse dynamics (IV form)
 // fitted it as 0.69 N m s, twice its value, where one-step finds it (mujoco_cli_test.cpp).

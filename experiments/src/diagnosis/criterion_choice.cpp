@@ -168,8 +168,8 @@ struct StateRatio {
   /// sqrt((mean a_s^2 + mean a_h^2) / mean |b_v u|^2): the filter's misfit on the model against the
   /// force the controls apply (infinite when they apply none)
   double misfit = 0.0;
-  /// kappa = sqrt(mean_t (sum_r m_r f_v,r)^2 / mean_t f_v,t^2): how much of the model's acceleration the
-  /// window's mean keeps (1 when there is none)
+  /// kappa (header): how much of the velocity's motion about its mean the window's mean keeps, its
+  /// noise discounted (1 when it does not move)
   double kept = 1.0;
 };
 
@@ -297,6 +297,9 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
   Matrix W;
   double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0, applied = 0.0, kept = 0.0, motion = 0.0;
   long count = 0, position = 0;
+  std::vector<double> mean_velocity;
+  for (const Episode& e : data.episodes) mean_velocity.push_back(e.x.col(state).mean());
+  double kept_noise = 0.0;
   for (std::size_t episode = 0; episode < data.episodes.size(); ++episode) {
     const Episode& e = data.episodes[episode];
     if (e.length() < window) continue;
@@ -319,9 +322,11 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
                         2);
       hold += std::pow(jac.fu.row(state).dot(du), 2);
       applied += std::pow(jac.fu.row(state).dot(e.u.row(t)), 2);
-      // How much of the model's acceleration the window's mean keeps.
-      kept += std::pow(own[episode].col(state).segment(start, window).dot(continuous[p]), 2);
-      motion += std::pow(own[episode](t, state), 2);
+      // How much of the velocity's motion about its mean the window's mean keeps, with the noise.
+      const double centre = mean_velocity[episode];
+      kept += std::pow(e.x.col(state).segment(start, window).dot(continuous[p]) - centre, 2);
+      motion += std::pow(e.x(t, state) - centre, 2);
+      kept_noise += continuous[p].squaredNorm();
       const double noise = jac.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
       shared += noise;
       filtered_noise += noise * continuous[p].squaredNorm();
@@ -343,7 +348,9 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
                                 : (e1_squared > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
   out.control_error = eid_squared > 0.0 ? std::sqrt(hold_mse / eid_squared) : 0.0;
   out.smear_error = eid_squared > 0.0 ? std::sqrt(smear_mse / eid_squared) : 0.0;
-  out.kept = motion > 0.0 ? std::sqrt(kept / motion) : 1.0;
+  // The measured velocity's white noise, sigma^2 per sample, |m|^2 sigma^2 through the window's mean.
+  const double kept_signal = kept - sigma * sigma * kept_noise, motion_signal = motion - sigma * sigma * n;
+  out.kept = motion_signal > 0.0 ? std::sqrt(std::max(0.0, kept_signal) / motion_signal) : 1.0;
   out.misfit = applied > 0.0 ? std::sqrt((smear + hold) / applied) : std::numeric_limits<double>::infinity();
   return out;
 }
@@ -556,17 +563,18 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
     return choice;
   }
   const std::string measured = fmt::format(
-      "{}: acceleration window of {} samples at {:.4g} Hz; of its mean squared error {:.0f}% from the motion within "
-      "the window, {:.0f}% from not knowing how the controls are held",
+      "{}: acceleration window of {} samples at {:.4g} Hz; of its mean squared error {:.0f}% from the inertia's "
+      "change over the window, {:.0f}% from not knowing how the controls are held",
       facts.ratio_state, facts.acceleration_window, 1.0 / facts.dt, 100.0 * facts.smear_error * facts.smear_error,
       100.0 * facts.control_error * facts.control_error);
   const std::string misfit = fmt::format(
-      "the filter's misfit on the model (the motion within the acceleration window of {} samples{} and the controls' "
-      "hold) is {:.2g}% of the force the controls apply on {} (at most {:g}%)",
+      "the filter's misfit on the model (the inertia's change over the acceleration window of {} samples{} and the "
+      "controls' hold) is {:.2g}% of the force the controls apply on {} (at most {:g}%)",
       facts.acceleration_window, facts.acceleration_derivative == 2 ? " on the measured positions" : "",
       100.0 * facts.misfit, facts.misfit_state, 100.0 * kFilterMisfit);
   const std::string kept = fmt::format(
-      "the acceleration window of {} samples keeps {:.0f}% of the model's acceleration on {} (rms; at least {:g}%)",
+      "the acceleration window of {} samples keeps {:.0f}% of the motion of {} (the rms of its window means about "
+      "its mean, against its own; at least {:g}%)",
       facts.acceleration_window, 100.0 * facts.motion_kept, facts.motion_kept_state, 100.0 * kMotionKept);
   // The filter follows the model: it keeps the motion and leaves little of a true model's equation.
   const bool follows = facts.motion_kept >= kMotionKept && facts.misfit <= kFilterMisfit;

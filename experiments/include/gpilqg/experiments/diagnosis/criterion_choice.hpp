@@ -79,30 +79,35 @@
 ///     it filters) is 20.5; the same arm with a Coulomb friction that switches within 0.03 rad/s in the
 ///     model and the data, 22.4 (actual 18.1); with the torques held for 20 ms rho = 2.24 (actual
 ///     2.05); the cart-pole test data (50 Hz, held 5 samples) give 0.21; the cart-pole loop's
-///     rollouts of 16 samples at 20 Hz, where most samples lie within a window of an end, 2.76
+///     rollouts of 16 samples at 20 Hz, where most samples lie within a window of an end, 2.81
 ///     (tests/experiments/criterion_choice_test.cpp, loop_diagnosis_test.cpp). On the two-link arm's
 ///     50 Hz command-line data (held commands, a window of 173 samples of the 200 of an episode) rho
 ///     is 3.38 (actual 3.63), all of it the arm's inertia changing over the window, which is no noise:
-///     kappa = 0.06 and eps = 0.14 keep one-step there (with inverse dynamics the unchanged model was
+///     kappa = 0.077 and eps = 0.14 keep one-step there (with inverse dynamics the unchanged model was
 ///     "explained" by a forearm 30% lighter, mujoco_cli_test.cpp).
 ///
 ///     kappa, per velocity state v, the smallest over them, at the window w above:
 ///
-///       kappa^2 = mean_t (sum_r m_r f_v,r)^2 / mean_t f_v,t^2
+///       kappa^2 = (mean_t (sum_r m_r v_r - vbar)^2 - sigma_v^2 mean_t |m|^2) / (mean_t (v_t - vbar)^2 - sigma_v^2)
 ///
-///     how much of the model's acceleration the window's mean keeps. The criterion compares the
-///     window's means of both sides of the equation (parallel filtering): what the window averages
-///     away is neither fitted nor scored, so a window as long as the motion leaves equations whose
-///     signal is mostly gone, against which the rest (the noise, the smear and the hold above) is
-///     large. IDIM sets its filters' cutoff well above the bandwidth of the motion (Gautier 1997);
-///     kappa >= 0.9 asks the window to keep 90% of the acceleration's rms, for a uniform window's mean
-///     of a sinusoid (sin x / x = 0.9 at x = 0.79 = pi f T) a window of a quarter of its period.
-///     Measured: 0.93 to 0.997 on the 1 kHz two-link arm's cases above, at least 0.955 on the 7-joint
-///     stand-ins (145 samples at 1 kHz), 0.985 on the Staubli TX40 (431 samples at 1 kHz), 1.0 on the
-///     light drive; 0.06 and 0.14 on the two-link arm's 50 Hz command-line data without and with an
-///     elbow damping of 0.35 N m s (173 samples of the 200 of an episode). With the damping rho = 26 and
-///     eps = 0.023 would take inverse dynamics, which fitted the damping as 0.69 N m s, twice its
-///     value (criterion_choice_test.cpp, mujoco_cli_test.cpp).
+///     (vbar the episode's mean velocity, sigma_v the robust noise level above, whose share the window's
+///     mean removes and which is no motion): how much of the motion the window's mean keeps. The
+///     criterion compares the window's means of both sides of the equation (parallel filtering), so an
+///     effect's regressor is its window's mean too (a viscous friction's is sum_r m_r v_r): what the
+///     window averages away is neither fitted nor scored, and a window as long as the motion leaves
+///     equations whose signal is mostly gone, against which the rest (the noise, the smear and the
+///     hold above) is large. The velocity, not the acceleration: a sharp friction's switch is a step
+///     in the acceleration that the window smooths without losing what the equation holds of it.
+///     IDIM sets its filters' cutoff well above the bandwidth of the motion (Gautier 1997); kappa >=
+///     0.9 asks the window to keep 90% of the motion's rms, for a uniform window's mean of a sinusoid
+///     (sin x / x = 0.9 at x = 0.79 = pi f T) a window of a quarter of its period. Measured: at least
+///     0.956 on the 1 kHz two-link arm's cases above, 0.995 on the 7-joint stand-ins (145 samples at
+///     1 kHz), 0.994 on the Staubli TX40 (431 samples at 1 kHz; also on the model the defaults write,
+///     whose sharp Coulomb friction on joint 4 keeps only 88% of the acceleration), 1.0 on the light
+///     drive; 0.077 and 0.118 on the two-link arm's 50 Hz command-line data without and with an elbow
+///     damping of 0.35 N m s (173 samples of the 200 of an episode). With the damping rho = 26 and eps
+///     = 0.023 would take inverse dynamics, which fitted the damping as 0.69 N m s, twice its value
+///     (criterion_choice_test.cpp, mujoco_cli_test.cpp).
 ///
 ///     eps, per velocity state v, the largest over them, at the window w above:
 ///
