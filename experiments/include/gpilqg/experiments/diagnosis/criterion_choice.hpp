@@ -18,7 +18,7 @@
 ///        the one-step residual's (rho >= kInverseDynamicsRatio = 3), else one-step (rule 4);
 ///      - velocities estimated from positions (MeasurementSet::estimated_states, e.g. differentiated
 ///        by `gpilqg data import`: an encoder drive or a robot logged as positions and motor
-///        commands, which robot and drive identification fits by IDIM): eps alone, and always in the
+///        commands, which robot and drive identification fits by IDIM): kappa and eps alone, always in the
 ///        instrumental-variable form; else simulation (rule 3). The per-sample noise of rho
 ///        means nothing here: an estimated velocity is already filtered, so its differences (E_1) are
 ///        far smoother than its errors, and one-step is no alternative anyway (rule 3).
@@ -69,7 +69,7 @@
 ///
 ///     The inverse-dynamics residual sees the controls through the weights the acceleration estimate
 ///     puts on the accelerations (parallel filtering, accelerations.hpp), so a control that changes
-///     within the window costs nothing as long as the state barely moves over it (a_s) and the
+///     within the window costs nothing as long as the inertia barely changes over it (a_s) and the
 ///     control is the signal the weights assume (a_h: the filter assumes a continuous one, measured
 ///     torques; a command held over each step differs from that by half a sample at every change).
 ///     sigma_v is estimated from the velocity column itself and a_s, a_h from the model at the
