@@ -292,10 +292,11 @@ double actual_ratio(const MeasurementSet& set, const ModelSpec& spec = arm_spec(
   const Matrix g = -generalised_force_residual(*arm, data, data.u, Matrix::Zero(data.size(), 2), rows);
   const Matrix mean_g = filtered_at(data, g, rows, qdd.filter());
   const auto& input = dynamic_cast<const GeneralisedForceInput&>(force_map_system(*arm));
+  const auto workspace = force_map_system(*arm).make_workspace();
   Matrix W;
   std::vector<double> eid(2, 0.0), e1(2, 0.0);
   for (int r = 0; r < data.size(); ++r) {
-    input.generalised_force_map(data.x.row(r).transpose(), W, nullptr);
+    input.generalised_force_map(data.x.row(r).transpose(), W, nullptr, *workspace);
     const Vector residual = qdd.qdd.row(r).transpose() - W.bottomRows(2) * mean_g.row(r).transpose();
     for (int k = 0; k < 2; ++k) {
       e1[k] += std::pow((data.x_next(r, 2 + k) - one_step(r, 2 + k)) / dt, 2);

@@ -231,6 +231,7 @@ std::vector<Matrix> model_derivatives(const Dynamics& model, const MeasurementSe
 std::vector<Matrix> model_forces(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own,
                                  const std::vector<GeneralisedCoordinate>& coordinates) {
   const GeneralisedForceInput* input = force_input(model);
+  const auto map_workspace = force_map_owner(model)->make_workspace();
   const auto k = static_cast<Eigen::Index>(coordinates.size());
   std::vector<Matrix> out;
   Matrix W;
@@ -240,7 +241,7 @@ std::vector<Matrix> model_forces(const Dynamics& model, const MeasurementSet& da
     const Episode& e = data.episodes[episode];
     Matrix F = Matrix::Zero(e.length(), k);
     for (Eigen::Index t = 0; t < e.length(); ++t) {
-      input->generalised_force_map(e.x.row(t).transpose(), W, nullptr);
+      input->generalised_force_map(e.x.row(t).transpose(), W, nullptr, *map_workspace);
       for (Eigen::Index c = 0; c < k; ++c) {
         const int v = coordinates[static_cast<std::size_t>(c)].velocity;
         Wv.row(c) = W.row(v);
@@ -294,6 +295,7 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
   Vector xdot(model.state_dim());
   const auto workspace = model.make_workspace();
   const GeneralisedForceInput* input = force_input(model);
+  const auto map_workspace = force_map_owner(model)->make_workspace();
   Matrix W;
   double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0, applied = 0.0, kept = 0.0, motion = 0.0;
   long count = 0, position = 0;
@@ -316,7 +318,7 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
       // mean of its generalised force seen through the inertia at x_t (0 when the inertia does not
       // change over the window, however sharply the forces do).
       model.evaluate(e.x.row(t).transpose(), e.u.row(t).transpose(), xdot, &jac, *workspace);
-      input->generalised_force_map(e.x.row(t).transpose(), W, nullptr);
+      input->generalised_force_map(e.x.row(t).transpose(), W, nullptr, *map_workspace);
       const Vector mean_force = forces[episode].middleRows(start, window).transpose() * continuous[p];
       smear += std::pow(own[episode].col(state).segment(start, window).dot(continuous[p]) - W.row(state).dot(mean_force),
                         2);
