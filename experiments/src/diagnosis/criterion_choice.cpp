@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 #include <Eigen/LU>
@@ -224,45 +225,82 @@ std::vector<Matrix> model_derivatives(const Dynamics& model, const MeasurementSe
   return out;
 }
 
-/// The model's generalised force at every sample, F_t = W_v(x_t)^-1 f_v(x_t, u_t) (T x k each, column i
-/// for `coordinates[i]`), from its derivatives `own` (model_derivatives): what the inverse-dynamics
-/// criterion filters (criteria/inverse_dynamics.hpp). A singular W_v leaves the row at zero (why_not_forces
-/// has refused the data when W_v was singular at the states it compared).
-std::vector<Matrix> model_forces(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own,
-                                 const std::vector<GeneralisedCoordinate>& coordinates) {
+/// Every sample of episode `index` of `data` as a row of Transitions (x_next is not set): what
+/// generalised_force_parts evaluates at each sample, the last of the episode included.
+Transitions episode_samples(const MeasurementSet& data, std::size_t index) {
+  const Episode& e = data.episodes[index];
+  Transitions out;
+  out.x = e.x;
+  out.u = e.u;
+  out.t = e.t;
+  out.episode.assign(static_cast<std::size_t>(e.length()), static_cast<int>(index));
+  out.heldout.assign(static_cast<std::size_t>(e.length()), false);
+  return out;
+}
+
+/// The model's generalised force at every sample, F_t = W_v(x_t)^-1 f_v(x_t, u_t) (T x k each, column
+/// i for force component i): what the inverse-dynamics criterion filters (criteria/inverse_dynamics.hpp),
+/// minus the residual's force term at zero acceleration (generalised_force_parts).
+std::vector<Matrix> model_forces(const Dynamics& model, const MeasurementSet& data, Eigen::Index k) {
+  std::vector<Matrix> out;
+  for (std::size_t episode = 0; episode < data.episodes.size(); ++episode) {
+    const Transitions samples = episode_samples(data, episode);
+    std::vector<int> rows(static_cast<std::size_t>(samples.size()));
+    std::iota(rows.begin(), rows.end(), 0);
+    out.push_back(-generalised_force_parts(model, samples, samples.u, Matrix::Zero(samples.size(), k), rows).forces);
+  }
+  return out;
+}
+
+/// A sample at which the rule averages (every stride-th of the episodes a window fits, at most
+/// kControlErrorRows): its window [start, start + window) of the acceleration estimate, and the model
+/// there, evaluated once for every velocity state.
+struct SampledRow {
+  std::size_t episode = 0;
+  Eigen::Index t = 0, start = 0;
+  Matrix fu;  ///< n x m, df/du at (x_t, u_t)
+  Matrix W;   ///< n x k, the generalised-force map at x_t
+};
+
+std::vector<SampledRow> sampled_rows(const Dynamics& model, const MeasurementSet& data, int window) {
+  long rows = 0;
+  for (const Episode& e : data.episodes)
+    if (e.length() >= window) rows += e.length();
+  const long stride = std::max(1L, rows / kControlErrorRows);
+  DynamicsJacobians jac;
+  Vector xdot(model.state_dim());
+  const auto workspace = model.make_workspace();
   const GeneralisedForceInput* input = force_input(model);
   const auto map_workspace = force_map_owner(model)->make_workspace();
-  const auto k = static_cast<Eigen::Index>(coordinates.size());
-  std::vector<Matrix> out;
-  Matrix W;
-  Matrix Wv(k, k);
-  Vector fv(k);
+  std::vector<SampledRow> out;
+  long position = 0;
   for (std::size_t episode = 0; episode < data.episodes.size(); ++episode) {
     const Episode& e = data.episodes[episode];
-    Matrix F = Matrix::Zero(e.length(), k);
-    for (Eigen::Index t = 0; t < e.length(); ++t) {
-      input->generalised_force_map(e.x.row(t).transpose(), W, nullptr, *map_workspace);
-      for (Eigen::Index c = 0; c < k; ++c) {
-        const int v = coordinates[static_cast<std::size_t>(c)].velocity;
-        Wv.row(c) = W.row(v);
-        fv(c) = own[episode](t, v);
-      }
-      const Eigen::PartialPivLU<Matrix> lu(Wv);
-      const Vector force = lu.solve(fv);
-      if (force.allFinite()) F.row(t) = force.transpose();
+    if (e.length() < window) continue;
+    // Every sample at its place in its window: centred, or off-centre at the episode's ends, where
+    // the estimate is noisier and no longer zero-phase (on short episodes most samples are there).
+    for (Eigen::Index t = 0; t < e.length(); ++t, ++position) {
+      if (position % stride != 0) continue;
+      SampledRow row;
+      row.episode = episode;
+      row.t = t;
+      row.start = std::clamp<Eigen::Index>(t - window / 2, 0, e.length() - window);
+      model.evaluate(e.x.row(t).transpose(), e.u.row(t).transpose(), xdot, &jac, *workspace);
+      row.fu = jac.fu;
+      input->generalised_force_map(e.x.row(t).transpose(), row.W, nullptr, *map_workspace);
+      out.push_back(std::move(row));
     }
-    out.push_back(std::move(F));
   }
   return out;
 }
 
 /// rho of velocity state `state` with the acceleration estimate `estimate` (the one filter of every
 /// coordinate, accelerations.hpp) of the column `differentiated` (the state itself or its measured
-/// position); `own` the model's derivatives at the samples (model_derivatives) and `forces` its
-/// generalised forces there (model_forces).
+/// position); `own` the model's derivatives at the samples (model_derivatives), `forces` its
+/// generalised forces there (model_forces) and `sampled` the rows it averages over (sampled_rows).
 StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own,
-                       const std::vector<Matrix>& forces, int state, int differentiated, double dt,
-                       const AccelerationFilter& estimate) {
+                       const std::vector<Matrix>& forces, const std::vector<SampledRow>& sampled, int state,
+                       int differentiated, double dt, const AccelerationFilter& estimate) {
   const std::vector<Vector> segments = state_segments(data, state);
   const int window = estimate.window;
   StateRatio out;
@@ -277,7 +315,6 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
     control_noise(j) = robust_noise_std(columns, 1, 2);
   }
   out.window = window;
-  const int h = window / 2;
   const SavitzkyGolayDerivative filter(window, estimate.order, estimate.derivative);
   // The weights on the accelerations at every place in the window (accelerations.hpp), for a
   // continuous control and for one held over each step.
@@ -287,54 +324,37 @@ StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const 
     held.push_back(acceleration_weights(filter, p, ControlHold::ZeroOrder));
   }
 
-  long rows = 0;
-  for (const Episode& e : data.episodes)
-    if (e.length() >= window) rows += e.length();
-  const long stride = std::max(1L, rows / kControlErrorRows);
-  DynamicsJacobians jac;
-  Vector xdot(model.state_dim());
-  const auto workspace = model.make_workspace();
-  const GeneralisedForceInput* input = force_input(model);
-  const auto map_workspace = force_map_owner(model)->make_workspace();
-  Matrix W;
   double hold = 0.0, smear = 0.0, shared = 0.0, gain = 0.0, filtered_noise = 0.0, applied = 0.0, kept = 0.0, motion = 0.0;
-  long count = 0, position = 0;
+  long count = 0;
   std::vector<double> mean_velocity;
   for (const Episode& e : data.episodes) mean_velocity.push_back(e.x.col(state).mean());
   double kept_noise = 0.0;
-  for (std::size_t episode = 0; episode < data.episodes.size(); ++episode) {
-    const Episode& e = data.episodes[episode];
-    if (e.length() < window) continue;
-    // Every sample at its place p in its window: centred, or off-centre at the episode's ends, where
-    // the estimate is noisier and no longer zero-phase (on short episodes most samples are there).
-    for (Eigen::Index t = 0; t < e.length(); ++t, ++position) {
-      if (position % stride != 0) continue;
-      const Eigen::Index start = std::clamp<Eigen::Index>(t - h, 0, e.length() - window);
-      const auto p = static_cast<std::size_t>(t - start);
-      const auto u = e.u.middleRows(start, window).transpose();
-      // The two holds' filtered controls differ by what the data cannot tell apart.
-      const Vector du = u * (continuous[p] - held[p]);
-      // What the filter smears: the window's mean of the model's acceleration against the window's
-      // mean of its generalised force seen through the inertia at x_t (0 when the inertia does not
-      // change over the window, however sharply the forces do).
-      model.evaluate(e.x.row(t).transpose(), e.u.row(t).transpose(), xdot, &jac, *workspace);
-      input->generalised_force_map(e.x.row(t).transpose(), W, nullptr, *map_workspace);
-      const Vector mean_force = forces[episode].middleRows(start, window).transpose() * continuous[p];
-      smear += std::pow(own[episode].col(state).segment(start, window).dot(continuous[p]) - W.row(state).dot(mean_force),
-                        2);
-      hold += std::pow(jac.fu.row(state).dot(du), 2);
-      applied += std::pow(jac.fu.row(state).dot(e.u.row(t)), 2);
-      // How much of the velocity's motion about its mean the window's mean keeps, with the noise.
-      const double centre = mean_velocity[episode];
-      kept += std::pow(e.x.col(state).segment(start, window).dot(continuous[p]) - centre, 2);
-      motion += std::pow(e.x(t, state) - centre, 2);
-      kept_noise += continuous[p].squaredNorm();
-      const double noise = jac.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
-      shared += noise;
-      filtered_noise += noise * continuous[p].squaredNorm();
-      gain += filter.weights(static_cast<int>(p)).squaredNorm();
-      ++count;
-    }
+  for (const SampledRow& row : sampled) {
+    const Episode& e = data.episodes[row.episode];
+    const Eigen::Index t = row.t, start = row.start;
+    const auto p = static_cast<std::size_t>(t - start);
+    const auto u = e.u.middleRows(start, window).transpose();
+    // The two holds' filtered controls differ by what the data cannot tell apart.
+    const Vector du = u * (continuous[p] - held[p]);
+    // What the filter smears: the window's mean of the model's acceleration against the window's
+    // mean of its generalised force seen through the inertia at x_t (0 when the inertia does not
+    // change over the window, however sharply the forces do).
+    const Vector mean_force = forces[row.episode].middleRows(start, window).transpose() * continuous[p];
+    smear += std::pow(own[row.episode].col(state).segment(start, window).dot(continuous[p]) -
+                          row.W.row(state).dot(mean_force),
+                      2);
+    hold += std::pow(row.fu.row(state).dot(du), 2);
+    applied += std::pow(row.fu.row(state).dot(e.u.row(t)), 2);
+    // How much of the velocity's motion about its mean the window's mean keeps, with the noise.
+    const double centre = mean_velocity[row.episode];
+    kept += std::pow(e.x.col(state).segment(start, window).dot(continuous[p]) - centre, 2);
+    motion += std::pow(e.x(t, state) - centre, 2);
+    kept_noise += continuous[p].squaredNorm();
+    const double noise = row.fu.row(state).cwiseProduct(control_noise.transpose()).squaredNorm();
+    shared += noise;
+    filtered_noise += noise * continuous[p].squaredNorm();
+    gain += filter.weights(static_cast<int>(p)).squaredNorm();
+    ++count;
   }
   const double n = std::max(1.0, static_cast<double>(count));
   const double hold_mse = hold / n, smear_mse = smear / n, shared_mse = shared / n;
@@ -532,11 +552,14 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
   facts.ratio = std::numeric_limits<double>::infinity();
   const std::vector<Matrix> own = filter.window > 0 ? model_derivatives(*dynamics, data) : std::vector<Matrix>();
   const std::vector<Matrix> forces =
-      filter.window > 0 ? model_forces(*dynamics, data, own, coordinates) : std::vector<Matrix>();
+      filter.window > 0 ? model_forces(*dynamics, data, static_cast<Eigen::Index>(coordinates.size()))
+                        : std::vector<Matrix>();
+  const std::vector<SampledRow> sampled =
+      filter.window > 0 ? sampled_rows(*dynamics, data, filter.window) : std::vector<SampledRow>();
   for (std::size_t i = 0; i < coordinates.size(); ++i) {
     if (filter.window == 0) break;
     const GeneralisedCoordinate& c = coordinates[i];
-    const StateRatio r = state_ratio(*dynamics, data, own, forces, c.velocity, columns.states[i], facts.dt, filter);
+    const StateRatio r = state_ratio(*dynamics, data, own, forces, sampled, c.velocity, columns.states[i], facts.dt, filter);
     const std::string name = data.system.states[static_cast<std::size_t>(c.velocity)].name;
     if (r.ratio < facts.ratio || facts.ratio_state.empty()) {
       facts.ratio = r.ratio;
