@@ -72,8 +72,8 @@ std::mutex& load_mutex() {
   return mutex;
 }
 
-/// A URDF with the motors of urdf_actuators.hpp: MuJoCo loads the URDF, writes it back as MJCF, and
-/// loads that with an <actuator> section added, from memory (named after the URDF, in its folder, so
+/// A URDF with the motors and mimic equalities of urdf_actuators.hpp: MuJoCo loads the URDF, writes it
+/// back as MJCF, and loads that with the <actuator> and <equality> sections added, from memory (named after the URDF, in its folder, so
 /// that mesh files resolve as they do for the URDF).
 mjModel* load_urdf(const std::string& path, const std::string& text, char* error, int error_size) {
   const std::vector<urdf::Joint> joints = urdf::read_joints(text, path);
@@ -81,14 +81,14 @@ mjModel* load_urdf(const std::string& path, const std::string& text, char* error
   if (plain == nullptr) return nullptr;
   std::vector<std::string> model_joints;
   for (int j = 0; j < plain->njnt; ++j) model_joints.push_back(object_name(plain, mjOBJ_JOINT, j));
-  std::string actuators;
+  std::string additions;
   try {
-    actuators = urdf::actuator_section(joints, model_joints, path);
+    additions = urdf::actuator_section(joints, model_joints, path) + urdf::equality_section(joints);
   } catch (...) {
     mj_deleteModel(plain);
     throw;
   }
-  if (actuators.empty()) return plain;  // every joint passive (effort = 0) or fixed
+  if (additions.empty()) return plain;  // every joint passive (effort = 0) or fixed, none mimics
 
   static std::atomic<int> counter{0};
   std::error_code ec;
@@ -105,7 +105,7 @@ mjModel* load_urdf(const std::string& path, const std::string& text, char* error
   const std::size_t end = mjcf.rfind("</mujoco>");
   if (end == std::string::npos)
     throw std::runtime_error(fmt::format("{}: MuJoCo's MJCF of the URDF has no </mujoco>", path));
-  mjcf.insert(end, actuators);
+  mjcf.insert(end, additions);
 
   mjVFS vfs;
   mj_defaultVFS(&vfs);

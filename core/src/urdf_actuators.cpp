@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -16,6 +17,7 @@ namespace {
 struct Tag {
   std::string name;
   std::map<std::string, std::string> attributes;
+  long line = 1;             ///< of its '<' in the text
   bool closing = false;       ///< </name>
   bool self_closing = false;  ///< <name ... />
 };
@@ -60,6 +62,7 @@ std::vector<Tag> tags(const std::string& text, const std::string& path) {
     if (text.compare(i, 2, "<?") == 0) { skip_to("?>"); continue; }
     if (text.compare(i, 2, "<!") == 0) { skip_to(">"); continue; }
     Tag tag;
+    tag.line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(i), '\n');
     std::size_t p = i + 1;
     if (p < text.size() && text[p] == '/') {
       tag.closing = true;
@@ -98,6 +101,74 @@ std::vector<Tag> tags(const std::string& text, const std::string& path) {
 
 bool actuated_type(const std::string& type) {
   return type == "revolute" || type == "continuous" || type == "prismatic";
+}
+
+/// The URDF joint types the MuJoCo system takes (a floating joint it refuses later, by its own rule).
+bool known_type(const std::string& type) { return actuated_type(type) || type == "fixed" || type == "floating"; }
+
+/// A number of the file: finite, nothing after it but spaces; nullopt otherwise.
+std::optional<double> finite_number(const std::string& s) {
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(s.c_str(), &end);
+  std::string rest(end == nullptr ? "" : end);
+  while (!rest.empty() && is_space(rest.back())) rest.pop_back();
+  if (s.empty() || !rest.empty() || errno != 0 || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+/// The name with the characters XML attribute values cannot hold escaped.
+std::string xml_escaped(const std::string& name) {
+  std::string escaped;
+  for (const char c : name) {
+    if (c == '"') escaped += "&quot;";
+    else if (c == '&') escaped += "&amp;";
+    else if (c == '<') escaped += "&lt;";
+    else escaped += c;
+  }
+  return escaped;
+}
+
+/// The mimic of joint `j` read from its <mimic> tag `t`.
+Mimic read_mimic(const Tag& t, const Joint& j, const std::string& path) {
+  Mimic mimic;
+  const auto leader = t.attributes.find("joint");
+  if (leader == t.attributes.end() || leader->second.empty())
+    throw std::invalid_argument(fmt::format("{}: line {}: joint '{}': <mimic> without a joint; expected "
+                                            "<mimic joint=\"<the joint it follows>\" multiplier=\"..\" offset=\"..\"/>",
+                                            path, t.line, j.name));
+  mimic.joint = leader->second;
+  for (const auto& [key, field] : {std::pair{"multiplier", &mimic.multiplier}, std::pair{"offset", &mimic.offset}}) {
+    const auto a = t.attributes.find(key);
+    if (a == t.attributes.end()) continue;
+    const std::optional<double> value = finite_number(a->second);
+    if (!value)
+      throw std::invalid_argument(fmt::format("{}: line {}: joint '{}': <mimic {}=\"{}\">; expected a finite number",
+                                              path, t.line, j.name, key, a->second));
+    *field = *value;
+  }
+  return mimic;
+}
+
+/// Every <mimic> names another moving joint of the file, one that does not itself mimic.
+void check_mimics(const std::vector<Joint>& joints, const std::string& path) {
+  for (const Joint& j : joints) {
+    if (!j.mimic) continue;
+    const auto leader = std::find_if(joints.begin(), joints.end(), [&](const Joint& o) { return o.name == j.mimic->joint; });
+    const std::string why = leader == joints.end()        ? "no joint of the file has that name"
+                            : leader->name == j.name       ? "a joint cannot follow itself"
+                            : !actuated_type(leader->type) ? fmt::format("it is a {} joint", leader->type)
+                            : leader->mimic                ? "it mimics another joint itself"
+                                                           : "";
+    if (!why.empty())
+      throw std::invalid_argument(fmt::format("{}: line {}: joint '{}' mimics '{}': {}; expected a revolute, "
+                                              "continuous or prismatic joint that moves by itself",
+                                              path, j.line, j.name, j.mimic->joint, why));
+    if (!actuated_type(j.type))
+      throw std::invalid_argument(fmt::format("{}: line {}: joint '{}' is {} and has a <mimic>; only a revolute, "
+                                              "continuous or prismatic joint can follow another",
+                                              path, j.line, j.name, j.type));
+  }
 }
 
 }  // namespace
@@ -139,27 +210,37 @@ std::vector<Joint> read_joints(const std::string& text, const std::string& path)
         throw std::invalid_argument(fmt::format("{}: joint {} has no name; every joint needs one", path, out.size()));
       j.name = name->second;
       j.type = type == t.attributes.end() ? "" : type->second;
+      j.line = t.line;
+      if (j.type == "planar")
+        throw std::invalid_argument(fmt::format(
+            "{}: line {}: joint '{}' is planar; gpilqg supports hinge and slide joints only, and MuJoCo would make "
+            "it three joints without motors: write it as two prismatic joints and a revolute one, with links "
+            "between them",
+            path, t.line, j.name));
+      if (!known_type(j.type))
+        throw std::invalid_argument(fmt::format(
+            "{}: line {}: joint '{}' has type \"{}\"; expected one of revolute, continuous, prismatic, fixed, "
+            "floating (URDF's types, in lower case)",
+            path, t.line, j.name, j.type));
       out.push_back(j);
       in_joint = !t.self_closing;
     } else if (level == 3 && in_joint && t.name == "limit") {
       const auto effort = t.attributes.find("effort");
       if (effort != t.attributes.end()) {
-        const std::string& s = effort->second;
-        char* end = nullptr;
-        errno = 0;
-        const double value = std::strtod(s.c_str(), &end);
-        std::string rest(end == nullptr ? "" : end);
-        while (!rest.empty() && is_space(rest.back())) rest.pop_back();
-        if (s.empty() || !rest.empty() || errno != 0 || !std::isfinite(value) || value < 0.0)
+        const std::optional<double> value = finite_number(effort->second);
+        if (!value || *value < 0.0)
           throw std::invalid_argument(fmt::format(
               "{}: joint '{}': <limit effort=\"{}\">; expected a finite number >= 0 (the motor's bound, N m or N; "
               "0 leaves the joint without a motor)",
-              path, out.back().name, s));
-        out.back().effort = value;
+              path, out.back().name, effort->second));
+        out.back().effort = *value;
       }
+    } else if (level == 3 && in_joint && t.name == "mimic") {
+      out.back().mimic = read_mimic(t, out.back(), path);
     }
     if (!t.self_closing) ++depth;
   }
+  check_mimics(out, path);
   return out;
 }
 
@@ -172,19 +253,14 @@ std::string actuator_section(const std::vector<Joint>& joints, const std::vector
       if (j.name == name) joint = &j;
     if (joint == nullptr || !actuated_type(joint->type)) continue;
     if (joint->effort && *joint->effort == 0.0) continue;  // a passive joint
+    if (joint->mimic) continue;                             // held at its leader (equality_section)
     const std::string motor = name + "_motor";
     for (const std::string& other : model_joints)
       if (other == motor)
         throw std::invalid_argument(
             fmt::format("{}: joint '{}' would get the motor '{}', the name of another joint; rename one of them", path,
                         name, motor));
-    std::string escaped;
-    for (const char c : name) {
-      if (c == '"') escaped += "&quot;";
-      else if (c == '&') escaped += "&amp;";
-      else if (c == '<') escaped += "&lt;";
-      else escaped += c;
-    }
+    const std::string escaped = xml_escaped(name);
     if (joint->effort)
       motors += fmt::format("    <motor name=\"{0}_motor\" joint=\"{0}\" gear=\"1\" ctrllimited=\"true\" "
                             "ctrlrange=\"{1:.17g} {2:.17g}\"/>\n",
@@ -194,6 +270,15 @@ std::string actuator_section(const std::vector<Joint>& joints, const std::vector
           fmt::format("    <motor name=\"{0}_motor\" joint=\"{0}\" gear=\"1\" ctrllimited=\"false\"/>\n", escaped);
   }
   return motors.empty() ? "" : "  <actuator>\n" + motors + "  </actuator>\n";
+}
+
+std::string equality_section(const std::vector<Joint>& joints) {
+  std::string held;
+  for (const Joint& j : joints)
+    if (j.mimic)
+      held += fmt::format("    <joint joint1=\"{}\" joint2=\"{}\" polycoef=\"{:.17g} {:.17g} 0 0 0\" solimp=\"0.9999 0.9999 0.001\"/>\n",
+                          xml_escaped(j.name), xml_escaped(j.mimic->joint), j.mimic->offset, j.mimic->multiplier);
+  return held.empty() ? "" : "  <equality>\n" + held + "  </equality>\n";
 }
 
 }  // namespace gpilqg::urdf

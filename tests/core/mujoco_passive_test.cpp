@@ -1,9 +1,11 @@
 // Systems without controls (m = 0, passive systems) and URDF robots (mujoco_system.hpp): a MuJoCo
 // model without actuators loads as a passive system and steps; a URDF's revolute, continuous and
 // prismatic joints get one motor each bounded by the joint's effort limit (effort 0: no motor); bad
-// efforts are errors naming the file and the joint; measurement files without control columns.
+// efforts are errors naming the file and the joint; joint types outside URDF's list are refused; a
+// <mimic> joint follows its leader; measurement files without control columns.
 
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <H5Cpp.h>
@@ -148,6 +150,74 @@ TEST(UrdfRobot, AMalformedUrdfNamesTheFileAndTheLine) {
     ADD_FAILURE() << "a malformed URDF was accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find(file.string() + ": line 3"), std::string::npos) << e.what();
+  }
+}
+
+/// The two-link arm's URDF with its first `type="revolute"` replaced by `type="<type>"`, or with
+/// `extra` inserted after the elbow's <joint> tag.
+fs::path edited_arm(const fs::path& dir, const std::string& type, const std::string& extra = "") {
+  std::ifstream in(urdf_arm_path());
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string revolute = "type=\"revolute\"";
+  if (type != "revolute") text.replace(text.find(revolute), revolute.size(), "type=\"" + type + "\"");
+  const std::string elbow = "<joint name=\"elbow\" type=\"revolute\">";
+  text.insert(text.find(elbow) + elbow.size(), extra);
+  const fs::path file = dir / "arm.urdf";
+  std::ofstream(file) << text;
+  return file;
+}
+
+/// The message MujocoSystem::load gives for `file`, "" when it loads.
+std::string load_error(const fs::path& file) {
+  try {
+    (void)MujocoSystem::load(file.string());
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// MuJoCo's URDF reader crashes the process on a joint type it does not know; each is refused first,
+// with the line and the joint, and the planar joint MuJoCo would split into three joints without
+// motors is refused too.
+TEST(UrdfRobot, AJointTypeOutsideUrdfsListIsAnErrorNamingTheLineAndTheJoint) {
+  const fs::path dir = test::temporary_dir("urdf_joint_type");
+  for (const std::string type : {"Revolute", "revolute ", "", "ball", "spherical", "planar"}) {
+    const fs::path file = edited_arm(dir, type);
+    const std::string what = load_error(file);
+    EXPECT_NE(what.find(file.string() + ": line 22: joint 'shoulder'"), std::string::npos) << type << ": " << what;
+    EXPECT_NE(what.find(type == "planar" ? "two prismatic joints and a revolute one"
+                                         : "expected one of revolute, continuous, prismatic, fixed, floating"),
+              std::string::npos)
+        << type << ": " << what;
+  }
+}
+
+// <mimic>: the follower has no motor and its acceleration follows the leader's, q_e = 0.5 q_s + 0.1
+// (MuJoCo's joint equality); without the mimic the elbow swings back against the shoulder.
+TEST(UrdfRobot, AMimicJointFollowsItsLeaderAndHasNoMotor) {
+  const fs::path dir = test::temporary_dir("urdf_mimic");
+  const auto arm =
+      MujocoSystem::load(edited_arm(dir, "revolute", R"(<mimic joint="shoulder" multiplier="0.5" offset="0.1"/>)").string());
+  EXPECT_EQ(names_of(arm->controls()), (std::vector<std::string>{"shoulder_motor"}));
+  Vector xdot(4);
+  const Vector on_constraint = (Vector(4) << 0.4, 0.3, 0.0, 0.0).finished();
+  arm->evaluate(on_constraint, (Vector(1) << 4.0).finished(), xdot, nullptr);
+  EXPECT_GT(std::abs(xdot(2)), 1.0);
+  EXPECT_NEAR(xdot(3), 0.5 * xdot(2), 0.05 * std::abs(xdot(2)));
+  const auto free_arm = MujocoSystem::load(urdf_arm_path());
+  free_arm->evaluate(on_constraint, (Vector(2) << 4.0, 0.0).finished(), xdot, nullptr);
+  EXPECT_LT(xdot(3) * xdot(2), 0.0);
+
+  for (const auto& [mimic, expected] :
+       std::vector<std::pair<std::string, std::string>>{
+           {R"(<mimic joint="wrist"/>)", "mimics 'wrist': no joint of the file has that name"},
+           {R"(<mimic joint="elbow"/>)", "a joint cannot follow itself"},
+           {R"(<mimic joint="shoulder" multiplier="nan"/>)", "<mimic multiplier=\"nan\">; expected a finite number"},
+           {R"(<mimic/>)", "<mimic> without a joint"}}) {
+    const std::string what = load_error(edited_arm(dir, "revolute", mimic));
+    EXPECT_NE(what.find("joint 'elbow'"), std::string::npos) << mimic << ": " << what;
+    EXPECT_NE(what.find(expected), std::string::npos) << mimic << ": " << what;
   }
 }
 
