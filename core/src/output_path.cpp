@@ -72,6 +72,21 @@ bool same_file(const fs::path& output, const fs::path& input) {
   return a.st_dev == b.st_dev && a.st_ino == b.st_ino;
 }
 
+std::optional<std::string> input_overwrite_problem(const fs::path& output, const std::vector<NamedInput>& inputs) {
+  for (const NamedInput& input : inputs)
+    if (same_file(output, input.file))
+      return "is the same file as " + input.name + " " + input.file.string() +
+             ", an input of the command; expected a file that is not one of its inputs";
+  return std::nullopt;
+}
+
+std::optional<std::string> output_problem(const fs::path& file, const OutputFormat& format,
+                                          const std::vector<NamedInput>& inputs) {
+  if (auto problem = output_file_problem(file)) return problem;
+  if (auto problem = input_overwrite_problem(file, inputs)) return problem;
+  return output_extension_problem(file, format);
+}
+
 std::optional<std::string> output_folder_problem(const fs::path& folder) {
   std::error_code error;
   const fs::file_status status = fs::status(folder, error);

@@ -1,6 +1,12 @@
 #include "gpilqg/experiments/config_model.hpp"
 
+#include <fstream>
+#include <iterator>
+
 #include <fmt/format.h>
+
+#include "gpilqg/core/input_file.hpp"
+#include "gpilqg/core/system_registry.hpp"
 
 #include "gpilqg/core/output_path.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
@@ -33,6 +39,28 @@ ModelSpec read_config_model(const TomlFields& f, const std::string& path, const 
                              "rollouts apply each control at once (`gpilqg simulate` applies a delay)",
                              file.string(), model.input_delay));
   return model;
+}
+
+std::vector<NamedInput> config_files(const TomlFields& f, const std::vector<std::string>& paths) {
+  std::vector<NamedInput> out;
+  for (const std::string& path : paths)
+    if (f.has(path))
+      if (const std::string named = f.string(path); is_model_file_name(named) || is_diagnosis_model_file(named))
+        out.push_back({"the config's " + path, f.file_path(path)});
+  return out;
+}
+
+std::string config_files_text(const std::vector<NamedInput>& files) {
+  std::string out;
+  for (const NamedInput& file : files) {
+    check_input_file_as<InputError>(file.file, kMaxConfigFileBytes, "a file the config names");
+    std::ifstream in(file.file, std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.good() && !in.eof()) throw InputError(fmt::format("{}: cannot be read; expected {}", file.file.string(), file.name));
+    out += fmt::format("# {} = {}\n", file.name, file.file.string()) + text;
+    if (!text.empty() && text.back() != '\n') out += '\n';
+  }
+  return out;
 }
 
 }  // namespace gpilqg

@@ -21,13 +21,13 @@ std::vector<std::string> seed_texts(const std::vector<std::uint64_t>& seeds) {
 
 /// The run's identity as stored in the manifest: a resumed run must match it in every field.
 struct Identity {
-  std::string system, config;
+  std::string system, config, model_files;
   std::int64_t iterations = 0;
   std::vector<std::string> seeds, backends;
 };
 
 Identity identity_of(const RunConfig& config, const RunOptions& options) {
-  return {config.system, config.text, config.iterations, seed_texts(options.seeds), options.backends};
+  return {config.system, config.text, config.files_text, config.iterations, seed_texts(options.seeds), options.backends};
 }
 
 std::string list_text(const std::vector<std::string>& values) {
@@ -78,6 +78,7 @@ RunCheckpoint RunCheckpoint::create(const std::filesystem::path& folder, const R
     h5.attribute("/", "format_version", kFormatVersion);
     h5.attribute("/", "system", id.system);
     h5.attribute("/", "config", id.config);
+    h5.attribute("/", "model_files", id.model_files);
     h5.attribute("/", "iterations", id.iterations);
     h5.attribute("/", "seeds", id.seeds);
     h5.attribute("/", "backends", id.backends.empty() ? std::vector<std::string>{""} : id.backends);
@@ -96,7 +97,7 @@ RunCheckpoint RunCheckpoint::resume(const std::filesystem::path& folder, const R
   // missing or of another type) is a damaged checkpoint, reported as bad input with the way out.
   struct Stored {
     std::int64_t version = 0, iterations = 0;
-    std::string system, config;
+    std::string system, config, model_files;
     std::vector<std::string> seeds, backends;
   } stored;
   try {
@@ -104,6 +105,7 @@ RunCheckpoint RunCheckpoint::resume(const std::filesystem::path& folder, const R
     stored.version = static_cast<std::int64_t>(h5.number_attribute("/", "format_version"));
     stored.system = h5.string_attribute("/", "system");
     stored.config = h5.string_attribute("/", "config");
+    if (h5.has_attribute("/", "model_files")) stored.model_files = h5.string_attribute("/", "model_files");
     stored.iterations = static_cast<std::int64_t>(h5.number_attribute("/", "iterations"));
     stored.seeds = h5.string_list_attribute("/", "seeds");
     stored.backends = h5.string_list_attribute("/", "backends");
@@ -126,6 +128,9 @@ RunCheckpoint RunCheckpoint::resume(const std::filesystem::path& folder, const R
   };
   if (stored.system != want.system) throw mismatch("system", stored.system, want.system);
   if (stored.config != want.config) throw mismatch("a different config", "(stored in its 'config' attribute)", "this one");
+  if (stored.model_files != want.model_files)
+    throw mismatch("other texts of the files its config names", "(stored in its 'model_files' attribute)",
+                   "the files as they read now: one was edited or replaced since");
   if (stored.iterations != want.iterations)
     throw mismatch("iterations", std::to_string(stored.iterations), std::to_string(want.iterations));
   if (stored.seeds != want.seeds) throw mismatch("seeds", list_text(stored.seeds), list_text(want.seeds));

@@ -228,6 +228,8 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
       f.fail(fmt::format("tasks[{}].horizon", i), *problem);
 
   c.text = stored_text(f, root);
+  c.files = config_files(f, {"system.name", "system.model", "world.model"});
+  c.files_text = config_files_text(c.files);
   return c;
 }
 

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -68,7 +69,25 @@ void require_distinct_files(const std::vector<std::filesystem::path>& files, con
   }
 }
 
-/// The parts must be runs of one experiment: the same system, gpilqg version and config.
+/// Where two texts of RunConfig::files_text first differ: the file (its "# <name> = <path>" line) and
+/// the line in it.
+std::string first_difference(const std::string& here, const std::string& there) {
+  std::istringstream a(here), b(there);
+  std::string line_a, line_b, file = "no file";
+  for (long line = 0;; ++line) {
+    const bool more_a = static_cast<bool>(std::getline(a, line_a)), more_b = static_cast<bool>(std::getline(b, line_b));
+    if (!more_a && !more_b) return "equal";
+    if (!more_a || !more_b || line_a != line_b)
+      return fmt::format("{}, line {}: {} here, {} there", file, line, more_a ? '"' + line_a + '"' : std::string("nothing"),
+                         more_b ? '"' + line_b + '"' : std::string("nothing"));
+    if (line_a.rfind("# the config's ", 0) == 0) {
+      file = line_a.substr(2);
+      line = 0;
+    }
+  }
+}
+
+/// The parts must be runs of one experiment: the same system, gpilqg version, config and files it names.
 void require_same_run(const Parts& parts) {
   const RunResultPart& first = parts.front();
   const auto config_of = [](const RunResultPart& part) {
@@ -87,6 +106,11 @@ void require_same_run(const Parts& parts) {
     if (const auto difference = config_difference(config_of(part), reference))
       throw InputError(fmt::format("{}: its config differs from {}'s in {} ({} here, {} there)", name_of(part), name_of(first),
                                    difference->field, difference->value_a, difference->value_b));
+    if (part.model_files != first.model_files)
+      throw InputError(fmt::format("{}: the files its config names read differently from {}'s ({}); the parts ran "
+                                   "different models, which one experiment cannot join",
+                                   name_of(part), name_of(first),
+                                   first_difference(part.model_files, first.model_files)));
   }
 }
 
@@ -328,6 +352,7 @@ MergeSummary write_merged(const std::filesystem::path& file, const Parts& parts,
   h5.attribute("/", "schema_version", kRunResultsSchemaVersion);
   h5.attribute("/", "gpilqg_version", first.gpilqg_version);
   h5.attribute("/", "config", first.config);
+  h5.attribute("/", "model_files", first.model_files);
   h5.attribute("/", "seed", static_cast<std::int64_t>(seeds.front()));
   h5.attribute("/", "created", utc_timestamp());
   h5.attribute("/", "system", first.system);

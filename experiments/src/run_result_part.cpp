@@ -49,6 +49,7 @@ class PartChecker {
                        kRunResultsSchemaVersion));
     part_.gpilqg_version = required_string("gpilqg_version");
     part_.config = required_string("config");
+    if (h5_.has_attribute("/", "model_files")) part_.model_files = required_string("model_files");
     part_.system = required_string("system");
     if (!h5_.exists("/seeds")) fail("dataset '/seeds' is missing; expected a result file of `gpilqg run`");
     std::set<std::uint64_t> seen;

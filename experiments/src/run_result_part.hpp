@@ -32,6 +32,9 @@ struct RunResultPart {
   std::filesystem::path file;
   std::unique_ptr<Hdf5Reader> h5;
   std::string gpilqg_version, config, system;
+  /// The texts of the files its config named (RunConfig::files_text); "" in a file of an earlier
+  /// gpilqg, which did not store them.
+  std::string model_files;
   std::vector<std::uint64_t> seeds;  ///< /seeds, in the file's order
   std::vector<RunTaskPart> tasks;    ///< by name
 

@@ -202,6 +202,7 @@ void write_run_results_to(Hdf5Writer& h5, const std::string& root, const RunResu
   h5.attribute(here, "schema_version", kRunResultsSchemaVersion);
   h5.attribute(here, "gpilqg_version", std::string(kVersionString));
   h5.attribute(here, "config", c.text);
+  h5.attribute(here, "model_files", c.files_text);
   h5.attribute(here, "seed", static_cast<std::int64_t>(results.options.seeds.front()));
   h5.attribute(here, "created", utc_timestamp());
   h5.attribute(here, "system", c.system);

@@ -88,6 +88,7 @@ SolveConfig read_solve_config(const TomlFields& f, const std::vector<std::string
   } catch (const std::invalid_argument& e) {
     f.fail("solver", e.what());
   }
+  c.files = config_files(f, {"system.name", "system.model"});
   return c;
 }
 

@@ -15,6 +15,7 @@
 #include "bindings.hpp"
 #include "conversions.hpp"
 #include "gpilqg/core/measurements.hpp"
+#include "gpilqg/core/output_path.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
@@ -76,6 +77,23 @@ struct ConfigSource {
   std::string text;
 };
 
+/// Refuses, before any work, an output `file` of `call` (given as argument `argument`) that cannot
+/// be written, would replace one of `inputs` or does not carry `format`'s extension (output_problem),
+/// as the command line refuses its --out.
+void check_output(const std::string& call, const std::string& argument, const std::optional<std::filesystem::path>& file,
+                  const OutputFormat& format, const std::vector<NamedInput>& inputs) {
+  if (!file) return;
+  if (const auto problem = output_problem(*file, format, inputs))
+    throw InputError(fmt::format("{}: {} {}: {}", call, argument, file->string(), *problem));
+}
+
+/// The files a call reads: the config (when a file) and the files it names.
+std::vector<NamedInput> config_inputs(const ConfigSource& source, const std::vector<NamedInput>& named) {
+  std::vector<NamedInput> out = named;
+  if (source.file) out.push_back({"config", *source.file});
+  return out;
+}
+
 SolveConfig solve_config_of(const ConfigSource& source) {
   if (source.file) return read_solve_config(*source.file);
   const toml::table root = TomlFields::parse_text(source.text, "<config>");
@@ -120,6 +138,13 @@ Policy plan(const ConfigSource& source, const std::vector<std::filesystem::path>
   PlanRequest request;
   request.diagnose = diagnose;
   request.config = plan_config_of(source);
+  std::vector<NamedInput> inputs = config_inputs(source, request.config.problem.files);
+  for (const auto& file : data) inputs.push_back({"data", file});
+  if (previous) inputs.push_back({"previous", *previous});
+  check_output("plan", "out", out, {"plan writes an HDF5 policy file", kHdf5Extensions}, inputs);
+  check_output("plan", "write_model", write_model, {"plan writes a TOML model file", kTomlExtensions}, inputs);
+  if (out && write_model && same_file(*write_model, *out))
+    throw InputError("plan: write_model and out name the same file; expected two files");
   request.data_files = data;
   request.previous = previous;
   request.seed = seed;
@@ -146,6 +171,7 @@ std::string run(const std::string& system, const ConfigSource& source, int seeds
     config.iterations = *iterations;
   }
   if (seeds < 1) throw InputError(fmt::format("seeds {}: expected >= 1", seeds));
+  check_output("run", "out", out, {"run writes an HDF5 result file", kHdf5Extensions}, config_inputs(source, config.files));
   RunOptions options;
   options.seeds.clear();
   for (int s = 0; s < seeds; ++s) options.seeds.push_back(first_seed + static_cast<std::uint64_t>(s));

@@ -134,6 +134,23 @@ def test_plan_errors_are_input_errors_with_the_commands_messages(tmp_path):
         gpilqg.plan({**PLAN, "solver": {"algorithm": "ilqr"}})
     with pytest.raises(gpilqg.InputError, match="gp.points"):
         gpilqg.plan({**PLAN, "gp": {"points": 3}})
+    # An output over an input is refused before any work: the config itself, the model file it names,
+    # a data file; and a file of the wrong format, as the command line refuses them.
+    (tmp_path / "sm.toml").write_text('[model]\nsystem = "cartpole"\npreset = "sim"\n')
+    named = {**PLAN, "system": {k: v for k, v in PLAN["system"].items() if k != "preset"}}
+    named["system"]["model"] = "sm.toml"
+    config = write_toml(tmp_path / "plan.toml", named)
+    before = {f: (tmp_path / f).read_bytes() for f in ("plan.toml", "sm.toml")}
+    with pytest.raises(gpilqg.InputError, match="plan: write_model .*plan.toml: is the same file as config"):
+        gpilqg.plan(config, diagnose=True, write_model=config, out=tmp_path / "p.h5")
+    with pytest.raises(gpilqg.InputError, match="is the same file as the config's system.model"):
+        gpilqg.plan(config, diagnose=True, write_model=tmp_path / "sm.toml", out=tmp_path / "p.h5")
+    with pytest.raises(gpilqg.InputError, match="plan: out .*plan.toml: is the same file as config"):
+        gpilqg.plan(config, out=config)
+    with pytest.raises(gpilqg.InputError, match="expected a name ending in .h5 or .hdf5"):
+        gpilqg.plan(config, out=tmp_path / "p.csv")
+    assert before == {f: (tmp_path / f).read_bytes() for f in ("plan.toml", "sm.toml")}
+    assert not (tmp_path / "p.h5").exists()
 
 
 RUN = {

@@ -290,6 +290,12 @@ TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   ASSERT_EQ(test::run_cli("simulate --system cartpole --episodes 1 --steps 20 --dt 0.05 --out " + quote(dir / "log.h5")).status, 0);
   expect_bad_input(plan(config, "--previous " + quote(dir / "log.h5") + " --out " + quote(dir / "x.h5")),
                    {"log.h5", "/policy/x_bar"});
+  // --write-model over the model file the config names as its simulator, refused before any work.
+  const fs::path named_model = test::write_text(dir / "sm.toml", "[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n");
+  const fs::path named = test::write_text(dir / "named.toml", tiny_plan_with("preset = \"sim\"", "model = \"sm.toml\""));
+  expect_bad_input(plan(named, "--diagnose --write-model " + quote(named_model) + " --out " + quote(dir / "x.h5")),
+                   {"--write-model", "sm.toml: is the same file as the config's system.model"});
+  EXPECT_EQ(test::read_text(named_model), "[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n");
   EXPECT_FALSE(fs::exists(dir / "x.h5")) << "a failed plan wrote its output";
 
   const std::string rollout = "rollout --policy " + p0 + " --out " + quote(dir / "r.csv");

@@ -151,6 +151,21 @@ TEST_F(RunMerge, ASeedHeldTwiceIsKeptOnceWhenOnlyItsWallClockTimesDiffer) {
   EXPECT_FALSE(fs::exists(dir_ / "refused.h5"));
 }
 
+// The same config naming a model file whose text differs between the parts: two simulators.
+TEST_F(RunMerge, PartsWhoseConfigNamedFilesThatReadDifferentlyAreRefused) {
+  RunResults first = single_[0], second = single_[1];
+  first.config.files_text = "# the config's system.model = /a/sm.toml\n[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n";
+  second.config.files_text = "# the config's system.model = /a/sm.toml\n[model]\nsystem = \"cartpole\"\npreset = \"real\"\n";
+  const fs::path a = written(dir_ / "model_a.h5", first), b = written(dir_ / "model_b.h5", second);
+  const std::string message = refusal({a, b}, dir_ / "merged.h5");
+  EXPECT_NE(message.find(fmt::format("{}: the files its config names read differently from {}'s (the config's "
+                                     "system.model = /a/sm.toml, line 3: \"preset = \"real\"\" here, \"preset = \"sim\"\" there)",
+                                     b.string(), a.string())),
+            std::string::npos)
+      << message;
+  EXPECT_FALSE(fs::exists(dir_ / "merged.h5"));
+}
+
 TEST_F(RunMerge, PartsOfADifferentConfigAreRefusedNamingTheField) {
   RunResults other_limit = single_[1];
   other_limit.config.text = parse_run_config("cartpole", std::string(test::kTinyRun) + "[control]\nu_max = [9.0]\n", "t.toml").text;

@@ -116,6 +116,30 @@ TEST(RunResume, ACheckpointServesOnlyTheRunItWasMadeFor) {
   std::filesystem::remove_all(dir);
 }
 
+// The same config text naming a model file that was edited in between: two simulators in one run.
+TEST(RunResume, AModelFileTheConfigNamesThatWasEditedSinceIsRefused) {
+  const auto dir = test::temporary_dir("run_resume_model_file");
+  const auto folder = dir / "r.h5.checkpoint";
+  const auto model = test::write_text(dir / "sm.toml", "[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n");
+  const auto config_file = test::write_text(dir / "c.toml", std::string(test::kTinyRun) + "[system]\nmodel = \"sm.toml\"\n");
+  const RunConfig config = load_run_config("cartpole", config_file);
+  ASSERT_EQ(config.files.size(), 1u);
+  EXPECT_EQ(config.files[0].name, "the config's system.model");
+  EXPECT_NE(config.files_text.find("preset = \"sim\""), std::string::npos) << config.files_text;
+  RunCheckpoint::create(folder, config, two_seeds());
+  EXPECT_NO_THROW(RunCheckpoint::resume(folder, load_run_config("cartpole", config_file), two_seeds()));
+  test::write_text(model, "[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n[parameters]\npole_length = 0.6\n");
+  const RunConfig edited = load_run_config("cartpole", config_file);
+  EXPECT_EQ(edited.text, config.text);
+  try {
+    RunCheckpoint::resume(folder, edited, two_seeds());
+    ADD_FAILURE() << "a checkpoint resumed with an edited model file";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("other texts of the files its config names"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(RunResume, ADamagedManifestIsReportedAsADamagedCheckpointWithTheWayToStartOver) {
   const auto dir = test::temporary_dir("run_resume_damaged");
   const auto folder = dir / "r.h5.checkpoint";

@@ -33,15 +33,6 @@ std::vector<CommandInput>& program_inputs() {
   return inputs;
 }
 
-/// Throws when `file` is one of `inputs`.
-void refuse_input(const std::string& option, const std::filesystem::path& file, const std::vector<CommandInput>& inputs) {
-  for (const CommandInput& input : inputs)
-    if (same_file(file, input.file))
-      throw InputError(fmt::format("{} {}: is the same file as {} {}, an input of the command; expected a file that is "
-                                   "not one of its inputs",
-                                   option, file.string(), input.name, input.file.string()));
-}
-
 }  // namespace
 
 CommandInput system_input(const std::string& system, const std::string& name) {
@@ -53,11 +44,9 @@ void set_program_inputs(std::vector<CommandInput> inputs) { program_inputs() = s
 void check_output_file_option(const std::string& option, const std::filesystem::path& file, const OutputFormat& format,
                               const std::vector<CommandInput>& inputs) {
   if (file.empty()) return;
-  if (const auto problem = output_file_problem(file))
-    throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
-  refuse_input(option, file, inputs);  // before the name's format: the input named is the more telling culprit
-  refuse_input(option, file, program_inputs());
-  if (const auto problem = output_extension_problem(file, format))
+  std::vector<CommandInput> all = inputs;
+  all.insert(all.end(), program_inputs().begin(), program_inputs().end());
+  if (const auto problem = output_problem(file, format, all))
     throw InputError(fmt::format("{} {}: {}", option, file.string(), *problem));
   remove_and_name(stale_temporaries(file));
 }

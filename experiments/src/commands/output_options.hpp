@@ -13,12 +13,8 @@
 
 namespace gpilqg::cli {
 
-/// A file a command reads, as messages name it: the option or argument that gave it ("--data",
-/// "LOG") and its path; an empty path (option not given) is skipped.
-struct CommandInput {
-  std::string name;
-  std::filesystem::path file;
-};
+/// A file a command reads (output_path.hpp).
+using CommandInput = NamedInput;
 
 /// Checks, in this order, and throws InputError "<option> <file>: <problem>" at the first problem:
 ///  1. output_file_problem (output_path.hpp): what is at the path, its folder, its name's length;

@@ -46,6 +46,25 @@ std::optional<std::string> output_file_problem(const std::filesystem::path& file
 /// file. False when either does not exist or cannot be inspected.
 bool same_file(const std::filesystem::path& output, const std::filesystem::path& input);
 
+/// A file a command or call reads, as messages name it: the option, argument or config field that
+/// gave it ("--data", "CONFIG", "the config's [system] model") and its path; an empty path (not
+/// given) is skipped.
+struct NamedInput {
+  std::string name;
+  std::filesystem::path file;
+};
+
+/// Why writing `output` would replace one of `inputs` (same_file), or nullopt: "is the same file as
+/// <name> <path>, an input of the command; expected a file that is not one of its inputs".
+std::optional<std::string> input_overwrite_problem(const std::filesystem::path& output,
+                                                   const std::vector<NamedInput>& inputs);
+
+/// Every check of a result file before any work, in this order: output_file_problem, then
+/// input_overwrite_problem against `inputs` (the input named is the more telling culprit), then
+/// output_extension_problem against `format`; nullopt when it passes all three.
+std::optional<std::string> output_problem(const std::filesystem::path& file, const OutputFormat& format,
+                                          const std::vector<NamedInput>& inputs);
+
 /// Why `folder` cannot receive output files (e.g. figures), or nullopt when it can: it must be a
 /// folder or absent, and it or its nearest existing ancestor must be writable.
 std::optional<std::string> output_folder_problem(const std::filesystem::path& folder);

@@ -10,8 +10,10 @@
 /// GP learns only what it still misses.
 
 #include <string>
+#include <vector>
 
 #include "gpilqg/core/effect_library.hpp"
+#include "gpilqg/core/output_path.hpp"
 #include "gpilqg/core/systems.hpp"
 
 namespace gpilqg {
@@ -28,5 +30,15 @@ ModelSpec read_config_model(const TomlFields& fields, const std::string& path, c
 /// True when `name` names a model file of the diagnosis (it ends in ".toml", any case) rather than a
 /// system or a MuJoCo model file.
 bool is_diagnosis_model_file(const std::string& name);
+
+/// The files a config names, resolved against its folder (TomlFields::file_path): each field of
+/// `fields` that is given and names a file (a MuJoCo model or URDF, or a model file of the diagnosis),
+/// as {"the config's <field>", path}. What a command that reads the config must not overwrite.
+std::vector<NamedInput> config_files(const TomlFields& fields, const std::vector<std::string>& paths);
+
+/// The text of each of `files`, each after a line "# <name> = <path>": what a run read from them,
+/// part of its identity (a resumed run and the parts of a merge must have read the same texts).
+/// Throws InputError naming a file that cannot be read.
+std::string config_files_text(const std::vector<NamedInput>& files);
 
 }  // namespace gpilqg

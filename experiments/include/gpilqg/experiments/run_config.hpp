@@ -31,6 +31,7 @@
 #include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/noise.hpp"
+#include "gpilqg/core/output_path.hpp"
 #include "gpilqg/experiments/gp_settings.hpp"
 
 namespace gpilqg {
@@ -100,6 +101,12 @@ struct RunConfig {
   /// The full effective config as TOML text (defaults merged with the user's file): what the result
   /// stores in its `config` attribute.
   std::string text;
+  /// The files the config names (config_files, config_model.hpp): system.name when it is a MuJoCo
+  /// model or URDF, system.model, world.model; and their texts as the run read them
+  /// (config_files_text), which the result stores in its `model_files` attribute: a resumed run and
+  /// the parts of a merge must have read the same.
+  std::vector<NamedInput> files;
+  std::string files_text;
 };
 
 /// The embedded default config of a system ("cartpole", "quadrotor") as TOML text. Throws InputError

@@ -21,7 +21,8 @@
 /// Refused with an InputError naming the files and the field: fewer than two parts, a part given
 /// twice, an output that is one of the parts; a part that is not a result file of this layout; parts
 /// whose config differs (the first differing field, as a dotted path with both values) or whose
-/// system, schema_version or gpilqg_version differ; datasets of an algorithm that differ in more than
+/// system, schema_version or gpilqg_version differ; parts whose config named files that read
+/// differently (`model_files`: the file and line of the first difference); datasets of an algorithm that differ in more than
 /// the seed axis between parts (e.g. another --iterations); a seed of an algorithm held by two parts
 /// with different values; an algorithm that would not have every seed of the merged file.
 

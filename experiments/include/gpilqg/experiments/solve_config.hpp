@@ -21,6 +21,7 @@
 #include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/noise.hpp"
+#include "gpilqg/core/output_path.hpp"
 #include "gpilqg/core/systems.hpp"
 
 namespace gpilqg {
@@ -40,6 +41,9 @@ struct SolveConfig {
   Vector u_min, u_max;  ///< empty: unconstrained
   Vector u_init;        ///< constant initial control (empty: zero)
   DdpOptions solver;
+  /// The files the config names (config_files, config_model.hpp): system.name when it is a MuJoCo
+  /// model or URDF, system.model. A command that reads the config must not overwrite them.
+  std::vector<NamedInput> files;
 };
 
 /// Reads and validates a config; throws InputError naming the file, line and field.
