@@ -57,6 +57,9 @@ void check_previous(const PolicyFile& previous, const std::filesystem::path& fil
 PlannedPolicy plan_policy(const PlanRequest& request) {
   const SolveConfig& c = request.config.problem;
   const GpSettings& gp_settings = request.config.gp;
+  if (request.diagnose && request.data_files.empty())
+    throw InputError("diagnose: no measurement files to diagnose; expected data files with it (--data FILE, or "
+                     "Python's data=[...])");
   const SystemSignature signature = system_signature(c.system);
   std::shared_ptr<const StepModel> simulator = make_solve_model(c);
   const int m = simulator->control_dim();
@@ -130,6 +133,7 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   f.created = utc_timestamp();
   f.gpilqg_version = kVersionString;
   f.simulator_model = simulator_text;
+  out.planned_on = planned_on;
   return out;
 }
 

@@ -270,4 +270,22 @@ RunConfig load_run_config(const std::string& system, const std::optional<std::fi
   return parse_run_config(system, text.str(), override_file->string());
 }
 
+RunConfig with_iterations(RunConfig config, int iterations, const std::string& option) {
+  if (iterations < 1 || iterations > limits::kMaxLoopIterations)
+    throw InputError(fmt::format("{}: is {}; expected a whole number from 1 to {}", option, iterations,
+                                 limits::kMaxLoopIterations));
+  if (config.diagnose_after >= iterations)
+    throw InputError(fmt::format("{} {}: the config's diagnosis.after_round is {}, a round the loop of {} iteration(s) "
+                                 "never reaches (its rounds are 0 to {}); expected more iterations, or an earlier "
+                                 "after_round (-1: no diagnosis)",
+                                 option, iterations, config.diagnose_after, iterations, iterations - 1));
+  config.iterations = iterations;
+  toml::table stored = toml::parse(config.text);
+  if (toml::table* loop = stored["loop"].as_table()) loop->insert_or_assign("iterations", iterations);
+  std::ostringstream text;
+  text << toml::toml_formatter{stored};
+  config.text = text.str();
+  return config;
+}
+
 }  // namespace gpilqg

@@ -176,10 +176,10 @@ SweepConfig load_sweep_config(const std::filesystem::path& file) {
     text << toml::toml_formatter{table};
     try {
       point.config = parse_run_config(s.system, text.str(), fmt::format("grid point {}", p));
+      if (iterations) point.config = with_iterations(std::move(point.config), *iterations, "field 'iterations'");
     } catch (const InputError& e) {
       throw InputError(fmt::format("{}: grid point {} ({}): {}", file.string(), p, point.label(), e.what()));
     }
-    if (iterations) point.config.iterations = *iterations;
     s.points.push_back(std::move(point));
   }
   return s;

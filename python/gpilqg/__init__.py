@@ -45,6 +45,13 @@ def _path(who, name, value, optional=False):
                      % (who, name, type(value).__name__, " or None" if optional else ""))
 
 
+def _flag(who, name, value):
+    """A yes/no argument: True or False (a NumPy bool too), never a string or a number taken for one."""
+    if isinstance(value, bool) or type(value).__name__ == "bool_":
+        return bool(value)
+    raise InputError("%s: %s is %r; expected True or False" % (who, name, value))
+
+
 def _paths(who, name, values):
     """A list of file paths; one path alone is not taken for the list of its characters."""
     if isinstance(values, (str, bytes, _os.PathLike)) or not hasattr(values, "__iter__"):
@@ -77,7 +84,8 @@ def plan(config, data=(), previous=None, out=None, seed=1, diagnose=False, write
         raise InputError("plan: config is None; expected a file path or a dict of TOML tables")
     return _gpilqg._plan(_config_source("plan", config), _paths("plan", "data", data),
                          _path("plan", "previous", previous, optional=True), _path("plan", "out", out, optional=True),
-                         seed, bool(diagnose), _path("plan", "write_model", write_model, optional=True), progress)
+                         seed, _flag("plan", "diagnose", diagnose), _path("plan", "write_model", write_model, optional=True),
+                         progress)
 
 
 def run(system, config=None, seeds=1, first_seed=1, iterations=None, backends=(), out=None, progress=None):

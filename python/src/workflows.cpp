@@ -154,8 +154,12 @@ Policy plan(const ConfigSource& source, const std::vector<std::filesystem::path>
   if (planned.summary.termination == DdpTermination::InitialRolloutDiverged)
     throw std::runtime_error("the initial controls drive the model to non-finite states; no policy");
   if (out) write_policy_file(*out, planned.file, planned.model.get());
-  if (write_model && planned.diagnosis && planned.diagnosis->adopted)
-    diagnosis::write_model_file(*write_model, planned.diagnosis->model, {"diagnosed by gpilqg.plan(diagnose=True)"});
+  if (write_model && planned.diagnosis)
+    diagnosis::write_model_file(*write_model, planned.planned_on,
+                                {planned.diagnosis->adopted
+                                     ? "diagnosed by gpilqg.plan(diagnose=True)"
+                                     : "the config's simulator, kept by gpilqg.plan(diagnose=True) (verdict " +
+                                           planned.diagnosis->verdict + ")"});
   return {std::move(planned.file), std::move(planned.model), std::move(planned.diagnosis)};
 }
 
@@ -166,10 +170,7 @@ std::string run(const std::string& system, const ConfigSource& source, int seeds
   RunConfig config = source.file ? load_run_config(system, *source.file)
                                  : (source.text.empty() ? load_run_config(system, std::nullopt)
                                                         : parse_run_config(system, source.text, "<config>"));
-  if (iterations) {
-    if (*iterations < 1) throw InputError(fmt::format("iterations {}: expected >= 1", *iterations));
-    config.iterations = *iterations;
-  }
+  if (iterations) config = with_iterations(std::move(config), *iterations, "run: iterations");
   if (seeds < 1) throw InputError(fmt::format("seeds {}: expected >= 1", seeds));
   check_output("run", "out", out, {"run writes an HDF5 result file", kHdf5Extensions}, config_inputs(source, config.files));
   RunOptions options;
@@ -188,7 +189,7 @@ std::string run(const std::string& system, const ConfigSource& source, int seeds
 
 py::object diagnose(const py::object& system, const py::object& data, const std::string& model,
                     const std::string& preset, const std::vector<std::string>& add, bool auto_select,
-                    const std::string& search, const std::vector<int>& horizons, const std::string& integrator,
+                    const std::optional<std::string>& search, const std::vector<int>& horizons, const std::string& integrator,
                     double heldout, int gp_points, int gp_restarts, const std::string& backend, std::uint64_t seed,
                     const std::string& criterion, std::optional<long> window, const std::vector<std::string>& exclude,
                     const std::vector<std::string>& include, const py::object& progress) {
@@ -323,7 +324,7 @@ Call it as policy(t, x). Arrays have one row per time step: x_bar (T+1, n), u_ba
   const diagnosis::DiagnoseRequest defaults;
   m.def("diagnose", &diagnose, py::arg("system"), py::arg("data"), py::arg("model") = "",
         py::arg("preset") = defaults.preset, py::arg("add") = std::vector<std::string>{},
-        py::arg("auto") = false, py::arg("search") = defaults.search, py::arg("horizons") = defaults.horizons, py::arg("integrator") = defaults.integrator, py::arg("heldout") = defaults.heldout,
+        py::arg("auto") = false, py::arg("search") = py::none(), py::arg("horizons") = defaults.horizons, py::arg("integrator") = defaults.integrator, py::arg("heldout") = defaults.heldout,
         py::arg("gp_points") = defaults.gp_points, py::arg("gp_restarts") = defaults.gp_restarts,
         py::arg("backend") = defaults.backend, py::arg("seed") = defaults.seed,
         py::arg("criterion") = defaults.criterion, py::arg("window") = py::none(), py::arg("exclude") = std::vector<std::string>{},

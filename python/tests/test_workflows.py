@@ -134,6 +134,10 @@ def test_plan_errors_are_input_errors_with_the_commands_messages(tmp_path):
         gpilqg.plan({**PLAN, "solver": {"algorithm": "ilqr"}})
     with pytest.raises(gpilqg.InputError, match="gp.points"):
         gpilqg.plan({**PLAN, "gp": {"points": 3}})
+    with pytest.raises(gpilqg.InputError, match="plan: diagnose is 'yes'; expected True or False"):
+        gpilqg.plan(PLAN, diagnose="yes")
+    with pytest.raises(gpilqg.InputError, match="diagnose: no measurement files to diagnose"):
+        gpilqg.plan(PLAN, diagnose=True)
     # An output over an input is refused before any work: the config itself, the model file it names,
     # a data file; and a file of the wrong format, as the command line refuses them.
     (tmp_path / "sm.toml").write_text('[model]\nsystem = "cartpole"\npreset = "sim"\n')

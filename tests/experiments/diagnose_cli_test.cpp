@@ -119,6 +119,11 @@ TEST(DiagnoseCli, BadInputIsExitTwoNamingWhatIsWrong) {
   auto missing = test::run_cli("diagnose --system cartpole --data " + quote(dir / "none.csv"));
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.err.find("none.csv"), std::string::npos) << missing.err;
+
+  // --search chooses how --auto searches; without --auto it would be ignored.
+  auto search = test::run_cli(base + " --search forward");
+  EXPECT_EQ(search.status, 2);
+  EXPECT_NE(search.err.find("--search forward: chooses how --auto searches"), std::string::npos) << search.err;
 }
 
 // --exclude leaves candidates out (by name or pattern), says so in both reports, and refuses a pattern that

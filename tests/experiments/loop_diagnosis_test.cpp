@@ -251,6 +251,18 @@ TEST(ConfigModelCli, AConfigNamesItsSimulatorAndWorldByModelFilesAndBadOnesAreRe
   expect_holds(error_of("[system]\nmodel = \"none.toml\"\n"), {"field 'system.model'", "none.toml"});
   expect_holds(error_of("[diagnosis]\nafter_round = 4\n"), {"field 'diagnosis.after_round'", "from 0 to 3"});
   expect_holds(error_of("[diagnosis]\nafter_round = 0\nevery = 1\n"), {"diagnosis.every"});
+  // --iterations (and a sweep's `iterations`, Python's run(iterations=)) fewer than after_round needs:
+  // refused, where the loop would never diagnose; more are kept in the stored config, which says what ran.
+  const RunConfig late = parse_run_config("cartpole", "[diagnosis]\nafter_round = 1\n", source);
+  try {
+    (void)with_iterations(late, 1, "--iterations");
+    ADD_FAILURE() << "after_round 1 accepted with 1 iteration";
+  } catch (const InputError& e) {
+    expect_holds(e.what(), {"--iterations 1: the config's diagnosis.after_round is 1", "rounds are 0 to 0"});
+  }
+  const RunConfig longer = with_iterations(late, 6, "--iterations");
+  EXPECT_EQ(longer.iterations, 6);
+  EXPECT_EQ(parse_run_config("cartpole", longer.text, "stored").iterations, 6);
 
   // `solve` and `plan`: [system] model is the simulator, instead of a preset.
   const auto solve = folder / "solve.toml";

@@ -257,6 +257,32 @@ void expect_bad_input(const test::CommandResult& r, const std::vector<std::strin
   for (const auto& text : where) EXPECT_NE(r.err.find(text), std::string::npos) << "'" << text << "' not in: " << r.err;
 }
 
+// --write-model writes the model the round planned on whatever the verdict: when the diagnosis adopts
+// nothing, the config's simulator with the verdict in its comment, in place of a file an earlier round
+// left (a scripted loop would otherwise plan its next round on that stale model).
+TEST(PlanCli, WriteModelWritesTheModelPlannedOnAlsoWhenNothingIsAdopted) {
+  const fs::path dir = test::temporary_dir("plan_write_kept");
+  const fs::path config = test::write_text(dir / "plan.toml", test::kTinyPlan);
+  ASSERT_EQ(plan(config, "--out " + quote(dir / "p0.h5")).status, 0);
+  const auto r = test::run_cli("rollout --system cartpole --policy " + quote(dir / "p0.h5") + " --out " +
+                               quote(dir / "d0.h5") + " --seed 3" + kRolloutOptions);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const fs::path written = test::write_text(dir / "w.toml", "# an earlier round's model\n[model]\nsystem = \"cartpole\"\npreset = \"real\"\n");
+  const auto p = plan(config, "--data " + quote(dir / "d0.h5") + " --diagnose --write-model " + quote(written) + " --json --out " +
+                                  quote(dir / "p1.h5"));
+  ASSERT_EQ(p.status, 0) << p.err;
+  const auto json = nlohmann::json::parse(p.out);
+  ASSERT_FALSE(json["diagnosis"]["adopted"].get<bool>()) << json["diagnosis"].dump();
+  EXPECT_EQ(json["diagnosis"]["model_file"], written.string());
+  const std::string text = test::read_text(written);
+  EXPECT_NE(text.find("# the config's simulator, kept by `gpilqg plan --diagnose` (verdict " +
+                      json["diagnosis"]["verdict"].get<std::string>() + ")"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("preset = \"sim\""), std::string::npos) << text;
+  EXPECT_EQ(text.find("earlier round"), std::string::npos) << text;
+}
+
 TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   const fs::path dir = test::temporary_dir("plan_errors");
   const fs::path config = test::write_text(dir / "plan.toml", test::kTinyPlan);
@@ -290,6 +316,8 @@ TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   ASSERT_EQ(test::run_cli("simulate --system cartpole --episodes 1 --steps 20 --dt 0.05 --out " + quote(dir / "log.h5")).status, 0);
   expect_bad_input(plan(config, "--previous " + quote(dir / "log.h5") + " --out " + quote(dir / "x.h5")),
                    {"log.h5", "/policy/x_bar"});
+  // --diagnose with nothing to diagnose.
+  expect_bad_input(plan(config, "--diagnose --out " + quote(dir / "x.h5")), {"diagnose: no measurement files to diagnose"});
   // --write-model over the model file the config names as its simulator, refused before any work.
   const fs::path named_model = test::write_text(dir / "sm.toml", "[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n");
   const fs::path named = test::write_text(dir / "named.toml", tiny_plan_with("preset = \"sim\"", "model = \"sm.toml\""));

@@ -166,8 +166,8 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--include", r.include,
                   "Rank and search candidates offered only on request too, e.g. 'param:*.second_moment_*' (the "
                   "bodies' second moments of mass; repeatable)");
-  cmd->add_option("--search", r.search, "How --auto searches: subsets (every set of up to 4 effects) or forward")
-      ->capture_default_str();
+  cmd->add_option("--search", r.search,
+                  "With --auto: how it searches, subsets (every set of up to 4 effects; the default) or forward");
   cmd->add_flag("--json", o->json, "Print one JSON document on stdout instead of the report");
   writes_json(cmd->add_option("--out", o->out, "Write the HDF5 report here"));  // its report attribute is JSON
   cmd->add_option("--plots", o->plots, "Write PNG plots into this folder (needs matplotlib and h5py)");

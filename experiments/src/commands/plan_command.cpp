@@ -61,8 +61,14 @@ int run_plan(const PlanOptions& o) {
   }
   write_policy_file(o.out, planned.file, planned.model.get());
   const auto& d = planned.diagnosis;
-  if (!o.write_model.empty() && d && d->adopted)
-    diagnosis::write_model_file(o.write_model, d->model, {"diagnosed by `gpilqg plan --diagnose` on " + fmt::format("{}", fmt::join(o.data, ", "))});
+  // The model the round planned on, adopted or not: a scripted loop's next round plans on it, never on
+  // a file an earlier round left there.
+  const std::string data_text = fmt::format("{}", fmt::join(o.data, ", "));
+  if (!o.write_model.empty() && d)
+    diagnosis::write_model_file(o.write_model, planned.planned_on,
+                                {d->adopted ? "diagnosed by `gpilqg plan --diagnose` on " + data_text
+                                            : fmt::format("the config's simulator, kept by `gpilqg plan --diagnose` "
+                                                          "(verdict {}) on {}", d->verdict, data_text)});
   if (o.json) {
     nlohmann::json out = policy_json(planned.file, planned.model.get());
     out["out"] = o.out;
@@ -78,7 +84,7 @@ int run_plan(const PlanOptions& o) {
       out["diagnosis"] = {{"verdict", d->verdict}, {"reason", d->reason}, {"adopted", d->adopted},
                           {"changes", d->changes}, {"transitions", d->transitions}, {"seconds", d->seconds},
                           {"model", d->adopted ? diagnosis::model_file_text(d->model) : std::string()},
-                          {"model_file", d->adopted ? o.write_model : std::string()}};
+                          {"model_file", o.write_model}};
     std::cout << out.dump() << '\n';
   } else {
     const PolicyFile& f = planned.file;
@@ -87,6 +93,10 @@ int run_plan(const PlanOptions& o) {
       if (d->adopted)
         std::cout << (o.write_model.empty() ? std::string("  planned on the diagnosed model (--write-model F.toml keeps it)\n")
                                             : fmt::format("  planned on the diagnosed model; wrote it to {}\n", o.write_model));
+      else if (!o.write_model.empty())
+        std::cout << fmt::format("  planned on the config's simulator (nothing adopted); wrote it to {} for the next "
+                                 "round\n",
+                                 o.write_model);
     }
     if (planned.model)
       std::cout << fmt::format("round {}: residual GP ({}) fitted on {} transitions from {} file(s) in {:.1f} s{}\n",

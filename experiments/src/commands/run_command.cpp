@@ -87,7 +87,7 @@ int run_command(const RunArguments& a) {
                                    a.seeds, limits::kMaxSeed));
     if (system_signature(a.system).controls.empty()) throw InputError(passive_system_refusal(a.system));
     config = load_run_config(a.system, a.config.empty() ? std::nullopt : std::optional<std::filesystem::path>(a.config));
-    if (a.iterations > 0) config.iterations = a.iterations;  // validated by its option check
+    if (a.iterations > 0) config = with_iterations(std::move(config), a.iterations, "--iterations");
     options.seeds.clear();
     for (int s = 0; s < a.seeds; ++s) options.seeds.push_back(a.first_seed + static_cast<std::uint64_t>(s));
     if (a.backends) {

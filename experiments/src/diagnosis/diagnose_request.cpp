@@ -145,10 +145,15 @@ DiagnosisOptions diagnosis_options(const DiagnoseRequest& o) {
   d.instruments = instruments;
   d.window = o.window ? static_cast<int>(*o.window) : 1;
   d.auto_select = o.auto_select;
-  if (o.search == "subsets") d.search = SearchMethod::Subsets;
-  else if (o.search == "forward") d.search = SearchMethod::Forward;
+  const std::string search = o.search.value_or("subsets");
+  if (search == "subsets") d.search = SearchMethod::Subsets;
+  else if (search == "forward") d.search = SearchMethod::Forward;
   else throw InputError(fmt::format("--search '{}': expected 'subsets' (every set of up to {} effects) or 'forward'",
-                                    o.search, d.max_subset));
+                                    search, d.max_subset));
+  if (o.search && !o.auto_select)
+    throw InputError(fmt::format("--search {}: chooses how --auto searches for a set of effects; expected --auto with "
+                                 "it (without --auto each effect is ranked alone)",
+                                 search));
   d.heldout_fraction = o.heldout;
   d.horizons = o.horizons;
   d.gp.points = o.gp_points;

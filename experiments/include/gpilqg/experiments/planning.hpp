@@ -40,11 +40,15 @@ struct PlannedPolicy {
   double fit_seconds = 0.0;
   bool warm_started_gp = false;                      ///< the previous file's GP was the fit's start
   std::optional<LoopDiagnosis> diagnosis;            ///< with request.diagnose and data
+  /// The model the round planned on (the GP's mean): the diagnosed model when the diagnosis adopted
+  /// it, else the config's simulator. What `plan --write-model` writes for the next round.
+  ModelSpec planned_on;
 };
 
 /// The round. Throws DataError or InputError naming the file and the line, dataset or attribute for
 /// bad data files (another system, a dt other than the config's) and for a previous policy of
-/// another system, dt or horizon, or whose GP backend differs from [gp] backend.
+/// another system, dt or horizon, or whose GP backend differs from [gp] backend; and InputError for
+/// request.diagnose without data files (nothing to diagnose).
 PlannedPolicy plan_policy(const PlanRequest& request);
 
 }  // namespace gpilqg

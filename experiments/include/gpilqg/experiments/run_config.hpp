@@ -121,4 +121,10 @@ RunConfig load_run_config(const std::string& system, const std::optional<std::fi
 /// The same from TOML text (`source` names it in errors), for tests and the resume path.
 RunConfig parse_run_config(const std::string& system, const std::string& override_text, const std::string& source);
 
+/// `config` with loop.iterations = `iterations` (1 to kMaxLoopIterations), in its stored text too, so
+/// that the result keeps what ran: `run --iterations`, a sweep file's `iterations`, Python's
+/// run(iterations=). Throws InputError naming `option` when [diagnosis] after_round is then no round
+/// of the loop.
+RunConfig with_iterations(RunConfig config, int iterations, const std::string& option);
+
 }  // namespace gpilqg

@@ -18,7 +18,8 @@ struct DiagnoseRequest {
   std::string preset = "sim";
   std::vector<std::string> add;  ///< EFFECT or EFFECT=VALUE
   bool auto_select = false;      ///< --auto: several effects
-  std::string search = "subsets";  ///< --search: how --auto searches, "subsets" or "forward"
+  /// --search: how --auto searches, "subsets" (when not given) or "forward"; only with --auto.
+  std::optional<std::string> search;
   std::string integrator = "rk4";
   double heldout = 0.3;          ///< fraction of the episodes held out
   std::vector<int> horizons = {1, 10, 50};  ///< k of the k-step predictions (distinct, >= 1)
