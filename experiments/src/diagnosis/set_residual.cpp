@@ -32,8 +32,18 @@ Vector EffectSet::null_values(const ModelSpec& base) const {
 }
 
 ModelSpec EffectSet::model_at(const ModelSpec& base, const VectorCRef& theta) const {
+  // A value past its bound by a difference step's size (1e-4 of the value, added at the bound) is
+  // taken at the bound: the fit's own rounding, not a value for ModelSpec::with to refuse (which the
+  // command would report as bad data).
+  Vector at = theta;
+  for (Eigen::Index j = 0; j < at.size(); ++j) {
+    const EffectParameter& p = parameter(j);
+    const double slack = 1e-3 * std::max({std::abs(p.lower), std::abs(p.upper), p.scale});
+    if (at(j) > p.upper && at(j) <= p.upper + slack) at(j) = p.upper;
+    if (at(j) < p.lower && at(j) >= p.lower - slack) at(j) = p.lower;
+  }
   ModelSpec model = base;
-  for (std::size_t e = 0; e < effects.size(); ++e) model = model.with(*effects[e], theta.segment(offset[e], length(e)));
+  for (std::size_t e = 0; e < effects.size(); ++e) model = model.with(*effects[e], at.segment(offset[e], length(e)));
   return model;
 }
 

@@ -38,7 +38,9 @@ struct EffectSet {
   const EffectParameter& parameter(Eigen::Index j) const;
   /// Every effect's value in `base` (ModelSpec::current_values): the stacked values without the set.
   Vector null_values(const ModelSpec& base) const;
-  /// `base` with every effect of the set at its slice of theta (ModelSpec::with, which validates).
+  /// `base` with every effect of the set at its slice of theta (ModelSpec::with, which validates); a
+  /// value past its bound by at most 1e-3 of the parameter's bounds or scale (a difference step's
+  /// rounding at the bound) is taken at the bound.
   ModelSpec model_at(const ModelSpec& base, const VectorCRef& theta) const;
 
   /// The stacked parameters split by how their regressor columns are found: those of the forces

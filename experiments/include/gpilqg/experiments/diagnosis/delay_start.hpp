@@ -12,13 +12,16 @@
 ///
 /// summed over the training rows of each episode with t - l in the same episode, peaks at l = d. The
 /// start is argmax_{0 <= l <= max_lag} rho(l), a whole number of periods; the fit refines it to a
-/// fraction.
+/// fraction. The lags span the delay's whole range, 0 to kMaxInputDelay periods: a delay beyond the
+/// lags searched is not found from any start (a 45-period delay at 1 kHz came out as 4.5 from lags
+/// up to 20, and an actuator gain of 0.007 "explained" the data better).
 
+#include "gpilqg/core/input_delay.hpp"
 #include "gpilqg/experiments/diagnosis/effect_fit.hpp"
 
 namespace gpilqg::diagnosis {
 
 /// The lag in [0, max_lag] of the peak of rho (0 when no lag correlates positively).
-int input_delay_start(const FitContext& context, int max_lag = 20);
+int input_delay_start(const FitContext& context, int max_lag = static_cast<int>(kMaxInputDelay));
 
 }  // namespace gpilqg::diagnosis
