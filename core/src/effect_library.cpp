@@ -84,6 +84,14 @@ std::vector<LibraryEffect> candidate_effects(const ModelSpec& model) {
 
 std::string candidate_names(const ModelSpec& model) { return joined_names(candidate_effects(model)); }
 
+ModelSpec with_parameter(const ModelSpec& model, const std::string& name, double value) {
+  for (const LibraryEffect& e : effect_library(model.system))
+    if (e.kind == EffectKind::Recalibration && e.recalibrated == name) return model.with(e, Vector::Constant(1, value));
+  ModelSpec out = model;
+  out.parameters[name] = value;
+  return out;
+}
+
 LibraryEffect find_candidate(const ModelSpec& model, std::string_view name) {
   for (const LibraryEffect& e : effect_library(model.system))
     if (e.name == name) return as_in_model(e, model);
@@ -150,9 +158,9 @@ ModelSpec ModelSpec::with(const LibraryEffect& effect, const VectorCRef& values)
     throw std::invalid_argument(fmt::format("effect '{}' takes {} value(s); got {}", effect.name, expected, values.size()));
   for (Eigen::Index i = 0; i < values.size(); ++i) {
     const EffectParameter& p = effect.parameters[static_cast<std::size_t>(i)];
-    if (!std::isfinite(values(i)) || values(i) < p.lower || values(i) > p.upper)
-      throw std::invalid_argument(fmt::format("effect '{}': {} = {}; expected a finite value in [{}, {}] {}", effect.name,
-                                              p.name, values(i), p.lower, p.upper, p.unit));
+    if (!std::isfinite(values(i)) || values(i) < p.lowest() || values(i) > p.highest())
+      throw std::invalid_argument(fmt::format("effect '{}': {} = {}; expected a finite value in [{:.6g}, {:.6g}] {}",
+                                              effect.name, p.name, values(i), p.lowest(), p.highest(), p.unit));
   }
   ModelSpec out = *this;
   switch (effect.kind) {

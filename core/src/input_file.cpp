@@ -65,12 +65,13 @@ const char* file_kind(std::filesystem::file_type type) {
 }
 
 std::string InputFileIssue::message(const std::filesystem::path& file) const {
-  return file.string() + ": " + problem + "; expected " + expected;
+  return (file.empty() ? std::string("'' (an empty path)") : file.string()) + ": " + problem + "; expected " + expected;
 }
 
 std::optional<InputFileIssue> input_file_issue(const std::filesystem::path& file, std::uintmax_t max_bytes,
                                                std::string_view description, std::uintmax_t* bytes) {
   const std::string expected(description);
+  if (file.empty()) return InputFileIssue{"names no file", expected};
   struct stat status {};
   if (::stat(file.c_str(), &status) != 0) {
     const int error = errno;

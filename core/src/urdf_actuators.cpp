@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/limits.hpp"
+
 namespace gpilqg::urdf {
 namespace {
 
@@ -228,11 +230,11 @@ std::vector<Joint> read_joints(const std::string& text, const std::string& path)
       const auto effort = t.attributes.find("effort");
       if (effort != t.attributes.end()) {
         const std::optional<double> value = finite_number(effort->second);
-        if (!value || *value < 0.0)
+        if (!value || *value < 0.0 || *value > limits::kMaxControlBound)
           throw std::invalid_argument(fmt::format(
-              "{}: joint '{}': <limit effort=\"{}\">; expected a finite number >= 0 (the motor's bound, N m or N; "
-              "0 leaves the joint without a motor)",
-              path, out.back().name, effort->second));
+              "{}: joint '{}': <limit effort=\"{}\">; expected a finite number from 0 to {:g} (the motor's bound, N m or "
+              "N; 0 leaves the joint without a motor; no limit: leave effort out)",
+              path, out.back().name, effort->second, limits::kMaxControlBound));
         out.back().effort = *value;
       }
     } else if (level == 3 && in_joint && t.name == "mimic") {

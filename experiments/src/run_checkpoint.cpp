@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "algorithm_run_io.hpp"
+#include "checkpoint_lock.hpp"
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/core/hdf5_reader.hpp"
 #include "gpilqg/core/hdf5_writer.hpp"
@@ -42,26 +43,38 @@ std::filesystem::path RunCheckpoint::folder_for(const std::filesystem::path& res
 
 namespace {
 
-/// True when `folder` holds no finished file: nothing, or only temporaries of interrupted writes
-/// (a checkpoint whose manifest was never written, e.g. after a failed or killed start).
+/// True when `folder` holds no finished file: nothing, or only temporaries of interrupted writes and
+/// the lock file (a checkpoint whose manifest was never written, e.g. after a failed or killed start).
 bool holds_no_finished_file(const std::filesystem::path& folder) {
   std::error_code error;
   for (std::filesystem::directory_iterator it(folder, error), end; !error && it != end; it.increment(error))
-    if (!is_atomic_temporary(it->path())) return false;
+    if (!is_atomic_temporary(it->path()) && it->path().filename() != CheckpointLock::kFileName) return false;
   return !error;
+}
+
+/// Removes what a failed or killed start left in `folder` (holds_no_finished_file), not the lock file.
+void remove_unfinished_start(const std::filesystem::path& folder) {
+  std::error_code error;
+  for (std::filesystem::directory_iterator it(folder, error), end; !error && it != end; it.increment(error))
+    if (it->path().filename() != CheckpointLock::kFileName) std::filesystem::remove_all(it->path(), error);
 }
 
 }  // namespace
 
 RunCheckpoint RunCheckpoint::create(const std::filesystem::path& folder, const RunConfig& config, const RunOptions& options) {
+  const auto in_the_way = [&] {
+    return std::invalid_argument(fmt::format("{}: a checkpoint of an interrupted run is in the way; continue that run with "
+                                             "--resume, or delete the folder to start over",
+                                             folder.string()));
+  };
   std::error_code error;
-  if (std::filesystem::is_directory(folder, error) && holds_no_finished_file(folder)) std::filesystem::remove_all(folder, error);
-  if (std::filesystem::exists(folder))
-    throw std::invalid_argument(fmt::format("{}: a checkpoint of an interrupted run is in the way; continue that run with "
-                                         "--resume, or delete the folder to start over",
-                                         folder.string()));
+  if (std::filesystem::exists(folder, error) && !std::filesystem::is_directory(folder, error)) throw in_the_way();
   std::filesystem::create_directories(folder, error);
   if (error) throw std::runtime_error(fmt::format("{}: cannot create the checkpoint folder ({})", folder.string(), error.message()));
+  // The lock before anything is looked at: a second run started at the same instant is refused here.
+  std::shared_ptr<CheckpointLock> lock = CheckpointLock::take(folder);
+  if (!holds_no_finished_file(folder)) throw in_the_way();
+  remove_unfinished_start(folder);
   const Identity id = identity_of(config, options);
   // A checkpoint without its manifest could be neither resumed nor replaced: when the manifest
   // cannot be written, the folder goes too.
@@ -85,14 +98,16 @@ RunCheckpoint RunCheckpoint::create(const std::filesystem::path& folder, const R
     h5.close();
   });
   cleanup.keep = true;
-  return RunCheckpoint(folder);
+  return RunCheckpoint(folder, std::move(lock));
 }
 
-RunCheckpoint RunCheckpoint::resume(const std::filesystem::path& folder, const RunConfig& config, const RunOptions& options) {
+RunCheckpoint RunCheckpoint::resume(const std::filesystem::path& folder, const RunConfig& config, const RunOptions& options,
+                                    bool take_lock) {
   const std::filesystem::path manifest = folder / kManifest;
   if (!std::filesystem::exists(manifest))
     throw std::invalid_argument(fmt::format("{}: no checkpoint to resume from (expected {}); run without --resume to start",
                                          folder.string(), manifest.string()));
+  std::shared_ptr<CheckpointLock> lock = take_lock ? CheckpointLock::take(folder) : nullptr;
   // What the manifest holds; a manifest that cannot be read (truncated, not HDF5, an attribute
   // missing or of another type) is a damaged checkpoint, reported as bad input with the way out.
   struct Stored {
@@ -135,7 +150,7 @@ RunCheckpoint RunCheckpoint::resume(const std::filesystem::path& folder, const R
     throw mismatch("iterations", std::to_string(stored.iterations), std::to_string(want.iterations));
   if (stored.seeds != want.seeds) throw mismatch("seeds", list_text(stored.seeds), list_text(want.seeds));
   if (stored.backends != want.backends) throw mismatch("backends", list_text(stored.backends), list_text(want.backends));
-  return RunCheckpoint(folder);
+  return RunCheckpoint(folder, std::move(lock));
 }
 
 std::filesystem::path RunCheckpoint::unit_file(const TaskContext& context, std::uint64_t seed, const std::string& name) const {
@@ -172,6 +187,7 @@ void RunCheckpoint::save(const TaskContext& context, std::uint64_t seed, const A
 void RunCheckpoint::remove() {
   std::error_code error;
   std::filesystem::remove_all(folder_, error);
+  lock_.reset();
   if (error) throw std::runtime_error(fmt::format("{}: cannot delete the checkpoint folder ({})", folder_.string(), error.message()));
 }
 

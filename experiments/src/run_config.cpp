@@ -113,8 +113,14 @@ void read_world(const TomlFields& f, const toml::table& root, RunConfig& c, cons
   if (const toml::node* node = root.at_path("world.parameters").node()) {
     const toml::table* table = node->as_table();
     if (table == nullptr) f.fail("world.parameters", "is not a table; expected name = value entries");
-    for (const auto& [key, value] : *table)
-      c.world.parameters[std::string(key.str())] = f.number("world.parameters." + toml_key(std::string(key.str())));
+    for (const auto& [key, value] : *table) {
+      const std::string field = "world.parameters." + toml_key(std::string(key.str()));
+      try {
+        c.world = with_parameter(c.world, std::string(key.str()), f.number(field));
+      } catch (const std::invalid_argument& e) {
+        f.fail(field, e.what());
+      }
+    }
   }
   try {
     (void)c.world.build(ActuatorNoise{});

@@ -257,9 +257,12 @@ and gpilqg.register_system(...) to use it by name in configs, solve, diagnose an
             raise_input_error("system: preset and model are both given; the model file names its own preset");
           try {
             const ActuatorNoise noise_model = noise_of(name, noise);
-            if (!model) return std::const_pointer_cast<Dynamics>(make_system(name, preset_of(preset), parameters, noise_model));
-            ModelSpec spec = diagnosis::read_model_file(*model, name, "system's name");
-            for (const auto& [parameter, value] : parameters) spec.parameters[parameter] = value;
+            ModelSpec spec;
+            spec.system = name;
+            spec.preset = preset_of(preset);
+            if (model) spec = diagnosis::read_model_file(*model, name, "system's name");
+            // Each override within its parameter's range, as a model file's or a --param.
+            for (const auto& [parameter, value] : parameters) spec = with_parameter(spec, parameter, value);
             if (spec.input_delay != 0.0)
               throw InputError(fmt::format("system: {} has an input delay of {} control periods; a Dynamics maps the "
                                            "applied input to xdot and cannot hold it (gpilqg.simulate applies delays)",

@@ -61,6 +61,14 @@ def test_python_dynamics_analytic_jacobians_are_used_when_defined():
     np.testing.assert_array_equal(fu, [[0.0], [1.0]])
 
 
+def test_system_parameters_and_model_files_are_checked_where_read():
+    # Each parameter within a million times its model's own value; an empty model path names no file.
+    with pytest.raises(gpilqg.InputError, match=r"pole_length = 1e\+300; expected a finite value in \[1e-06, 1e\+06\] m"):
+        gpilqg.system("cartpole", parameters={"pole_length": 1e300})
+    with pytest.raises(gpilqg.InputError, match=r"'' \(an empty path\): names no file"):
+        gpilqg.system("cartpole", model="")
+
+
 def test_python_dynamics_errors_are_python_exceptions():
     class WrongShape(gpilqg.Dynamics):
         def __init__(self):

@@ -127,7 +127,7 @@ TEST(UrdfRobot, EffortZeroLeavesAJointPassiveAndNoEffortLeavesTheMotorUnbounded)
 
 TEST(UrdfRobot, ABadEffortNamesTheFileAndTheJoint) {
   const fs::path dir = test::temporary_dir("urdf_bad_effort");
-  for (const std::string effort : {"-2", "abc", "nan", ""}) {
+  for (const std::string effort : {"-2", "abc", "nan", "", "1e308"}) {
     const fs::path file =
         write_urdf(dir, R"(<limit lower="-1" upper="1" effort=")" + effort + R"(" velocity="1"/>)", "");
     try {

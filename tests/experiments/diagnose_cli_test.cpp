@@ -120,6 +120,19 @@ TEST(DiagnoseCli, BadInputIsExitTwoNamingWhatIsWrong) {
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.err.find("none.csv"), std::string::npos) << missing.err;
 
+  // A window longer than the episodes allow, and an empty one (was read as --window 0).
+  auto long_window = test::run_cli(base + " --criterion simulation --window 500 --horizons 1,5");
+  EXPECT_EQ(long_window.status, 2);
+  EXPECT_NE(long_window.err.find("--window 500: longer than the data allow, at most"), std::string::npos) << long_window.err;
+  auto empty_window = test::run_cli(base + " --criterion simulation --window ''");
+  EXPECT_EQ(empty_window.status, 2);
+  EXPECT_NE(empty_window.err.find("--window: '' is not a whole number"), std::string::npos) << empty_window.err;
+  // --param beyond its range, named with the option.
+  auto param = test::run_cli("simulate --system cartpole --param pole_length=1e300 --episodes 1 --steps 5 --out " +
+                             quote(dir / "p.csv"));
+  EXPECT_EQ(param.status, 2);
+  EXPECT_NE(param.err.find("--param pole_length=1e+300: effect 'param:pole_length'"), std::string::npos) << param.err;
+
   // --search chooses how --auto searches; without --auto it would be ignored.
   auto search = test::run_cli(base + " --search forward");
   EXPECT_EQ(search.status, 2);

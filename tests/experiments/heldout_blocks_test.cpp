@@ -103,7 +103,7 @@ TEST(HeldoutBlocks, GapIsTheLongestWindowAndTheRecordMustHoldTheBlocks) {
   } catch (const std::invalid_argument& e) {
     const std::string message = e.what();
     for (const char* part : {"1 episode of 1019 samples", "expected at least 1020 samples", "10 blocks", "102 samples",
-                             "gap of 50 samples", "--horizons"})
+                             "gap of 50 samples (the longest k-step horizon)", "shorten the longest k-step horizon"})
       EXPECT_NE(message.find(part), std::string::npos) << part << " in: " << message;
   }
 }

@@ -231,6 +231,9 @@ TEST(ConfigModelCli, AConfigNamesItsSimulatorAndWorldByModelFilesAndBadOnesAreRe
   write_world(folder);
   test::write_text(folder / "quadrotor.toml", "[model]\nsystem = \"quadrotor\"\n");
   test::write_text(folder / "delayed.toml", "[model]\nsystem = \"cartpole\"\n[effects]\ninput_delay = 1.0\n");
+  // Values a million times the model's own scale: no physical model (a pole of 1e300 m, a gain of 1e308).
+  test::write_text(folder / "long.toml", "[model]\nsystem = \"cartpole\"\n[parameters]\npole_length = 1e300\n");
+  test::write_text(folder / "gain.toml", "[model]\nsystem = \"cartpole\"\n[effects]\nactuator_gain = 1e308\n");
   const std::string source = (folder / "c.toml").string();
   // The simulator of `run`, by a path relative to the config; the stored text names it absolutely.
   const RunConfig run = parse_run_config("cartpole", "[system]\nmodel = \"world.toml\"\n", source);
@@ -250,6 +253,13 @@ TEST(ConfigModelCli, AConfigNamesItsSimulatorAndWorldByModelFilesAndBadOnesAreRe
   expect_holds(error_of("[system]\nmodel = \"delayed.toml\"\n"), {"field 'system.model'", "input delay of 1"});
   expect_holds(error_of("[system]\nmodel = \"none.toml\"\n"), {"field 'system.model'", "none.toml"});
   expect_holds(error_of("[diagnosis]\nafter_round = 4\n"), {"field 'diagnosis.after_round'", "from 0 to 3"});
+  expect_holds(error_of("[system]\nmodel = \"long.toml\"\n"),
+               {"field 'system.model'", "long.toml:line 4: field 'parameters.pole_length'",
+                "pole_length = 1e+300; expected a finite value in [1e-06, 1e+06] m"});
+  expect_holds(error_of("[world]\nmodel = \"gain.toml\"\n"),
+               {"field 'world.model'", "gain.toml:line 4: field 'effects.actuator_gain'", "[0, 1e+06]"});
+  expect_holds(error_of("[world]\nparameters = { pole_length = 1e300 }\n"),
+               {"field 'world.parameters.pole_length'", "expected a finite value in [1e-06, 1e+06] m"});
   expect_holds(error_of("[diagnosis]\nafter_round = 0\nevery = 1\n"), {"diagnosis.every"});
   // --iterations (and a sweep's `iterations`, Python's run(iterations=)) fewer than after_round needs:
   // refused, where the loop would never diagnose; more are kept in the stored config, which says what ran.

@@ -331,6 +331,10 @@ TEST(PlanCli, BadInputIsExit2NamingTheFileAndTheField) {
   expect_bad_input(test::run_cli(rollout + " --system cartpole --observation-noise 0.1,0.1,0.1"),
                    {"--observation-noise", "3 values"});
   expect_bad_input(test::run_cli(rollout + " --system cartpole --exploration -1"), {"--exploration"});
+  // A delay in a world model file is named by its file, not by --effect.
+  const fs::path delayed = test::write_text(dir / "delayed.toml", "[model]\nsystem = \"cartpole\"\n[effects]\ninput_delay = 1.0\n");
+  expect_bad_input(test::run_cli(rollout + " --system cartpole --world-model " + quote(delayed)),
+                   {"--world-model", "delayed.toml: an input delay of 1 control periods"});
   expect_bad_input(test::run_cli(rollout + " --system cartpole --param pole_lenght=1"), {"pole_lenght"});
   expect_bad_input(test::run_cli(rollout + " --system " + quote(test::arm_model())), {"--policy", "p0.h5", "shoulder"});
 }

@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "gpilqg/core/atomic_file.hpp"
@@ -113,6 +114,24 @@ TEST(RunResume, ACheckpointServesOnlyTheRunItWasMadeFor) {
   EXPECT_NE(message_of(more_iterations, two_seeds()).find("iterations 2, this run asks for 5"), std::string::npos);
   const RunConfig other_config = parse_run_config("cartpole", std::string(test::kTinyRun) + "[control]\nu_max = [9.0]\n", "t.toml");
   EXPECT_NE(message_of(other_config, two_seeds()).find("a different config"), std::string::npos);
+
+  // While a checkpoint is open (its lock held, in this process too), neither a second start nor a
+  // resume may work in it; when it is removed, or its holder goes, the folder is free again.
+  {
+    const RunCheckpoint working = RunCheckpoint::resume(folder, config, two_seeds());
+    const std::string in_use = fmt::format("in use by pid {}", ::getpid());
+    EXPECT_NE(message_of(config, two_seeds()).find(in_use), std::string::npos) << message_of(config, two_seeds());
+    try {
+      RunCheckpoint::create(folder, config, two_seeds());
+      ADD_FAILURE() << "a second start in a checkpoint in use";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(in_use), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(RunCheckpoint::resume(folder, config, two_seeds()));
+  RunCheckpoint::resume(folder, config, two_seeds()).remove();
+  EXPECT_FALSE(std::filesystem::exists(folder));
+  EXPECT_NO_THROW(RunCheckpoint::create(folder, config, two_seeds()));
   std::filesystem::remove_all(dir);
 }
 
@@ -192,13 +211,14 @@ pid_t start_run(const std::filesystem::path& config, const std::filesystem::path
   return pid;
 }
 
-/// Waits until the checkpoint folder holds `files` entries (the manifest and the first saves).
+/// Waits until the checkpoint folder holds `files` entries (the manifest and the first saves; not the
+/// lock file).
 bool wait_for_checkpoint_files(const std::filesystem::path& folder, int files, pid_t child) {
   for (int i = 0; i < 120000; ++i) {
     int count = 0;
     std::error_code error;
     for (auto it = std::filesystem::directory_iterator(folder, error); !error && it != std::filesystem::directory_iterator(); ++it)
-      count += is_atomic_temporary(it->path()) ? 0 : 1;
+      count += is_atomic_temporary(it->path()) || it->path().filename() == "lock" ? 0 : 1;
     if (count >= files) return true;
     if (waitpid(child, nullptr, WNOHANG) == child) return false;
     std::this_thread::sleep_for(std::chrono::microseconds(500));
@@ -254,6 +274,28 @@ TEST_F(RunSignalsCli, SigintStopsAtAnIterationLeavesThePreviousResultAndResumesT
   for (const auto& entry : std::filesystem::directory_iterator(dir_))
     EXPECT_FALSE(is_atomic_temporary(entry.path())) << "left behind: " << entry.path();
   resume_and_compare(out);
+}
+
+// One run at a time on a result file: while a run works, a second run on the same --out and a --resume
+// of it are refused at once, naming the run's pid, and the run finishes with the uninterrupted result.
+TEST_F(RunSignalsCli, ASecondRunOrAResumeWhileARunWorksIsRefusedAndTheRunFinishes) {
+  const auto out = dir_ / "busy.h5";
+  const pid_t child = start_run(config_, out, dir_ / "busy.log");
+  ASSERT_TRUE(wait_for_checkpoint_files(RunCheckpoint::folder_for(out), 2, child)) << "the run ended before its first save";
+  const std::string run = "run cartpole --config '" + config_.string() + "' --out '" + out.string() + "' --no-plots";
+  const std::string in_use = fmt::format("in use by pid {}", child);
+  for (const std::string& second : {run, run + " --resume"}) {
+    const auto refused = test::run_cli(second);
+    EXPECT_EQ(refused.status, 2) << second << "\n" << refused.err;
+    EXPECT_NE(refused.err.find(in_use), std::string::npos) << second << "\n" << refused.err;
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  const std::string log = read_bytes(dir_ / "busy.log");
+  ASSERT_TRUE(WIFEXITED(status)) << log;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << log;
+  EXPECT_FALSE(std::filesystem::exists(RunCheckpoint::folder_for(out)));
+  test::expect_same_result_files(out, reference_);
 }
 
 TEST_F(RunSignalsCli, SigkillAtAnyMomentLeavesACheckpointThatResumesToTheSameResult) {

@@ -196,7 +196,8 @@ void add_diagnose_command(CLI::App& app, CommandAction& action) {
       ->capture_default_str();
   auto* window = cmd->add_option("--window", o->window,
                                  "Samples per simulation window, with --criterion simulation (e.g. a few periods of the "
-                                 "slowest motion)");
+                                 "slowest motion)")
+                         ->check(integer_in(1, limits::kMaxHorizon));
   cmd->callback([&action, o, window] {
     if (window->count() > 0) o->request.window = o->window;
     action = [o] { return run_diagnose(*o); };

@@ -34,16 +34,22 @@ struct PlanOptions {
 };
 
 int run_plan(const PlanOptions& o) {
-  PlanRequest request;
-  request.config = read_plan_config(o.config);
   std::vector<CommandInput> inputs = {{"CONFIG", o.config}, {"--previous", o.previous}};
   for (const auto& file : o.data) inputs.push_back({"--data", file});
+  // The outputs against the files named on the command line, then, once the config is read, against
+  // the files it names.
+  const auto check_outputs = [&] {
+    check_output_file_option("--out", o.out, {"plan writes an HDF5 policy file", kHdf5Extensions}, inputs);
+    if (!o.write_model.empty())
+      check_output_file_option("--write-model", o.write_model, {"plan writes a TOML model file", kTomlExtensions}, inputs);
+  };
+  check_outputs();
+  if (!o.write_model.empty() && same_file(o.write_model, o.out))
+    throw InputError("--write-model and --out name the same file; expected two files");
+  PlanRequest request;
+  request.config = read_plan_config(o.config);
   inputs.insert(inputs.end(), request.config.problem.files.begin(), request.config.problem.files.end());
-  check_output_file_option("--out", o.out, {"plan writes an HDF5 policy file", kHdf5Extensions}, inputs);
-  if (!o.write_model.empty()) {
-    check_output_file_option("--write-model", o.write_model, {"plan writes a TOML model file", kTomlExtensions}, inputs);
-    if (same_file(o.write_model, o.out)) throw InputError("--write-model and --out name the same file; expected two files");
-  }
+  check_outputs();
   for (const auto& file : o.data) request.data_files.emplace_back(file);
   if (!o.previous.empty()) request.previous = o.previous;
   request.seed = o.seed;

@@ -93,16 +93,27 @@ DynamicsPtr build_world(const WorldOptions& o, double* input_delay, const std::s
   }
   world.preset = *preset;
   if (!o.world_model.empty()) world = diagnosis::read_model_file(o.world_model, o.system);
-  for (const auto& [name, value] : parse_assignments(o.parameters, "--param")) world.parameters[name] = value;
+  for (const auto& [name, value] : parse_assignments(o.parameters, "--param")) {
+    try {
+      world = with_parameter(world, name, value);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("--param {}={}: {}", name, value, e.what()));
+    }
+  }
   for (const std::string& text : o.effects) {
     const diagnosis::EffectRequest request = diagnosis::parse_add_option(text, world, "--effect");
     if (!request.values) throw InputError("--effect '" + text + "': expected EFFECT=VALUE, e.g. cart_coulomb_friction=1");
     world = world.with(find_candidate(world, request.effect), *request.values);
   }
   if (input_delay != nullptr) *input_delay = world.input_delay;
-  else if (world.input_delay != 0.0)
-    throw InputError(fmt::format("--effect input_delay: `gpilqg {}` does not simulate an input delay in closed loop; "
-                                 "`gpilqg simulate` does", command));
+  else if (world.input_delay != 0.0) {
+    bool by_effect = false;
+    for (const std::string& text : o.effects) by_effect = by_effect || text.rfind("input_delay", 0) == 0;
+    throw InputError(fmt::format("{}: an input delay of {} control periods; `gpilqg {}` does not simulate an input delay "
+                                 "in closed loop (`gpilqg simulate` does): expected a world without one",
+                                 by_effect ? std::string("--effect input_delay") : "--world-model " + o.world_model,
+                                 world.input_delay, command));
+  }
   return world.build(noise);
 }
 

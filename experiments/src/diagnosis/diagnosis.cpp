@@ -224,7 +224,9 @@ Matrix residual_of_model(const ModelSpec& model, const FitContext& settings) {
 const MeasurementSet& episodes_of(const MeasurementSet& input, const DiagnosisOptions& o,
                                   MeasurementSet& blocks_as_episodes, DiagnosisReport& R) {
   if (input.episodes.size() == 1) {
-    R.blocks = split_heldout_blocks(input.episodes.front(), o.heldout_fraction, heldout_block_gap(o.horizons, o.window));
+    const int gap = heldout_block_gap(o.horizons, o.window);
+    R.blocks = split_heldout_blocks(input.episodes.front(), o.heldout_fraction, gap, kHeldoutBlockCount,
+                                    gap == o.window && o.window > 1 ? "the simulation window" : "the longest k-step horizon");
     blocks_as_episodes = block_episodes(input, *R.blocks);
   }
   const MeasurementSet& set = R.blocks ? blocks_as_episodes : input;
@@ -603,6 +605,14 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& op
       criterion_reason = std::string("one-step: the data are too short to choose by the rule (") + e.what() + ")";
     }
   }
+  // A window the user gave that the episodes cannot hold would leave nothing to score.
+  if (o.criterion == FitCriterion::Simulation && criterion_reason.empty() && o.window > simulation_window_cap(input))
+    throw std::invalid_argument(fmt::format(
+        "--window {}: longer than the data allow, at most {} samples ({}); expected a shorter window", o.window,
+        simulation_window_cap(input),
+        input.episodes.size() == 1 ? fmt::format("a quarter of each of the {} blocks of the record, less 2",
+                                                 kHeldoutBlockCount)
+                                   : "half the shortest episode"));
   DiagnosisReport R;
   R.system = o.model.system;
   R.criterion_reason = criterion_reason;

@@ -209,8 +209,8 @@ std::pair<Vector, Vector> confidence_interval(const SetResidual& residual, const
 DifferenceStep difference_step(const EffectParameter& spec, const Vector& theta, Eigen::Index j) {
   const double h = 1e-4 * std::max(std::abs(theta(j)), spec.scale);
   DifferenceStep d{theta, theta, 0.0};
-  d.plus(j) = std::min(theta(j) + h, std::max(spec.upper, theta(j)));
-  d.minus(j) = std::max(theta(j) - h, std::min(spec.lower, theta(j)));
+  d.plus(j) = std::min(theta(j) + h, std::max(spec.highest(), theta(j)));
+  d.minus(j) = std::max(theta(j) - h, std::min(spec.lowest(), theta(j)));
   d.width = d.plus(j) - d.minus(j);
   return d;
 }
@@ -423,8 +423,8 @@ EffectFit fit_set(const EffectSet& set, const Vector& initial, const FitContext&
   const std::vector<int> training = c.data->rows(false);
   Vector lower(p), upper(p);
   for (Eigen::Index j = 0; j < p; ++j) {
-    lower(j) = set.parameter(j).lower;
-    upper(j) = set.parameter(j).upper;
+    lower(j) = set.parameter(j).lowest();
+    upper(j) = set.parameter(j).highest();
   }
   Vector theta_ls = initial, theta_hat = initial, ci_low = initial, ci_high = initial;
   EffectFit fit;

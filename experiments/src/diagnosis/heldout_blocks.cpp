@@ -34,7 +34,7 @@ int heldout_block_gap(const std::vector<int>& horizons, int window) {
   return gap;
 }
 
-HeldoutBlocks split_heldout_blocks(const Episode& record, double fraction, int gap, int count) {
+HeldoutBlocks split_heldout_blocks(const Episode& record, double fraction, int gap, int count, const std::string& gap_is) {
   if (count < 2) throw std::invalid_argument(fmt::format("{} held-out block(s); expected at least 2", count));
   if (gap < 1) throw std::invalid_argument(fmt::format("held-out block gap {}; expected at least 1 sample", gap));
   const int T = record.length();
@@ -42,10 +42,9 @@ HeldoutBlocks split_heldout_blocks(const Episode& record, double fraction, int g
   if (T < needed)
     throw std::invalid_argument(fmt::format(
         "the data has 1 episode of {} samples; expected at least {} samples, since a single record is cut into {} "
-        "blocks for held-out scoring, each of at least 2 x gap + 2 = {} samples with a gap of {} samples (the longest "
-        "k-step horizon) dropped on either side of every held-out block; record longer, lower --horizons, or give "
-        "several episodes",
-        T, needed, count, 2 * gap + 2, gap));
+        "blocks for held-out scoring, each of at least 2 x gap + 2 = {} samples with a gap of {} samples ({}) dropped "
+        "on either side of every held-out block; record longer, shorten {}, or give several episodes",
+        T, needed, count, 2 * gap + 2, gap, gap_is, gap_is));
   HeldoutBlocks out;
   out.episode_id = record.id;
   out.samples = T;

@@ -38,9 +38,9 @@ ModelSpec EffectSet::model_at(const ModelSpec& base, const VectorCRef& theta) co
   Vector at = theta;
   for (Eigen::Index j = 0; j < at.size(); ++j) {
     const EffectParameter& p = parameter(j);
-    const double slack = 1e-3 * std::max({std::abs(p.lower), std::abs(p.upper), p.scale});
-    if (at(j) > p.upper && at(j) <= p.upper + slack) at(j) = p.upper;
-    if (at(j) < p.lower && at(j) >= p.lower - slack) at(j) = p.lower;
+    const double lo = p.lowest(), hi = p.highest();
+    if (at(j) > hi && std::isfinite(hi) && at(j) <= hi + 1e-3 * std::max(std::abs(hi), p.scale)) at(j) = hi;
+    if (at(j) < lo && std::isfinite(lo) && at(j) >= lo - 1e-3 * std::max(std::abs(lo), p.scale)) at(j) = lo;
   }
   ModelSpec model = base;
   for (std::size_t e = 0; e < effects.size(); ++e) model = model.with(*effects[e], at.segment(offset[e], length(e)));

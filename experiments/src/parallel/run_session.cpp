@@ -23,12 +23,13 @@ void remove_checkpoints(std::vector<RunCheckpoint>& checkpoints) {
 
 /// Creates (or opens) every checkpoint; when creating one fails, the ones created before it go too,
 /// so a failed start leaves nothing that a later start would take for an interrupted run.
-std::vector<RunCheckpoint> open_all(const std::vector<CheckpointRequest>& requests, bool create) {
+/// `take_lock` false on the ranks that join the checkpoints rank 0 opened (and locked for the run).
+std::vector<RunCheckpoint> open_all(const std::vector<CheckpointRequest>& requests, bool create, bool take_lock = true) {
   std::vector<RunCheckpoint> out;
   try {
     for (const auto& r : requests) {
       out.push_back(create ? RunCheckpoint::create(r.folder, *r.config, *r.options)
-                           : RunCheckpoint::resume(r.folder, *r.config, *r.options));
+                           : RunCheckpoint::resume(r.folder, *r.config, *r.options, take_lock));
       remove_stale_temporaries_in(r.folder);  // of writes that a kill interrupted
     }
   } catch (...) {
@@ -87,7 +88,7 @@ std::vector<RunCheckpoint> open_checkpoints(const MpiSession& mpi, const std::ve
   std::string error;
   if (!mpi.is_root()) {
     try {
-      checkpoints = open_all(requests, false);
+      checkpoints = open_all(requests, false, false);
     } catch (const std::exception& e) {
       error = fmt::format("rank {} on {} cannot open the checkpoint rank 0 prepared ({}); the result's folder must be on a "
                           "file system that every rank sees",

@@ -153,6 +153,13 @@ std::vector<LibraryEffect> candidate_effects(const ModelSpec& model);
 /// std::invalid_argument naming `name` and the system and listing every candidate's name.
 LibraryEffect find_candidate(const ModelSpec& model, std::string_view name);
 
+/// `model` with its physical parameter `name` set to `value` (a `--param`, a config's [world]
+/// parameters): through the parameter's recalibration effect ("param:<name>") when the system's
+/// library has one, which checks the value against its range (EffectParameter::lowest/highest); else
+/// as given (the system checks the name when it is built). Throws std::invalid_argument for a value
+/// outside the range.
+ModelSpec with_parameter(const ModelSpec& model, const std::string& name, double value);
+
 /// The names of candidate_effects(model), comma-separated, for error messages.
 std::string candidate_names(const ModelSpec& model);
 

@@ -20,6 +20,8 @@
 /// Parameter recalibrations ("param:<name>") are not forces: they rebuild the base system with another
 /// parameter value (effect_library.hpp, ModelSpec).
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -43,6 +45,16 @@ struct EffectParameter {
   /// A quantity that cannot be zero (a mass, a length; `lower` is then above 0): its own value is the
   /// yardstick of what the data can weigh (effect_test.hpp, test 1).
   bool strictly_positive = false;
+
+  /// How far a value may lie from the typical magnitude, as a ratio: a model with a pole a million
+  /// times its own length, or a gain of 1e308, is no physical model, and its failure would surface
+  /// far from its cause (a solver's bound, an overflow, a "converged" solve on a 1e300 kg forearm).
+  static constexpr double kMaxScaleRatio = 1e6;
+  /// The values the parameter may take: [lower, upper] within kMaxScaleRatio * scale of 0 either way
+  /// (for a recalibration, scale is the model's own value). Every model file, option and fit checks
+  /// against these (ModelSpec::with), and a fit's steps stay inside them.
+  double lowest() const { return scale > 0.0 && std::isfinite(scale) ? std::max(lower, -kMaxScaleRatio * scale) : lower; }
+  double highest() const { return scale > 0.0 && std::isfinite(scale) ? std::min(upper, kMaxScaleRatio * scale) : upper; }
 };
 
 /// A generalised force Q(x, u; theta) with k_Q entries, in the components of the system's

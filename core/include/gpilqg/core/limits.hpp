@@ -55,6 +55,10 @@ inline constexpr long kMaxThreads = 1'024;
 /// while n * T * dt < 1e133, a margin no dimension or step of a real problem approaches. A weight of
 /// 1e308 instead makes a state of 1e1 overflow to inf, which the solver would see as divergence.
 inline constexpr double kMaxCostWeight = 1e150;
+/// The largest control bound a model may give (a URDF joint's effort limit): beyond the divergence
+/// bound of controls (|u| <= 1e12, kDivergedStateMagnitude) a bound bounds nothing, and twice it
+/// overflows the excitation of `simulate` (1e308).
+inline constexpr double kMaxControlBound = 1e12;
 /// Memory a command may plan to use for the arrays whose size the user controls (horizons x state
 /// dimensions, GP matrices); `profile --memory-budget-gb` sets its own.
 inline constexpr double kMemoryBudgetBytes = 8.0 * (1ull << 30);

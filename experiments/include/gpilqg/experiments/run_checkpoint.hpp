@@ -4,7 +4,10 @@
 /// "<result>.checkpoint/" beside the result file holds
 ///
 ///   manifest.h5                          what the run is: attrs format_version, system, config (the full
-///                                        TOML), iterations, seeds, backends
+///                                        TOML), model_files (the texts of the files it names),
+///                                        iterations, seeds, backends
+///   lock                                 the pid of the run working in the folder, locked while it
+///                                        works (checkpoint_lock.hpp): a second run on it is refused
 ///   seed-<s>_task-<t>_<algorithm>.h5     one algorithm on one task and seed after its last completed
 ///                                        iteration: every IterationRecord (policy, prediction, evaluation,
 ///                                        timings, GP hyperparameters), the collected data, converged_at,
@@ -25,6 +28,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -32,6 +36,8 @@
 #include "gpilqg/experiments/run_experiment.hpp"
 
 namespace gpilqg {
+
+class CheckpointLock;
 
 /// Thrown by RunCheckpoint::save when a stop was requested; what() says what was saved.
 class RunInterrupted : public std::runtime_error {
@@ -44,14 +50,18 @@ class RunCheckpoint final : public RunJournal {
   /// "<result>.checkpoint" beside the result file.
   static std::filesystem::path folder_for(const std::filesystem::path& result_file);
 
-  /// Starts an empty checkpoint in `folder` for this run. Throws std::invalid_argument when `folder`
-  /// already exists (it holds an interrupted run: resume it or delete it), std::runtime_error when it
-  /// cannot be created.
+  /// Starts an empty checkpoint in `folder` for this run and takes its lock (checkpoint_lock.hpp),
+  /// held by this object and its copies until remove() or the last of them goes. Throws
+  /// std::invalid_argument when `folder` holds an interrupted run (resume it or delete it) or another
+  /// run holds the lock ("in use by pid N"), std::runtime_error when it cannot be created.
   static RunCheckpoint create(const std::filesystem::path& folder, const RunConfig& config, const RunOptions& options);
-  /// Opens the checkpoint of an interrupted run. Throws std::invalid_argument when there is none, or
-  /// when it was made for a different run (naming the field that differs: system, config, iterations,
-  /// seeds or backends); std::runtime_error when the manifest cannot be read.
-  static RunCheckpoint resume(const std::filesystem::path& folder, const RunConfig& config, const RunOptions& options);
+  /// Opens the checkpoint of an interrupted run and takes its lock; `take_lock` false for the ranks of
+  /// an MPI run that join the checkpoint rank 0 opened (rank 0 holds the lock for the run). Throws
+  /// std::invalid_argument when there is none, when another run holds the lock, or when it was made
+  /// for a different run (naming the field that differs: system, config, the files it names,
+  /// iterations, seeds or backends); std::runtime_error when the manifest cannot be read.
+  static RunCheckpoint resume(const std::filesystem::path& folder, const RunConfig& config, const RunOptions& options,
+                              bool take_lock = true);
 
   const std::filesystem::path& folder() const { return folder_; }
   /// Asked after every save; true makes save throw RunInterrupted.
@@ -66,10 +76,12 @@ class RunCheckpoint final : public RunJournal {
   void remove();
 
  private:
-  explicit RunCheckpoint(std::filesystem::path folder) : folder_(std::move(folder)) {}
+  RunCheckpoint(std::filesystem::path folder, std::shared_ptr<CheckpointLock> lock)
+      : folder_(std::move(folder)), lock_(std::move(lock)) {}
   std::filesystem::path unit_file(const TaskContext& context, std::uint64_t seed, const std::string& name) const;
 
   std::filesystem::path folder_;
+  std::shared_ptr<CheckpointLock> lock_;  ///< null for an MPI rank that joined rank 0's checkpoint
   std::function<bool()> stop_requested_;
   mutable int restored_ = 0;
 };

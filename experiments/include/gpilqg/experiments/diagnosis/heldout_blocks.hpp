@@ -26,6 +26,7 @@
 /// delete-one-episode jackknife (batches and replicates never cross a block), the whiteness test
 /// (pairs within a block), the free run of every held-out block and --auto's forward selection.
 
+#include <string>
 #include <vector>
 
 #include "gpilqg/core/measurements.hpp"
@@ -73,8 +74,9 @@ int heldout_block_gap(const std::vector<int>& horizons, int window = 0);
 /// by `gap` (the rule above). Throws std::invalid_argument when the record has fewer than
 /// count (2 gap + 2) samples (naming its length, the blocks, the gap and the need), count < 2, gap < 1
 /// or fraction is outside (0, 1).
-HeldoutBlocks split_heldout_blocks(const Episode& record, double fraction, int gap,
-                                   int count = kHeldoutBlockCount);
+/// `gap_is` says what sets the gap in that message (the diagnosis's longest horizon or its window).
+HeldoutBlocks split_heldout_blocks(const Episode& record, double fraction, int gap, int count = kHeldoutBlockCount,
+                                   const std::string& gap_is = "the longest k-step horizon");
 
 /// The blocks as episodes: episode b holds the kept samples [used_first, used_end) of block b, id b;
 /// `set` must hold the one episode `blocks` was cut from. The system is `set`'s.
