@@ -105,11 +105,18 @@ TEST(DiagnoseDivergenceCli, AHugeTimeStepMakesTheModelDiverge) {
 }
 
 TEST(DiagnoseDivergenceCli, AModelWithAnAbsurdParameterDiverges) {
-  // A pole of 1e300 m: once "explained -1.5e302% +- inf%" for every candidate effect.
+  // A pole of 1e300 m (once "explained -1.5e302% +- inf%" for every candidate effect) is no physical
+  // model and is refused where it is read; the shortest pole the range allows, a micrometre, swings far
+  // too fast for the data's step, and the model diverges on them.
   const fs::path dir = test::temporary_dir("diagnose_absurd_model");
   const fs::path data = write_csv(dir, "plain.csv", plain_data());
+  const fs::path absurd = dir / "absurd.toml";
+  std::ofstream(absurd) << "[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n[parameters]\npole_length = 1e300\n";
+  const auto refused = test::run_cli("diagnose --system cartpole --data " + quote(data) + " --model " + quote(absurd));
+  EXPECT_EQ(refused.status, 2);
+  EXPECT_NE(refused.err.find("absurd.toml:line 5: field 'parameters.pole_length'"), std::string::npos) << refused.err;
   const fs::path model = dir / "pole.toml";
-  std::ofstream(model) << "[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n[parameters]\npole_length = 1e300\n";
+  std::ofstream(model) << "[model]\nsystem = \"cartpole\"\npreset = \"sim\"\n[parameters]\npole_length = 1e-6\n";
   const std::string base = "diagnose --system cartpole --data " + quote(data) + " --model " + quote(model) + test::kFastDiagnose;
   expect_model_diverges(base, dir);
   // Adding an effect to it fits and scores the effect with finite numbers, and still says so.

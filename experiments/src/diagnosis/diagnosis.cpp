@@ -591,6 +591,10 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& op
   // one-step criterion, and the reason says so.
   DiagnosisOptions o = options;
   std::string criterion_reason;
+  // Progress from the first moment: on a long record every stage below takes a while.
+  if (o.progress)
+    o.progress(fmt::format("{} samples in {} episode(s){}", input.sample_count(), input.episodes.size(),
+                           o.choose_criterion ? "; choosing the criterion by the data" : ""));
   if (o.choose_criterion) {
     o.choose_criterion = false;
     try {
@@ -621,8 +625,10 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& op
 
   // One-step predictions of a model (its input delay applied to the measured inputs).
   const FitContext settings{&R.data, o.model, o.integrator, R.dt, o.substeps, Vector(), Matrix()};
-  const ModelAsGiven given = model_as_given(o, settings);
   if (o.progress && !criterion_reason.empty()) o.progress("criterion: " + criterion_reason);
+  if (o.progress)
+    o.progress(fmt::format("the model's one-step residual on {} transitions, and its GP", R.data.size()));
+  const ModelAsGiven given = model_as_given(o, settings);
   R.model_before = given.model;
   // The library and the model's declared effects; the fits below point into it.
   const std::vector<LibraryEffect> candidates = candidate_effects(given.model);
