@@ -313,7 +313,9 @@ def test_diagnose_reports_progress_and_ctrl_c_stops_it_between_effects():
 
     with pytest.raises(KeyboardInterrupt):
         gpilqg.diagnose("cartpole", data, progress=progress)
-    assert lines[0] == "residual GP of the model fitted"
+    # Progress from the first moment: the samples, the criterion, the model's residual and its GP.
+    assert lines[0] == "2000 samples in 10 episode(s); choosing the criterion by the data", lines
+    assert "residual GP of the model fitted" in lines
     # Effects are fitted on several threads and Python handles the signal on the calling thread only: the
     # call stops after the calling thread's current effect, so after effect 2 and before all 13 were fitted.
     last, total = map(int, lines[-1].split()[1].split("/"))
