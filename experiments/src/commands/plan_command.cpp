@@ -68,7 +68,7 @@ int run_plan(const PlanOptions& o) {
   write_policy_file(o.out, planned.file, planned.model.get());
   const auto& d = planned.diagnosis;
   // The model the round planned on, adopted or not: a scripted loop's next round plans on it, never on
-  // a file an earlier round left there.
+  // a stale file left there before.
   const std::string data_text = fmt::format("{}", fmt::join(o.data, ", "));
   if (!o.write_model.empty() && d)
     diagnosis::write_model_file(o.write_model, planned.planned_on,
