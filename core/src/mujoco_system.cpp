@@ -63,20 +63,25 @@ struct MujocoStepWorkspace final : StepWorkspace {
   Matrix A_chain, B_chain;  ///< the products of the chain rule
 };
 
+/// Why a step of dt does not suit `model` (MujocoSystem::step_problem), or nothing.
+std::optional<std::string> step_problem(const MujocoModel& model, double dt) {
+  if (!std::isfinite(dt) || dt <= 0.0) return fmt::format("step length dt = {}; expected a finite value > 0", dt);
+  const double timestep = model.m()->opt.timestep;
+  const double ratio = dt / timestep;
+  const long substeps = std::lround(ratio);
+  if (substeps < 1 || std::abs(ratio - static_cast<double>(substeps)) > 1e-6 * ratio)
+    return fmt::format("dt = {} s is not a whole multiple of the MuJoCo model's timestep {} s ({}); use a multiple such as {} s",
+                       dt, timestep, model.path(), std::max(1L, substeps) * timestep);
+  return std::nullopt;
+}
+
 /// The model's own integrator and timestep as a StepModel: dt / timestep calls of mj_step.
 class MujocoStepModel final : public StepModel {
  public:
   MujocoStepModel(std::shared_ptr<const MujocoModel> model, DynamicsPtr decorated, double dt)
       : model_(std::move(model)), decorated_(std::move(decorated)), dt_(dt) {
-    const double timestep = model_->m()->opt.timestep;
-    if (!std::isfinite(dt) || dt <= 0.0)
-      throw std::invalid_argument(fmt::format("step length dt = {}; expected a finite value > 0", dt));
-    const double ratio = dt / timestep;
-    substeps_ = static_cast<int>(std::lround(ratio));
-    if (substeps_ < 1 || std::abs(ratio - substeps_) > 1e-6 * ratio)
-      throw std::invalid_argument(fmt::format(
-          "dt = {} s is not a whole multiple of the MuJoCo model's timestep {} s ({}); use a multiple such as {} s",
-          dt, timestep, model_->path(), std::max(1L, std::lround(ratio)) * timestep));
+    if (const std::optional<std::string> problem = step_problem(*model_, dt)) throw std::invalid_argument(*problem);
+    substeps_ = static_cast<int>(std::lround(dt / model_->m()->opt.timestep));
     const auto* effects = dynamic_cast<const EffectDynamics*>(decorated_.get());
     gains_ = model_->gains();
     if (effects != nullptr) {
@@ -188,6 +193,8 @@ const std::vector<Quantity>& MujocoSystem::controls() const { return model_->con
 std::vector<Parameter> MujocoSystem::parameters() const { return model_->parameters(); }
 const std::vector<Quantity>& MujocoSystem::generalised_forces() const { return model_->forces(); }
 double MujocoSystem::timestep() const { return model_->m()->opt.timestep; }
+
+std::optional<std::string> MujocoSystem::step_problem(double dt) const { return gpilqg::step_problem(*model_, dt); }
 const std::string& MujocoSystem::path() const { return model_->path(); }
 std::vector<std::string> MujocoSystem::body_names() const { return model_->body_names(); }
 std::vector<std::string> MujocoSystem::joint_names() const { return model_->joint_names(); }

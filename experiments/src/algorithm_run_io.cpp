@@ -1,5 +1,7 @@
 #include "algorithm_run_io.hpp"
 
+#include <limits>
+
 #include <fmt/format.h>
 
 #include "gpilqg/core/hdf5_reader.hpp"
@@ -37,6 +39,16 @@ std::vector<Matrix> read_gains(const Hdf5Reader& h5, const std::string& path) {
   return gains;
 }
 
+/// A summary number that is +inf (a cost or gradient norm that was not finite: DdpSolver's merit and
+/// gradient norm) is left out, so that a checkpoint holds finite numbers only; read_unbounded reads it back.
+void write_unbounded(Hdf5Writer& h5, const std::string& path, double value) {
+  if (value != std::numeric_limits<double>::infinity()) h5.write_scalar(path, value);
+}
+
+double read_unbounded(const Hdf5Reader& h5, const std::string& path) {
+  return h5.exists(path) ? h5.read_scalar(path) : std::numeric_limits<double>::infinity();
+}
+
 void write_record(Hdf5Writer& h5, const std::string& g, const IterationRecord& r) {
   const AffinePolicy& p = r.plan.policy;
   h5.write_matrix(g + "/policy/x_bar", p.x_bar);
@@ -45,18 +57,18 @@ void write_record(Hdf5Writer& h5, const std::string& g, const IterationRecord& r
   write_gains(h5, g + "/policy/K", p.K);
   h5.write_vector(g + "/policy/u_min", p.u_min);
   h5.write_vector(g + "/policy/u_max", p.u_max);
-  h5.write_scalar(g + "/predicted_cost", r.plan.predicted_cost);
+  write_unbounded(h5, g + "/predicted_cost", r.plan.predicted_cost);
   h5.write_scalar(g + "/solve_seconds", r.plan.solve_seconds);
   h5.write_scalar(g + "/variant", static_cast<double>(r.plan.variant));
   const DdpSummary& s = r.plan.summary;
   h5.write_scalar(g + "/summary/termination", static_cast<double>(s.termination));
   h5.write_scalar(g + "/summary/iterations", s.iterations);
-  h5.write_scalar(g + "/summary/initial_cost", s.initial_cost);
-  h5.write_scalar(g + "/summary/final_cost", s.final_cost);
-  h5.write_scalar(g + "/summary/final_gradient_norm", s.final_gradient_norm);
+  write_unbounded(h5, g + "/summary/initial_cost", s.initial_cost);
+  write_unbounded(h5, g + "/summary/final_cost", s.final_cost);
+  write_unbounded(h5, g + "/summary/final_gradient_norm", s.final_gradient_norm);
   h5.write_scalar(g + "/summary/final_backward_failed", s.final_backward_failed ? 1.0 : 0.0);
   const Evaluation& e = r.evaluation;
-  h5.write_scalar(g + "/evaluation/mean_cost", e.mean_cost);
+  write_unbounded(h5, g + "/evaluation/mean_cost", e.mean_cost);
   h5.write_vector(g + "/evaluation/costs", e.costs);
   h5.write_matrix(g + "/evaluation/example_x", e.example.x);
   h5.write_matrix(g + "/evaluation/example_u", e.example.u);
@@ -65,7 +77,7 @@ void write_record(Hdf5Writer& h5, const std::string& g, const IterationRecord& r
   h5.write_scalar(g + "/data_rows", r.data_rows);
   h5.write_scalar(g + "/fit_seconds", r.fit_seconds);
   h5.write_scalar(g + "/rollout_seconds", r.rollout_seconds);
-  h5.write_scalar(g + "/policy_change", r.policy_change);
+  write_unbounded(h5, g + "/policy_change", r.policy_change);
   h5.write_scalar(g + "/repeated", r.repeated ? 1.0 : 0.0);
   Matrix hyper(static_cast<Eigen::Index>(r.hyperparameters.size()),
                r.hyperparameters.empty() ? 0 : r.hyperparameters.front().size());
@@ -85,18 +97,18 @@ IterationRecord read_record(const Hdf5Reader& h5, const std::string& g) {
   p.K = read_gains(h5, g + "/policy/K");
   p.u_min = h5.read_vector(g + "/policy/u_min");
   p.u_max = h5.read_vector(g + "/policy/u_max");
-  r.plan.predicted_cost = h5.read_scalar(g + "/predicted_cost");
+  r.plan.predicted_cost = read_unbounded(h5, g + "/predicted_cost");
   r.plan.solve_seconds = h5.read_scalar(g + "/solve_seconds");
   r.plan.variant = static_cast<DdpVariant>(read_int(h5, g + "/variant"));
   DdpSummary& s = r.plan.summary;
   s.termination = static_cast<DdpTermination>(read_int(h5, g + "/summary/termination"));
   s.iterations = read_int(h5, g + "/summary/iterations");
-  s.initial_cost = h5.read_scalar(g + "/summary/initial_cost");
-  s.final_cost = h5.read_scalar(g + "/summary/final_cost");
-  s.final_gradient_norm = h5.read_scalar(g + "/summary/final_gradient_norm");
+  s.initial_cost = read_unbounded(h5, g + "/summary/initial_cost");
+  s.final_cost = read_unbounded(h5, g + "/summary/final_cost");
+  s.final_gradient_norm = read_unbounded(h5, g + "/summary/final_gradient_norm");
   s.final_backward_failed = h5.read_scalar(g + "/summary/final_backward_failed") != 0.0;
   Evaluation& e = r.evaluation;
-  e.mean_cost = h5.read_scalar(g + "/evaluation/mean_cost");
+  e.mean_cost = read_unbounded(h5, g + "/evaluation/mean_cost");
   const Vector costs = h5.read_vector(g + "/evaluation/costs");
   e.costs.assign(costs.data(), costs.data() + costs.size());
   e.example.x = h5.read_matrix(g + "/evaluation/example_x");
@@ -106,7 +118,7 @@ IterationRecord read_record(const Hdf5Reader& h5, const std::string& g) {
   r.data_rows = read_int(h5, g + "/data_rows");
   r.fit_seconds = h5.read_scalar(g + "/fit_seconds");
   r.rollout_seconds = h5.read_scalar(g + "/rollout_seconds");
-  r.policy_change = h5.read_scalar(g + "/policy_change");
+  r.policy_change = read_unbounded(h5, g + "/policy_change");
   r.repeated = h5.read_scalar(g + "/repeated") != 0.0;
   const Matrix hyper = h5.read_matrix(g + "/hyperparameters");
   for (Eigen::Index i = 0; i < hyper.rows(); ++i) r.hyperparameters.push_back(hyper.row(i).transpose());

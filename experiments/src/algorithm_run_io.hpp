@@ -10,6 +10,9 @@
 ///   /iter_<k>/summary/{termination, iterations, initial_cost, final_cost, final_gradient_norm,
 ///              final_backward_failed}   (the DDP summary without its per-iteration trace)
 ///   /iter_<k>/evaluation/{mean_cost, costs, example_x, example_u, diverged, seconds}
+///   (predicted_cost, initial_cost, final_cost, final_gradient_norm, mean_cost and policy_change are
+///   absent where they are +inf: a solve or rollout whose cost or gradient was not finite; every
+///   number in the file is finite)
 ///   /iter_<k>/hyperparameters (outputs x D+2; 0 x 0 without a GP)
 ///   /iter_<k>/noise_floor (outputs; empty without a GP)
 ///   /model                   the final residual model (gp_io.hpp layout) when final_model is one

@@ -8,6 +8,7 @@
 
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
 #include "gpilqg/experiments/diagnosis/diagnosis.hpp"
 
@@ -67,9 +68,11 @@ LoopDiagnosis diagnose_loop_data(const LoopModel& model, const TransitionData& d
       out.reason = fmt::format("the diagnosed model has an input delay of {} control periods, which the planners do not "
                                "apply; {}",
                                report.model_next.input_delay, out.reason);
-  } catch (const std::invalid_argument& e) {  // data the diagnosis cannot use: the loop goes on without it
+  } catch (const diagnosis::DataProblem& e) {  // data the diagnosis cannot use: the loop goes on without it
     out.verdict = "failed";
     out.reason = e.what();
+  } catch (const std::invalid_argument& e) {
+    throw diagnosis::own_failure(fmt::format("the {} transitions of rounds 0 to {}", data.size(), round), e);
   }
   out.changes = out.model.describe();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -18,6 +18,7 @@
 #include "gpilqg/core/output_path.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
@@ -214,17 +215,14 @@ py::object diagnose(const py::object& system, const py::object& data, const std:
   diagnosis::DiagnosisOptions options = diagnosis::diagnosis_options(request);
   LongCall call(progress);
   options.progress = [&call](const std::string& line) { call.throwing_checkpoint(line); };
-  const MeasurementSet set =
-      py::isinstance<MeasurementSet>(data)
-          ? data.cast<MeasurementSet>()
-          : read_measurements(path_argument(data, "diagnose", "data", "a gpilqg.MeasurementSet or a measurement file path"),
-                              system_signature(request.system));
+  const bool in_memory = py::isinstance<MeasurementSet>(data);
+  const std::filesystem::path file =
+      in_memory ? std::filesystem::path()
+                : path_argument(data, "diagnose", "data", "a gpilqg.MeasurementSet or a measurement file path");
+  const MeasurementSet set = in_memory ? data.cast<MeasurementSet>() : read_measurements(file, system_signature(request.system));
+  const std::string source = in_memory ? std::string("the MeasurementSet given as data") : file.string();
   const nlohmann::json report = call.run<nlohmann::json>([&] {
-    try {
-      return diagnosis::report_json(diagnosis::diagnose(set, options));
-    } catch (const std::invalid_argument& e) {
-      throw InputError(e.what());
-    }
+    return diagnosis::blame_for_diagnosis(source, [&] { return diagnosis::report_json(diagnosis::diagnose(set, options)); });
   });
   return to_python(report);
 }

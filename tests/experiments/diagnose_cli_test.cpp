@@ -13,9 +13,12 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <set>
+#include <sstream>
+#include <stdexcept>
 
 #include "diagnosis_support.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
 #include "test_support.hpp"
 
@@ -65,6 +68,19 @@ TEST(DiagnoseCli, JsonHasTheFixedKeysAndNamesTheHiddenEffect) {
   EXPECT_EQ(j["relevance"]["x_dot"].size(), 5u);
   EXPECT_TRUE(j["heldout_blocks"].is_null());  // several episodes are held out whole, never cut into blocks
   EXPECT_TRUE(has_no_nan(j));
+  // Progress on stderr from the first moment; each candidate's line says the time so far and, but the
+  // last, the time the others will take at that pace.
+  EXPECT_EQ(result.err.rfind("diagnose: 840 samples in 7 episode(s)", 0), 0u) << result.err;
+  std::istringstream lines(result.err);
+  int candidates = 0, estimates = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find(" fitted: ") == std::string::npos) continue;
+    ++candidates;
+    EXPECT_NE(line.find(" s so far"), std::string::npos) << line;
+    estimates += line.find(" s for the other ") != std::string::npos;
+  }
+  EXPECT_GT(candidates, 5);
+  EXPECT_EQ(estimates, candidates - 1) << result.err;
 }
 
 TEST(DiagnoseCli, AddWriteModelAndStartTheNextRoundFromIt) {
@@ -297,7 +313,32 @@ TEST(DiagnosisPieces, HeldOutEpisodesAreWholeAndSpread) {
   EXPECT_EQ(data.size(), 20);
   EXPECT_EQ(data.rows(true).size(), 6u);
   set.episodes.resize(1);
-  EXPECT_THROW(diagnosis::heldout_episodes(set, 0.3), std::invalid_argument);
+  EXPECT_THROW(diagnosis::heldout_episodes(set, 0.3), diagnosis::DataProblem);  // the data's, named with its file
+}
+
+/// The data's file is named for what the data lack (a DataProblem: exit 2); any other
+/// std::invalid_argument from inside the diagnosis is the program's own failure ("internal error",
+/// exit 1) and never names the file as its cause.
+TEST(DiagnosisPieces, OnlyTheDataProblemsBlameTheDataFile) {
+  try {
+    diagnosis::blame_for_diagnosis("F.h5", []() -> int { throw diagnosis::DataProblem("the data has 1 episode(s)"); });
+    ADD_FAILURE() << "a DataProblem was swallowed";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "F.h5: the data has 1 episode(s)");
+  }
+  try {
+    diagnosis::blame_for_diagnosis("F.h5", []() -> int { throw std::invalid_argument("d = 50.005; expected [0, 50]"); });
+    ADD_FAILURE() << "the program's own failure was swallowed";
+  } catch (const std::invalid_argument& e) {
+    ADD_FAILURE() << "the program's own failure reported as bad input: " << e.what();
+  } catch (const std::logic_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "the diagnosis failed on its own, not because of the data in F.h5: d = 50.005; expected [0, 50]");
+    std::ostringstream err;
+    EXPECT_EQ(run_reporting_errors([&]() -> int { throw e; }, err), kExitInternalFailure);
+    EXPECT_EQ(err.str().rfind("internal error: ", 0), 0u) << err.str();
+  }
+  EXPECT_EQ(diagnosis::blame_for_diagnosis("F.h5", [] { return 7; }), 7);
 }
 
 /// Independent white residual and input: about 95% of the lags stay inside the band (binomial

@@ -17,6 +17,7 @@
 
 #include "diagnosis_support.hpp"
 #include "gpilqg/core/systems.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
 #include "gpilqg/experiments/diagnosis/report.hpp"
 #include "test_support.hpp"
@@ -100,7 +101,7 @@ TEST(HeldoutBlocks, GapIsTheLongestWindowAndTheRecordMustHoldTheBlocks) {
   try {
     diagnosis::split_heldout_blocks(record_of(1019), 0.3, 50);
     FAIL() << "a record too short for its blocks was accepted";
-  } catch (const std::invalid_argument& e) {
+  } catch (const diagnosis::DataProblem& e) {  // the data's, named with its file
     const std::string message = e.what();
     for (const char* part : {"1 episode of 1019 samples", "expected at least 1020 samples", "10 blocks", "102 samples",
                              "gap of 50 samples (the longest k-step horizon)", "shorten the longest k-step horizon"})

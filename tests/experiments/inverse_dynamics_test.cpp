@@ -20,6 +20,7 @@
 
 #include "gpilqg/core/effect_library.hpp"
 #include "gpilqg/core/savitzky_golay.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
 #include "gpilqg/experiments/diagnosis/criteria/criterion_context.hpp"
 #include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
@@ -398,15 +399,21 @@ TEST(InverseDynamicsAccelerations, ShortEpisodesAndWrongStepsAreClearErrors) {
                                           {Matrix::Zero(50, 1), Matrix::Zero(4, 1)}, dt);
   try {
     estimate_accelerations(data, {0}, dt);
-    ADD_FAILURE() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& e) {
+    ADD_FAILURE() << "expected a DataProblem";
+  } catch (const diagnosis::DataProblem& e) {  // the data's, named with its file
     EXPECT_NE(std::string(e.what()).find("episode 1 (rows 49 to 51) has 4 consecutive samples"), std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find("needs at least 5"), std::string::npos) << e.what();
   }
   const Transitions long_enough = transitions_of({sampled(v, 50, dt, 0.0, 1)}, {Matrix::Zero(50, 1)}, dt);
-  EXPECT_THROW(estimate_accelerations(long_enough, {0}, 0.02), std::invalid_argument);  // t says 0.01
-  EXPECT_THROW(estimate_accelerations(long_enough, {1}, dt), std::invalid_argument);     // no column 1
+  EXPECT_THROW(estimate_accelerations(long_enough, {0}, 0.02), diagnosis::DataProblem);  // t says 0.01
+  try {  // no column 1: the caller's mistake, not the data's
+    estimate_accelerations(long_enough, {1}, dt);
+    ADD_FAILURE() << "a velocity column outside the state was accepted";
+  } catch (const diagnosis::DataProblem& e) {
+    ADD_FAILURE() << "the caller's mistake blamed on the data: " << e.what();
+  } catch (const std::invalid_argument&) {
+  }
 }
 
 // --- The residual on the cart-pole, against its textbook inverse dynamics ------------------------

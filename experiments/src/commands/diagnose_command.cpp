@@ -27,6 +27,7 @@
 #include "gpilqg/core/system_registry.hpp"
 #include "gpilqg/core/systems.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/diagnose_request.hpp"
 #include "gpilqg/experiments/diagnosis/diagnosis.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
@@ -94,12 +95,8 @@ int run_diagnose(const DiagnoseOptions& options_given) {
   options.progress = [](const std::string& line) { std::cerr << "diagnose: " << line << std::endl; };
   if (!o.plots.empty()) check_plotting();
   const MeasurementSet data = read_measurements(o.data, signature);
-  diagnosis::DiagnosisReport report;
-  try {
-    report = diagnosis::diagnose(data, options);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(fmt::format("{}: {}", o.data, e.what()));
-  }
+  const diagnosis::DiagnosisReport report =
+      diagnosis::blame_for_diagnosis(o.data, [&] { return diagnosis::diagnose(data, options); });
 
   std::filesystem::path h5 = o.out;
   if (h5.empty() && !o.plots.empty()) h5 = std::filesystem::path(o.plots) / "diagnosis.h5";

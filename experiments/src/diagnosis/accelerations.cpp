@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "gpilqg/core/savitzky_golay.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -43,7 +44,7 @@ void check_time_steps(const Transitions& data, const RowSegment& segment, double
   for (int r = segment.first + 1; r < segment.end; ++r) {
     const double step = data.t(r) - data.t(r - 1);
     if (!(std::abs(step - dt) <= 1e-6 * dt))
-      throw std::invalid_argument(fmt::format(
+      throw DataProblem(fmt::format(
           "accelerations: episode {} steps from t = {} to t = {} ({} s); expected dt = {} s within 1e-6 relative",
           segment.episode, data.t(r - 1), data.t(r), step, dt));
   }
@@ -75,7 +76,7 @@ AccelerationEstimate estimate_accelerations(const Transitions& data, const std::
   const int needed = shortest_differentiable_segment(order);
   for (const RowSegment& s : segments) {
     if (s.samples() < needed)
-      throw std::invalid_argument(fmt::format(
+      throw DataProblem(fmt::format(
           "accelerations: episode {} (rows {} to {}) has {} consecutive samples; the acceleration estimate needs at "
           "least {}", s.episode, s.first, s.end - 1, s.samples(), needed));
     check_time_steps(data, s, dt);
@@ -175,7 +176,7 @@ Matrix filtered_at(const Transitions& data, const Matrix& y, const std::vector<i
   std::vector<int> segment_of(static_cast<std::size_t>(data.size()), -1);
   for (std::size_t s = 0; s < segments.size(); ++s) {
     if (segments[s].samples() < window)
-      throw std::invalid_argument(fmt::format(
+      throw DataProblem(fmt::format(
           "filtered signal: episode {} (rows {} to {}) has {} samples; the window spans {}", segments[s].episode,
           segments[s].first, segments[s].end - 1, segments[s].samples(), window));
     for (int t = segments[s].first; t < segments[s].end; ++t) segment_of[static_cast<std::size_t>(t)] = static_cast<int>(s);

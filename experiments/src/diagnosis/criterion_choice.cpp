@@ -13,6 +13,7 @@
 #include "gpilqg/core/generalised_forces.hpp"
 #include "gpilqg/core/savitzky_golay.hpp"
 #include "gpilqg/experiments/diagnosis/accelerations.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/derivative_window.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
 #include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
@@ -487,11 +488,11 @@ int simulation_window_cap(const MeasurementSet& data) {
 }
 
 CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& model) {
-  if (data.episodes.empty()) throw std::invalid_argument("criterion choice: the measurement set has no episodes");
+  if (data.episodes.empty()) throw DataProblem("criterion choice: the measurement set has no episodes");
   const DynamicsPtr dynamics = model.build();
   if (dynamics->state_dim() != static_cast<int>(data.system.states.size()) ||
       dynamics->control_dim() != static_cast<int>(data.system.controls.size()))
-    throw std::invalid_argument(fmt::format(
+    throw DataProblem(fmt::format(
         "criterion choice: the model '{}' has {} states and {} controls; the data of '{}' have {} and {}",
         dynamics->name(), dynamics->state_dim(), dynamics->control_dim(), data.system.name,
         data.system.states.size(), data.system.controls.size()));

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "gpilqg/core/savitzky_golay.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -80,7 +81,7 @@ double difference_noise_std(const std::vector<Vector>& segments) {
     if (count > 0) best = std::min(best, sum / (static_cast<double>(count) * central_binomial(k)));
   }
   if (!std::isfinite(best))
-    throw std::invalid_argument("noise estimate: no segment has 3 samples; expected at least one");
+    throw DataProblem("noise estimate: no segment has 3 samples; expected at least one");
   return std::sqrt(best);
 }
 
@@ -98,11 +99,11 @@ DerivativeWindow choose_derivative_window(const std::vector<Vector>& segments, d
   Eigen::Index shortest = std::numeric_limits<Eigen::Index>::max();
   for (std::size_t s = 0; s < segments.size(); ++s) {
     if (segments[s].size() < needed)
-      throw std::invalid_argument(fmt::format(
+      throw DataProblem(fmt::format(
           "derivative window: segment {} has {} samples; expected at least {} (the reference differentiator of "
           "order {} spans {})", s, segments[s].size(), needed, order + 2, needed));
     if (!segments[s].allFinite())
-      throw std::invalid_argument(fmt::format("derivative window: segment {} has a sample that is not finite", s));
+      throw DataProblem(fmt::format("derivative window: segment {} has a sample that is not finite", s));
     shortest = std::min(shortest, segments[s].size());
   }
 

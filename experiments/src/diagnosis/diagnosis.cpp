@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -9,9 +10,11 @@
 
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/input_delay.hpp"
+#include "gpilqg/core/integrator.hpp"
 #include "gpilqg/experiments/diagnosis/criteria/criterion_context.hpp"
 #include "gpilqg/experiments/diagnosis/criteria/inverse_dynamics.hpp"
 #include "gpilqg/experiments/diagnosis/criterion_choice.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/effect_selection.hpp"
 #include "gpilqg/experiments/diagnosis/effect_test.hpp"
 #include "gpilqg/experiments/diagnosis/generalised_force_residual.hpp"
@@ -581,11 +584,17 @@ void falls(const DiagnosisOptions& o, const MeasurementSet& set, const ModelAsGi
 
 DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& options) {
   options.validate();
-  if (input.episodes.empty()) throw std::invalid_argument("the data has no episodes");
+  if (input.episodes.empty()) throw DataProblem("the data has no episodes");
   check_measurement_range(input);
   // A model file's data carry the model's name (<mujoco model="...">), not the file's path.
   if (const std::string model_name = system_signature(options.model.system).name; input.system.name != model_name)
-    throw std::invalid_argument("the data are of system '" + input.system.name + "'; the model is '" + model_name + "'");
+    throw DataProblem("the data are of system '" + input.system.name + "'; the model is '" + model_name + "'");
+  // The data's sampling step must be one the model can take (a MuJoCo model steps in whole multiples of
+  // its timestep); every step model below is built at it.
+  const DynamicsPtr model = options.model.build();
+  if (const OwnIntegrator* own = own_integrator(*model))
+    if (const std::optional<std::string> problem = own->step_problem(input.episodes.front().dt()))
+      throw DataProblem("the data's sampling step: " + *problem);
   // --criterion auto: the data choose the criterion and its window, before the record is cut into
   // blocks (whose gaps depend on the window). Data too short for the rule's estimates keep the
   // one-step criterion, and the reason says so.
@@ -603,7 +612,7 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& op
       o.window = choice.window;
       o.instruments = choice.instruments;
       criterion_reason = choice.reason;
-    } catch (const std::invalid_argument& e) {
+    } catch (const DataProblem& e) {
       o.criterion = FitCriterion::OneStep;
       o.window = 1;
       criterion_reason = std::string("one-step: the data are too short to choose by the rule (") + e.what() + ")";
@@ -611,7 +620,7 @@ DiagnosisReport diagnose(const MeasurementSet& input, const DiagnosisOptions& op
   }
   // A window the user gave that the episodes cannot hold would leave nothing to score.
   if (o.criterion == FitCriterion::Simulation && criterion_reason.empty() && o.window > simulation_window_cap(input))
-    throw std::invalid_argument(fmt::format(
+    throw DataProblem(fmt::format(
         "--window {}: longer than the data allow, at most {} samples ({}); expected a shorter window", o.window,
         simulation_window_cap(input),
         input.episodes.size() == 1 ? fmt::format("a quarter of each of the {} blocks of the record, less 2",

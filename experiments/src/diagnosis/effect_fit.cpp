@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <atomic>
+#include <chrono>
 #include <iterator>
 #include <map>
 #include <mutex>
@@ -579,14 +580,23 @@ std::vector<RankedEffect> rank_effects(const FitContext& context, double alias_g
   std::vector<EffectFit> fits(candidates.size());
   std::atomic<std::size_t> next{0}, done{0};
   std::mutex report;
+  // Each line says how long the candidates took so far and, at that pace, how long the others will take
+  // (on a long record each fit goes over every sample, so the pace holds).
+  const auto start = std::chrono::steady_clock::now();
   ForkJoin workers;
   workers.run(std::max(1, std::min<int>(threads, static_cast<int>(candidates.size()))), [&](int, int) {
     for (std::size_t i = next++; i < candidates.size(); i = next++) {
       fits[i] = fit_jointly(*candidates[i], refit, context);
       if (progress) {
         const std::lock_guard<std::mutex> lock(report);
-        progress(fmt::format("effect {}/{} fitted: {} explains {:.1f}%", ++done, candidates.size(), fits[i].effect,
-                             100.0 * fits[i].explained));
+        const std::size_t finished = ++done, left = candidates.size() - finished;
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        progress(fmt::format("effect {}/{} fitted: {} explains {:.1f}% ({:.1f} s so far{})", finished,
+                             candidates.size(), fits[i].effect, 100.0 * fits[i].explained, seconds,
+                             left == 0 ? std::string()
+                                       : fmt::format(", about {:.0f} s for the other {}",
+                                                     seconds / static_cast<double>(finished) * static_cast<double>(left),
+                                                     left)));
       }
     }
   });

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "gpilqg/core/effects.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -62,7 +63,7 @@ GeneralisedForceParts generalised_force_parts(const Dynamics& model, const Trans
   const auto k = static_cast<Eigen::Index>(components.forces.size());
   const int n = model.state_dim();
   if (data.x.cols() != n)
-    throw std::invalid_argument(fmt::format("inverse-dynamics residual: the data have {} states; system '{}' has {}",
+    throw DataProblem(fmt::format("inverse-dynamics residual: the data have {} states; system '{}' has {}",
                                             data.x.cols(), model.name(), n));
   if (applied_u.rows() != data.size() || applied_u.cols() != model.control_dim())
     throw std::invalid_argument(fmt::format(
@@ -93,7 +94,7 @@ GeneralisedForceParts generalised_force_parts(const Dynamics& model, const Trans
   GeneralisedForceParts out{Matrix(static_cast<Eigen::Index>(rows.size()), k),
                             Matrix(static_cast<Eigen::Index>(rows.size()), k)};
   const auto not_finite = [&](int t, const std::string& what) {
-    return std::invalid_argument(fmt::format("inverse-dynamics residual: at row {} (episode {}, t = {}) the model's {}; "
+    return DataProblem(fmt::format("inverse-dynamics residual: at row {} (episode {}, t = {}) the model's {}; "
                                              "no force residual there",
                                              t, data.episode[static_cast<std::size_t>(t)],
                                              data.t.size() > t ? data.t(t) : 0.0, what));

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 
 namespace gpilqg::diagnosis {
 
@@ -40,7 +41,7 @@ HeldoutBlocks split_heldout_blocks(const Episode& record, double fraction, int g
   const int T = record.length();
   const long needed = static_cast<long>(count) * (2L * gap + 2L);
   if (T < needed)
-    throw std::invalid_argument(fmt::format(
+    throw DataProblem(fmt::format(
         "the data has 1 episode of {} samples; expected at least {} samples, since a single record is cut into {} "
         "blocks for held-out scoring, each of at least 2 x gap + 2 = {} samples with a gap of {} samples ({}) dropped "
         "on either side of every held-out block; record longer, shorten {}, or give several episodes",

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/derivative_window.hpp"
 
 namespace gpilqg::diagnosis {
@@ -38,7 +39,7 @@ Crossings count_crossings(const Vector& centred, double band) {
 }  // namespace
 
 MotionPeriod motion_period(const MeasurementSet& data, int state) {
-  if (data.episodes.empty()) throw std::invalid_argument("motion period: the measurement set has no episodes");
+  if (data.episodes.empty()) throw DataProblem("motion period: the measurement set has no episodes");
   const auto n = static_cast<int>(data.system.states.size());
   if (state < 0 || state >= n)
     throw std::invalid_argument(fmt::format("motion period: state column {} is outside the {} states", state, n));

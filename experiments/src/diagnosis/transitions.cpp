@@ -4,6 +4,7 @@
 
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/input_delay.hpp"
+#include "gpilqg/experiments/diagnosis/data_problem.hpp"
 #include "gpilqg/experiments/diagnosis/heldout_blocks.hpp"
 
 #include <algorithm>
@@ -23,7 +24,7 @@ std::vector<int> Transitions::rows(bool heldout_rows) const {
 std::vector<int> heldout_episodes(const MeasurementSet& set, double fraction) {
   const auto count = static_cast<int>(set.episodes.size());
   if (count < 2)
-    throw std::invalid_argument("the data has " + std::to_string(count) +
+    throw DataProblem("the data has " + std::to_string(count) +
                                 " episode(s); expected at least 2, since the diagnosis holds whole episodes out");
   return heldout_indices(count, fraction);
 }
@@ -69,7 +70,7 @@ Transitions make_transitions(const MeasurementSet& set, const std::vector<int>& 
       os.precision(17);
       os << "episode " << e.id << " has dt = " << e.dt() << " s; expected " << dt
          << " s like the first episode (within 1e-6 relative)";
-      throw std::invalid_argument(os.str());
+      throw DataProblem(os.str());
     }
     const bool held = std::find(heldout.begin(), heldout.end(), static_cast<int>(k)) != heldout.end();
     const Eigen::Index steps = e.length() - 1;
@@ -92,7 +93,7 @@ void check_measurement_range(const MeasurementSet& set) {
     for (Eigen::Index s = 0; s < values.rows(); ++s)
       for (Eigen::Index j = 0; j < values.cols(); ++j)
         if (std::abs(values(s, j)) > kDivergedStateMagnitude)
-          throw std::invalid_argument(fmt::format(
+          throw DataProblem(fmt::format(
               "episode {} at t = {}: column '{}' is {:g}; expected |value| <= {:g} (the bound beyond which a state "
               "counts as diverged)", e.id, e.t(s), columns[static_cast<std::size_t>(j)].name, values(s, j),
               kDivergedStateMagnitude));

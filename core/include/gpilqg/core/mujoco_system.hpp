@@ -95,6 +95,8 @@ class MujocoSystem final : public Dynamics, public GeneralisedForceInput, public
   /// The model's integrator and timestep with `decorated`'s effects (this system, or an EffectDynamics
   /// over it). Throws std::invalid_argument when dt is not a whole multiple of the timestep.
   std::shared_ptr<const StepModel> own_step_model(DynamicsPtr decorated, double dt) const override;
+  /// dt not finite and > 0, or not a whole multiple of the timestep (within 1e-6 relative).
+  std::optional<std::string> step_problem(double dt) const override;
 
   /// The model's timestep [s].
   double timestep() const;

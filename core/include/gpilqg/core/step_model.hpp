@@ -12,6 +12,8 @@
 /// iLQR uses the mean only, iLQG adds F, Robust-iLQG adds F and G.
 
 #include <memory>
+#include <string>
+#include <optional>
 
 #include "gpilqg/core/dynamics.hpp"
 #include "gpilqg/core/noise.hpp"
@@ -96,6 +98,10 @@ class OwnIntegrator {
   /// when dt does not suit the system (for MuJoCo: not a whole multiple of the timestep).
   virtual std::shared_ptr<const StepModel> own_step_model(std::shared_ptr<const Dynamics> decorated,
                                                           double dt) const = 0;
+  /// Why a step of dt does not suit the system (own_step_model's refusal, e.g. "dt = 0.015 s is not a
+  /// whole multiple of the MuJoCo model's timestep 0.01 s ..."), or nothing when it does: callers that
+  /// take dt from measurements name the data as the cause.
+  virtual std::optional<std::string> step_problem(double dt) const = 0;
 };
 
 }  // namespace gpilqg
