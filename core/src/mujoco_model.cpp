@@ -20,6 +20,7 @@
 #include "gpilqg/core/measurements.hpp"
 #include "mujoco_actuator_units.hpp"
 #include "mujoco_model_files.hpp"
+#include "mujoco_model_numbers.hpp"
 #include "urdf_actuators.hpp"
 
 namespace gpilqg {
@@ -95,23 +96,27 @@ mjModel* load_urdf(const std::string& path, const std::string& text, char* error
   const std::filesystem::path saved =
       std::filesystem::temp_directory_path(ec) / fmt::format("gpilqg_urdf_{}_{}.xml", ::getpid(), counter++);
   const int ok = mj_saveLastXML(saved.string().c_str(), plain, error, error_size);
-  mj_deleteModel(plain);
   if (!ok) {
+    mj_deleteModel(plain);
     std::filesystem::remove(saved, ec);
     throw std::runtime_error(fmt::format("{}: MuJoCo could not convert the URDF to MJCF: {}", path, one_line(error)));
   }
   std::string mjcf = model_file_text(saved.string());
   std::filesystem::remove(saved, ec);
   const std::size_t end = mjcf.rfind("</mujoco>");
-  if (end == std::string::npos)
+  if (end == std::string::npos) {
+    mj_deleteModel(plain);
     throw std::runtime_error(fmt::format("{}: MuJoCo's MJCF of the URDF has no </mujoco>", path));
+  }
   mjcf.insert(end, additions);
 
   mjVFS vfs;
   mj_defaultVFS(&vfs);
   const std::string name = path + ".gpilqg.xml";
-  if (mj_makeEmptyFileVFS(&vfs, name.c_str(), static_cast<int>(mjcf.size())) != 0)
+  if (mj_makeEmptyFileVFS(&vfs, name.c_str(), static_cast<int>(mjcf.size())) != 0) {
+    mj_deleteModel(plain);
     throw std::runtime_error(fmt::format("{}: MuJoCo could not hold the converted model in memory", path));
+  }
   std::memcpy(vfs.filedata[vfs.nfile - 1], mjcf.data(), mjcf.size());
   mjModel* m = mj_loadXML(name.c_str(), &vfs, error, error_size);
   mj_deleteVFS(&vfs);
@@ -119,7 +124,10 @@ mjModel* load_urdf(const std::string& path, const std::string& text, char* error
     const std::string reason = one_line(error);
     std::snprintf(error, static_cast<std::size_t>(error_size), "with the motors gpilqg adds to its joints: %s",
                   reason.c_str());
+  } else {
+    copy_real_numbers(plain, m);  // the URDF's numbers, not the MJCF writer's 6 digits
   }
+  mj_deleteModel(plain);
   return m;
 }
 
@@ -161,6 +169,8 @@ std::shared_ptr<const MujocoModel> MujocoModel::load(const std::string& path) {
   // One extra userdata slot per mjData holds the passive-force context of the step (mujoco_system.cpp).
   m->nuserdata += 1;
   std::shared_ptr<MujocoModel> model(new MujocoModel(m, path));
+  if (const std::optional<std::string> problem = model_number_problem(m))
+    throw std::invalid_argument(fmt::format("{}: {}", path, *problem));
   // MuJoCo accepts timestep="0"; every step length derived from it would be NaN or infinite.
   if (!(std::isfinite(m->opt.timestep) && m->opt.timestep > 0.0))
     throw std::invalid_argument(fmt::format(

@@ -119,6 +119,57 @@ std::optional<double> finite_number(const std::string& s) {
   return value;
 }
 
+/// The numeric attributes of URDF elements that MuJoCo reads, with their number of values. MuJoCo takes
+/// a NaN or an infinity with a warning only and then drops some (a NaN rpy becomes no rotation) or
+/// carries others into the simulation.
+struct NumericAttribute {
+  const char* element;
+  const char* attribute;
+  int count;
+};
+
+constexpr NumericAttribute kNumericAttributes[] = {
+    {"origin", "xyz", 3},       {"origin", "rpy", 3},        {"axis", "xyz", 3},         {"mass", "value", 1},
+    {"inertia", "ixx", 1},      {"inertia", "ixy", 1},       {"inertia", "ixz", 1},      {"inertia", "iyy", 1},
+    {"inertia", "iyz", 1},      {"inertia", "izz", 1},       {"limit", "lower", 1},      {"limit", "upper", 1},
+    {"limit", "velocity", 1},   {"dynamics", "damping", 1},  {"dynamics", "friction", 1}, {"box", "size", 3},
+    {"cylinder", "radius", 1},  {"cylinder", "length", 1},   {"sphere", "radius", 1},    {"mesh", "scale", 3},
+};
+
+/// Checks every numeric attribute of `t` that MuJoCo reads (kNumericAttributes): `count` finite numbers
+/// separated by spaces, and a joint's damping and friction >= 0 (a negative one adds energy).
+void check_numbers(const Tag& t, const std::string& path) {
+  for (const NumericAttribute& a : kNumericAttributes) {
+    if (t.name != a.element) continue;
+    const auto found = t.attributes.find(a.attribute);
+    if (found == t.attributes.end()) continue;
+    std::vector<std::string> words;
+    std::size_t p = 0;
+    const std::string& text = found->second;
+    while (p < text.size()) {
+      while (p < text.size() && is_space(text[p])) ++p;
+      const std::size_t start = p;
+      while (p < text.size() && !is_space(text[p])) ++p;
+      if (p > start) words.push_back(text.substr(start, p - start));
+    }
+    bool ok = static_cast<int>(words.size()) == a.count;
+    for (const std::string& w : words) ok = ok && finite_number(w).has_value();
+    if (!ok)
+      throw std::invalid_argument(fmt::format("{}: line {}: <{} {}=\"{}\">; expected {} finite number{}", path, t.line,
+                                              a.element, a.attribute, text, a.count, a.count == 1 ? "" : "s"));
+    if (t.name == "dynamics" && *finite_number(words.front()) < 0.0)
+      throw std::invalid_argument(fmt::format(
+          "{}: line {}: <dynamics {}=\"{}\">; expected a value >= 0 (a negative one adds energy: the joint would speed "
+          "itself up)",
+          path, t.line, a.attribute, text));
+  }
+  if (t.name == "limit" && t.attributes.contains("lower") && t.attributes.contains("upper") &&
+      *finite_number(t.attributes.at("lower")) > *finite_number(t.attributes.at("upper")))
+    throw std::invalid_argument(fmt::format("{}: line {}: <limit lower=\"{}\" upper=\"{}\">; expected lower <= upper "
+                                            "(MuJoCo would drop the limits without a word)",
+                                            path, t.line, t.attributes.at("lower"), t.attributes.at("upper")));
+}
+
 /// The name with the characters XML attribute values cannot hold escaped.
 std::string xml_escaped(const std::string& name) {
   std::string escaped;
@@ -203,6 +254,7 @@ std::vector<Joint> read_joints(const std::string& text, const std::string& path)
       --depth;
       continue;
     }
+    check_numbers(t, path);
     const int level = depth + 1;
     if (level == 2 && t.name == "joint") {
       Joint j;

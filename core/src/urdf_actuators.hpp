@@ -13,6 +13,12 @@
 /// line, the joint and the types allowed. A joint with <mimic joint="j" multiplier="a" offset="b"/>
 /// follows joint j, q = a q_j + b: it gets no motor, and the model holds it there by a MuJoCo joint
 /// equality (equality_section), as it holds any other MJCF equality constraint.
+///
+/// Every number MuJoCo reads from the file (an origin, an axis, a mass, an inertia, limits, damping and
+/// friction, a geometry's size) must be finite and have its count of values, a joint's damping and
+/// friction >= 0, and a limit's lower <= upper: MuJoCo takes a NaN with a warning and drops some of
+/// them (a NaN rpy becomes no rotation, limits with lower > upper become no limits), so each is an
+/// error naming the file, the line and the attribute.
 
 #include <optional>
 #include <string>
@@ -39,8 +45,9 @@ struct Joint {
 bool is_urdf(const std::string& text);
 
 /// The joints of a URDF in file order. Throws std::invalid_argument naming `path` (and the line and
-/// joint) for malformed XML, a joint type outside the list above, a bad effort, or a <mimic> without a
-/// finite multiplier and offset or whose joint is not another moving joint of the file.
+/// joint) for malformed XML, a number that breaks the rules above, a joint type outside the list above,
+/// a bad effort, or a <mimic> without a finite multiplier and offset or whose joint is not another
+/// moving joint of the file.
 std::vector<Joint> read_joints(const std::string& text, const std::string& path);
 
 /// The <actuator> section of the motors of `joints` in the order of `model_joints` (MuJoCo's joint

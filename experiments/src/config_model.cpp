@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include <iterator>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -41,13 +42,27 @@ ModelSpec read_config_model(const TomlFields& f, const std::string& path, const 
   return model;
 }
 
+namespace {
+
+/// How every name of config_files starts, and so every header of config_files_text after "# ".
+constexpr std::string_view kConfigFileName = "the config's ";
+
+}  // namespace
+
 std::vector<NamedInput> config_files(const TomlFields& f, const std::vector<std::string>& paths) {
   std::vector<NamedInput> out;
   for (const std::string& path : paths)
     if (f.has(path))
       if (const std::string named = f.string(path); is_model_file_name(named) || is_diagnosis_model_file(named))
-        out.push_back({"the config's " + path, f.file_path(path)});
+        out.push_back({std::string(kConfigFileName) + path, f.file_path(path)});
   return out;
+}
+
+std::string config_file_header(const NamedInput& file) { return fmt::format("# {} = {}", file.name, file.file.string()); }
+
+std::optional<std::string> config_file_of_header(const std::string& line) {
+  if (!line.starts_with("# ") || !std::string_view(line).substr(2).starts_with(kConfigFileName)) return std::nullopt;
+  return line.substr(2);
 }
 
 std::string config_files_text(const std::vector<NamedInput>& files) {
@@ -57,7 +72,7 @@ std::string config_files_text(const std::vector<NamedInput>& files) {
     std::ifstream in(file.file, std::ios::binary);
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (!in.good() && !in.eof()) throw InputError(fmt::format("{}: cannot be read; expected {}", file.file.string(), file.name));
-    out += fmt::format("# {} = {}\n", file.name, file.file.string()) + text;
+    out += config_file_header(file) + '\n' + text;
     if (!text.empty() && text.back() != '\n') out += '\n';
   }
   return out;

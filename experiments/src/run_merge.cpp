@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -16,6 +17,7 @@
 #include "gpilqg/core/output_path.hpp"
 #include "gpilqg/core/utc_time.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/config_model.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
 
@@ -69,8 +71,8 @@ void require_distinct_files(const std::vector<std::filesystem::path>& files, con
   }
 }
 
-/// Where two texts of RunConfig::files_text first differ: the file (its "# <name> = <path>" line) and
-/// the line in it.
+/// Where two texts of RunConfig::files_text first differ: the file (its header, config_file_header)
+/// and the line in it.
 std::string first_difference(const std::string& here, const std::string& there) {
   std::istringstream a(here), b(there);
   std::string line_a, line_b, file = "no file";
@@ -80,8 +82,8 @@ std::string first_difference(const std::string& here, const std::string& there) 
     if (!more_a || !more_b || line_a != line_b)
       return fmt::format("{}, line {}: {} here, {} there", file, line, more_a ? '"' + line_a + '"' : std::string("nothing"),
                          more_b ? '"' + line_b + '"' : std::string("nothing"));
-    if (line_a.rfind("# the config's ", 0) == 0) {
-      file = line_a.substr(2);
+    if (const std::optional<std::string> named = config_file_of_header(line_a)) {
+      file = *named;
       line = 0;
     }
   }

@@ -2,7 +2,9 @@
 // model without actuators loads as a passive system and steps; a URDF's revolute, continuous and
 // prismatic joints get one motor each bounded by the joint's effort limit (effort 0: no motor); bad
 // efforts are errors naming the file and the joint; joint types outside URDF's list are refused; a
-// <mimic> joint follows its leader; measurement files without control columns.
+// <mimic> joint follows its leader; the file's numbers reach the model to the last digit, and numbers
+// MuJoCo would take with a warning or drop are refused (URDF and MJCF); measurement files without
+// control columns.
 
 #include <fstream>
 #include <iterator>
@@ -190,6 +192,84 @@ TEST(UrdfRobot, AJointTypeOutsideUrdfsListIsAnErrorNamingTheLineAndTheJoint) {
                                          : "expected one of revolute, continuous, prismatic, fixed, floating"),
               std::string::npos)
         << type << ": " << what;
+  }
+}
+
+/// `file`'s text with `from` replaced by `to` (which must occur), written to dir / name.
+fs::path replaced(const fs::path& file, const std::string& from, const std::string& to, const fs::path& dir,
+                  const std::string& name) {
+  std::ifstream in(file);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  const fs::path out = dir / name;
+  std::ofstream(out) << text;
+  return out;
+}
+
+double parameter_value(const MujocoSystem& system, const std::string& name) {
+  for (const Parameter& p : system.parameters())
+    if (p.name == name) return p.value;
+  ADD_FAILURE() << "no parameter " << name;
+  return 0.0;
+}
+
+// A URDF reaches MuJoCo through its MJCF writer, which keeps 6 significant digits and writes an
+// integral value beyond 2^31 as -2147483648: the model simulates the file's own numbers.
+TEST(UrdfRobot, TheFilesNumbersReachTheModelToTheLastDigit) {
+  const fs::path dir = test::temporary_dir("urdf_digits");
+  const fs::path mass = replaced(urdf_arm_path(), R"(<mass value="1.0"/>)", R"(<mass value="1.23456789012345"/>)", dir,
+                                 "mass.urdf");
+  const fs::path both = replaced(mass, R"(<dynamics damping="0.05"/>)", R"(<dynamics damping="3000000000"/>)", dir,
+                                 "both.urdf");
+  const auto arm = MujocoSystem::load(both.string());
+  EXPECT_EQ(parameter_value(*arm, "upper_arm.mass"), 1.23456789012345);
+  EXPECT_EQ(parameter_value(*arm, "shoulder.damping"), 3e9);
+  EXPECT_EQ(parameter_value(*arm, "elbow.damping"), 0.05);
+  EXPECT_EQ(arm->control_dim(), 2);  // the motors of the converted model are there
+}
+
+// MuJoCo takes a NaN with a warning and drops some numbers without a word (a NaN rpy becomes no
+// rotation, lower > upper no limits, a NaN axis the default one): each is refused naming the line.
+TEST(UrdfRobot, ANumberMujocoWouldDropOrTakeWithAWarningIsRefusedNamingTheLine) {
+  const fs::path dir = test::temporary_dir("urdf_numbers");
+  const std::string arm = urdf_arm_path();
+  const struct {
+    std::string from, to, expected;
+  } cases[] = {
+      {R"(<axis xyz="0 1 0"/>)", R"(<axis xyz="nan 1 0"/>)", R"(: line 26: <axis xyz="nan 1 0">; expected 3 finite numbers)"},
+      {R"(<axis xyz="0 1 0"/>)", R"(<axis xyz="0 1"/>)", R"(: line 26: <axis xyz="0 1">; expected 3 finite numbers)"},
+      {R"(<origin xyz="0 0 -0.5"/>)", R"(<origin xyz="0 0 -0.5" rpy="nan 0 0"/>)", R"(: line 33: <origin rpy="nan 0 0">)"},
+      {R"(<mass value="1.0"/>)", R"(<mass value="abc"/>)", R"(: line 11: <mass value="abc">; expected 1 finite number)"},
+      {R"(ixx="0.021")", R"(ixx="inf")", R"(: line 12: <inertia ixx="inf">)"},
+      {R"(lower="-3.0" upper="3.0")", R"(lower="3.0" upper="-3.0")", R"(: line 27: <limit lower="3.0" upper="-3.0">; expected lower <= upper)"},
+      {R"(<dynamics damping="0.05"/>)", R"(<dynamics damping="-5"/>)", R"(: line 28: <dynamics damping="-5">; expected a value >= 0)"},
+      {R"(<dynamics damping="0.05"/>)", R"(<dynamics damping="0.05" friction="-1"/>)", R"(: line 28: <dynamics friction="-1">; expected a value >= 0)"},
+  };
+  for (const auto& c : cases) {
+    const fs::path file = replaced(arm, c.from, c.to, dir, "arm.urdf");
+    EXPECT_NE(load_error(file).find(file.string() + c.expected), std::string::npos) << c.to << ": " << load_error(file);
+  }
+}
+
+// The same in an MJCF model, after MuJoCo compiled it: a NaN (read with a warning only), a negative
+// damping, armature or friction loss.
+TEST(MujocoModelNumbers, ANumberThatIsNotFiniteOrAddsEnergyIsRefusedNamingTheJoint) {
+  const fs::path dir = test::temporary_dir("mjcf_numbers");
+  const std::string pendulum = pendulum_path();
+  const struct {
+    std::string from, to, expected;
+  } cases[] = {
+      {R"(axis="0 1 0")", R"(axis="0 nan 0")", "joint 'swing': jnt_axis is (nan, nan, nan); expected finite numbers"},
+      {R"(damping="0.02")", R"(damping="-0.02")", "joint 'swing': damping is -0.02; expected a value >= 0"},
+      {R"(damping="0.02")", R"(damping="0.02" armature="-1")", "joint 'swing': armature is -1; expected a value >= 0"},
+      {R"(damping="0.02")", R"(damping="0.02" frictionloss="-1")", "joint 'swing': frictionloss is -1; expected a value >= 0"},
+      {R"(gravity="0 0 -9.81")", R"(gravity="0 0 nan")", "<option gravity>: entry 2 is nan; expected finite numbers"},
+  };
+  for (const auto& c : cases) {
+    const fs::path file = replaced(pendulum, c.from, c.to, dir, "pendulum.xml");
+    EXPECT_NE(load_error(file).find(file.string() + ": " + c.expected), std::string::npos) << c.to << ": " << load_error(file);
   }
 }
 

@@ -295,26 +295,30 @@ std::vector<SampledRow> sampled_rows(const Dynamics& model, const MeasurementSet
   return out;
 }
 
+/// The noise of each control, which both residuals carry (b_v n_u in acceleration units), the
+/// inverse-dynamics one seen through the filter (|m|^2 of its variance).
+Vector controls_noise(const MeasurementSet& data, int controls) {
+  Vector out(controls);
+  for (int j = 0; j < controls; ++j) {
+    std::vector<Vector> columns;
+    for (const Episode& e : data.episodes) columns.push_back(e.u.col(j));
+    out(j) = robust_noise_std(columns, 1, 2);
+  }
+  return out;
+}
+
 /// rho of velocity state `state` with the acceleration estimate `estimate` (the one filter of every
 /// coordinate, accelerations.hpp) of the column `differentiated` (the state itself or its measured
 /// position); `own` the model's derivatives at the samples (model_derivatives), `forces` its
-/// generalised forces there (model_forces) and `sampled` the rows it averages over (sampled_rows).
-StateRatio state_ratio(const Dynamics& model, const MeasurementSet& data, const std::vector<Matrix>& own,
-                       const std::vector<Matrix>& forces, const std::vector<SampledRow>& sampled, int state,
+/// generalised forces there (model_forces), `sampled` the rows it averages over (sampled_rows) and
+/// `control_noise` the noise of each control (controls_noise).
+StateRatio state_ratio(const MeasurementSet& data, const std::vector<Matrix>& own, const std::vector<Matrix>& forces,
+                       const std::vector<SampledRow>& sampled, const Vector& control_noise, int state,
                        int differentiated, double dt, const AccelerationFilter& estimate) {
   const std::vector<Vector> segments = state_segments(data, state);
   const int window = estimate.window;
   StateRatio out;
   if (segments.empty()) return out;
-  // The noise of the controls, which both residuals carry (b_v n_u in acceleration units), the
-  // inverse-dynamics one seen through the filter (|m|^2 of its variance).
-  const int m = model.control_dim();
-  Vector control_noise(m);
-  for (int j = 0; j < m; ++j) {
-    std::vector<Vector> columns;
-    for (const Episode& e : data.episodes) columns.push_back(e.u.col(j));
-    control_noise(j) = robust_noise_std(columns, 1, 2);
-  }
   out.window = window;
   const SavitzkyGolayDerivative filter(window, estimate.order, estimate.derivative);
   // The weights on the accelerations at every place in the window (accelerations.hpp), for a
@@ -557,10 +561,12 @@ CriterionChoice choose_criterion(const MeasurementSet& data, const ModelSpec& mo
                         : std::vector<Matrix>();
   const std::vector<SampledRow> sampled =
       filter.window > 0 ? sampled_rows(*dynamics, data, filter.window) : std::vector<SampledRow>();
+  const Vector control_noise = controls_noise(data, dynamics->control_dim());
   for (std::size_t i = 0; i < coordinates.size(); ++i) {
     if (filter.window == 0) break;
     const GeneralisedCoordinate& c = coordinates[i];
-    const StateRatio r = state_ratio(*dynamics, data, own, forces, sampled, c.velocity, columns.states[i], facts.dt, filter);
+    const StateRatio r =
+        state_ratio(data, own, forces, sampled, control_noise, c.velocity, columns.states[i], facts.dt, filter);
     const std::string name = data.system.states[static_cast<std::size_t>(c.velocity)].name;
     if (r.ratio < facts.ratio || facts.ratio_state.empty()) {
       facts.ratio = r.ratio;

@@ -9,6 +9,7 @@
 /// x_{t+1} = f_sim(x_t, u_t) + GP residual): what the diagnosis named, the model already has, and the
 /// GP learns only what it still misses.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,13 @@ bool is_diagnosis_model_file(const std::string& name);
 /// as {"the config's <field>", path}. What a command that reads the config must not overwrite.
 std::vector<NamedInput> config_files(const TomlFields& fields, const std::vector<std::string>& paths);
 
-/// The text of each of `files`, each after a line "# <name> = <path>": what a run read from them,
+/// The line that starts each file's text in config_files_text: "# <name> = <path>".
+std::string config_file_header(const NamedInput& file);
+
+/// "<name> = <path>" when `line` is a header of config_files_text, nothing otherwise.
+std::optional<std::string> config_file_of_header(const std::string& line);
+
+/// The text of each of `files`, each after its header (config_file_header): what a run read from them,
 /// part of its identity (a resumed run and the parts of a merge must have read the same texts).
 /// Throws InputError naming a file that cannot be read.
 std::string config_files_text(const std::vector<NamedInput>& files);
