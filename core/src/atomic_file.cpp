@@ -15,6 +15,8 @@
 #include <string_view>
 #include <system_error>
 
+#include "gpilqg/core/fnv_hash.hpp"
+
 namespace gpilqg {
 
 namespace {
@@ -73,9 +75,7 @@ std::string previous_state(const std::filesystem::path& target) {
 std::string temporary_stem(const std::string& name) {
   constexpr std::size_t kSuffixRoom = 48;  // ".tmp-" + two 20-digit numbers + "-", rounded up
   if (name.size() + kSuffixRoom <= kMaxFileNameBytes) return name;
-  std::uint64_t hash = 14695981039346656037ull;
-  for (const unsigned char c : name) hash = (hash ^ c) * 1099511628211ull;
-  return name.substr(0, kMaxFileNameBytes - kSuffixRoom - 9) + fmt::format("~{:08x}", hash & 0xffffffffull);
+  return name.substr(0, kMaxFileNameBytes - kSuffixRoom - 9) + fmt::format("~{:08x}", fnv1a_64(name) & 0xffffffffull);
 }
 
 void write_through_temporary(const std::filesystem::path& target, bool copy_existing,

@@ -14,6 +14,7 @@
 #include <tinyxml2.h>
 
 #include "gpilqg/core/input_file.hpp"
+#include "gpilqg/core/mujoco_system.hpp"
 
 namespace gpilqg {
 
@@ -64,19 +65,23 @@ class Scan {
     walk(document.RootElement(), source, depth);
   }
 
-  /// Checks the asset files with the folders of the last <compiler> attributes.
-  void check_assets() const {
+  /// Checks the asset files with the folders of the last <compiler> attributes; records those that exist.
+  void check_assets() {
     for (const Named& named : assets_) {
       const bool texture = named.folder == Named::Folder::Texture;
       std::string file = named.file;
       if (named.folder == Named::Folder::UrdfMesh && strip_path_) file = fs::path(file).filename().string();
-      check_named_file(resolved(file, texture ? texture_dir_ : mesh_dir_), kMaxDataFileBytes,
-                       description(texture ? "a texture file" : named.element == "hfield" ? "a height-field file"
-                                                              : named.element == "skin"  ? "a skin file"
-                                                                                         : "a mesh file",
-                                   named));
+      const std::string what = texture                    ? "a texture file"
+                               : named.element == "hfield" ? "a height-field file"
+                               : named.element == "skin"   ? "a skin file"
+                                                           : "a mesh file";
+      const std::string path = resolved(file, texture ? texture_dir_ : mesh_dir_);
+      if (check_named_file(path, kMaxDataFileBytes, description(what, named))) found(path, what);
     }
   }
+
+  /// The included files and existing assets, in the order they were found.
+  const std::vector<ModelDependency>& dependencies() const { return dependencies_; }
 
  private:
   /// Where MuJoCo looks for the asset `file` of a folder attribute `folder` (meshdir, texturedir).
@@ -119,7 +124,15 @@ class Scan {
     std::error_code error;
     const fs::path canonical = fs::weakly_canonical(file, error);
     if (depth >= kMaxIncludeDepth || !included_.insert(error ? file : canonical.string()).second) return;
+    found(file, "an included MJCF file");
     walk_text(model_file_text(file), file, depth + 1);
+  }
+
+  /// Records `file` once (by its canonical path).
+  void found(const std::string& file, const std::string& what) {
+    std::error_code error;
+    const fs::path canonical = fs::weakly_canonical(file, error);
+    if (seen_.insert(error ? file : canonical.string()).second) dependencies_.push_back({file, what});
   }
 
   std::string model_dir_;
@@ -127,6 +140,8 @@ class Scan {
   bool strip_path_ = true;  // URDF only: MuJoCo's default for URDF mesh names
   std::vector<Named> assets_;
   std::set<std::string> included_;
+  std::set<std::string> seen_;
+  std::vector<ModelDependency> dependencies_;
 };
 
 }  // namespace
@@ -135,6 +150,14 @@ void check_mujoco_model_files(const std::string& path, const std::string& text) 
   Scan scan(path);
   scan.walk_text(text, path, 0);
   scan.check_assets();
+}
+
+std::vector<ModelDependency> mujoco_model_dependencies(const std::string& path) {
+  check_input_file_as<std::invalid_argument>(path, kMaxConfigFileBytes, "a MuJoCo model file (MJCF or URDF)");
+  Scan scan(path);
+  scan.walk_text(model_file_text(path), path, 0);
+  scan.check_assets();
+  return scan.dependencies();
 }
 
 std::string model_file_text(const std::string& file) {

@@ -1,12 +1,17 @@
 #include "gpilqg/experiments/config_model.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
 #include <fstream>
 #include <iterator>
 #include <string_view>
 
 #include <fmt/format.h>
 
+#include "gpilqg/core/fnv_hash.hpp"
 #include "gpilqg/core/input_file.hpp"
+#include "gpilqg/core/mujoco_system.hpp"
 #include "gpilqg/core/system_registry.hpp"
 
 #include "gpilqg/core/output_path.hpp"
@@ -51,10 +56,21 @@ constexpr std::string_view kConfigFileName = "the config's ";
 
 std::vector<NamedInput> config_files(const TomlFields& f, const std::vector<std::string>& paths) {
   std::vector<NamedInput> out;
-  for (const std::string& path : paths)
-    if (f.has(path))
-      if (const std::string named = f.string(path); is_model_file_name(named) || is_diagnosis_model_file(named))
-        out.push_back({std::string(kConfigFileName) + path, f.file_path(path)});
+  for (const std::string& path : paths) {
+    if (!f.has(path)) continue;
+    const std::string named = f.string(path);
+    if (!is_model_file_name(named) && !is_diagnosis_model_file(named)) continue;
+    const std::string name = std::string(kConfigFileName) + path;
+    out.push_back({name, f.file_path(path)});
+    if (!is_model_file_name(named)) continue;
+    // A MuJoCo model's included files and assets are the model too.
+    try {
+      for (const ModelDependency& d : mujoco_model_dependencies(f.file_path(path).string()))
+        out.push_back({fmt::format("{}'s {}", name, d.what.substr(d.what.find(' ') + 1)), d.file});
+    } catch (const std::invalid_argument& e) {
+      f.fail(path, e.what());
+    }
+  }
   return out;
 }
 
@@ -65,15 +81,40 @@ std::optional<std::string> config_file_of_header(const std::string& line) {
   return line.substr(2);
 }
 
+namespace {
+
+/// A file kept in a run's identity by its text: a model's own text (MJCF, URDF, a model file of the
+/// diagnosis), not an asset such as a mesh.
+bool kept_as_text(const std::filesystem::path& file) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  return extension == ".xml" || extension == ".urdf" || extension == ".toml";
+}
+
+}  // namespace
+
 std::string config_files_text(const std::vector<NamedInput>& files) {
   std::string out;
   for (const NamedInput& file : files) {
-    check_input_file_as<InputError>(file.file, kMaxConfigFileBytes, "a file the config names");
+    const bool text_file = kept_as_text(file.file);
+    check_input_file_as<InputError>(file.file, text_file ? kMaxConfigFileBytes : kMaxDataFileBytes, "a file the config names");
     std::ifstream in(file.file, std::ios::binary);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (!in.good() && !in.eof()) throw InputError(fmt::format("{}: cannot be read; expected {}", file.file.string(), file.name));
-    out += config_file_header(file) + '\n' + text;
-    if (!text.empty() && text.back() != '\n') out += '\n';
+    std::string text;
+    std::uint64_t hash = kFnvOffsetBasis, bytes = 0;
+    for (char chunk[1 << 16]; in.read(chunk, sizeof chunk) || in.gcount() > 0;) {
+      const std::string_view read(chunk, static_cast<std::size_t>(in.gcount()));
+      if (text_file) text += read;
+      hash = fnv1a_64(read, hash);
+      bytes += read.size();
+    }
+    if (in.bad()) throw InputError(fmt::format("{}: cannot be read; expected {}", file.file.string(), file.name));
+    out += config_file_header(file) + '\n';
+    if (text_file) {
+      out += text;
+      if (!text.empty() && text.back() != '\n') out += '\n';
+    } else {
+      out += fmt::format("{} bytes, FNV-1a 64 hash {:016x}\n", bytes, hash);
+    }
   }
   return out;
 }

@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include "gpilqg/core/fnv_hash.hpp"
 #include "gpilqg/core/integrator.hpp"
 #include "gpilqg/core/systems.hpp"
 
@@ -38,9 +39,9 @@ std::uint64_t derive_seed(std::uint64_t seed, int task, RandomStream stream, std
 }
 
 std::uint64_t stream_id(const std::string& algorithm) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (const char ch : algorithm) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
-  return h;
+  // FNV-1a from 1469598103934665603, the offset basis without its last digit: every random stream of a
+  // run derives from these numbers, so they stay as they are.
+  return fnv1a_64(algorithm, 1469598103934665603ull);
 }
 
 std::uint64_t gp_fit_seed(std::uint64_t seed, int task, const std::string& algorithm, int rows) {

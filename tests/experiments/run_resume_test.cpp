@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include "gpilqg/core/atomic_file.hpp"
+#include "gpilqg/experiments/config_model.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
 #include "result_files.hpp"
 #include "same_run_results.hpp"
@@ -156,6 +157,46 @@ TEST(RunResume, AModelFileTheConfigNamesThatWasEditedSinceIsRefused) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("other texts of the files its config names"), std::string::npos) << e.what();
   }
+  std::filesystem::remove_all(dir);
+}
+
+// A MuJoCo model's included files and assets are part of the run too: a --resume after the file the
+// model includes was edited is refused; an asset (a mesh) is kept by its size and FNV-1a hash.
+TEST(RunResume, AFileTheMujocoModelIncludesThatWasEditedSinceIsRefused) {
+  const auto dir = test::temporary_dir("run_resume_included_file");
+  const auto folder = dir / "r.h5.checkpoint";
+  std::string arm = read_file_bytes(test::source_dir() / "data" / "two_link_arm.xml");
+  const std::size_t begin = arm.find("<actuator>"), end = arm.find("</actuator>") + std::string("</actuator>").size();
+  ASSERT_NE(begin, std::string::npos);
+  const std::string motors = arm.substr(begin, end - begin);
+  arm.replace(begin, end - begin, "<include file=\"motors.xml\"/>");
+  test::write_text(dir / "arm.xml", arm);
+  const auto included = test::write_text(dir / "motors.xml", "<mujoco>\n" + motors + "\n</mujoco>\n");
+  std::string run = read_file_bytes(test::source_dir() / "data" / "two_link_arm_run.toml");
+  run.replace(run.find("name = \"two_link_arm.xml\""), std::string("name = \"two_link_arm.xml\"").size(), "name = \"arm.xml\"");
+  const auto config_file = test::write_text(dir / "c.toml", run);
+  const std::string system = (dir / "arm.xml").string();
+  const RunConfig config = load_run_config(system, config_file);
+  ASSERT_EQ(config.files.size(), 2u);
+  EXPECT_EQ(config.files[1].name, "the config's system.name's included MJCF file");
+  EXPECT_NE(config.files_text.find("# the config's system.name's included MJCF file = " + included.string() + "\n<mujoco>"),
+            std::string::npos)
+      << config.files_text;
+  RunCheckpoint::create(folder, config, two_seeds());
+  EXPECT_NO_THROW(RunCheckpoint::resume(folder, load_run_config(system, config_file), two_seeds()));
+  std::string geared = motors;
+  geared.replace(geared.find("gear=\"1\""), 8, "gear=\"2\"");
+  test::write_text(included, "<mujoco>\n" + geared + "\n</mujoco>\n");
+  try {
+    RunCheckpoint::resume(folder, load_run_config(system, config_file), two_seeds());
+    ADD_FAILURE() << "a checkpoint resumed with an edited included file";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("other texts of the files its config names"), std::string::npos) << e.what();
+  }
+  // An asset by its size and hash: "a" is FNV-1a 64's published test vector.
+  const auto mesh = test::write_text(dir / "a.stl", "a");
+  EXPECT_EQ(config_files_text({{"the config's system.name's mesh file", mesh}}),
+            "# the config's system.name's mesh file = " + mesh.string() + "\n1 bytes, FNV-1a 64 hash af63dc4c8601ec8c\n");
   std::filesystem::remove_all(dir);
 }
 

@@ -33,6 +33,7 @@
 /// belongs to the caller's workspace (make_workspace()), and every call sets the whole state first, so
 /// results never depend on the workspace's history and any number of threads can step one model.
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -132,5 +133,17 @@ SystemEntry mujoco_system_entry(const std::string& path);
 /// joint_coulomb_friction:<joint>, actuator_gain:<actuator>, external_force_{x,y,z}:<body>, then
 /// param:<field> for every parameter except the gains.
 std::vector<LibraryEffect> mujoco_effect_library(const MujocoSystem& system);
+
+/// A file a MuJoCo model reads besides itself: an MJCF file it includes (`<include file>`, also nested),
+/// or an asset that exists (a mesh, skin, height-field or texture file; a URDF's `<mesh filename>`), found
+/// the way MuJoCo 2.2 finds it. `what` says which, e.g. "an included MJCF file", "a mesh file".
+struct ModelDependency {
+  std::filesystem::path file;
+  std::string what;
+};
+
+/// The files the model at `path` reads besides itself, in document order (each once): part of what a
+/// run depends on. Throws std::invalid_argument naming a file that cannot be read.
+std::vector<ModelDependency> mujoco_model_dependencies(const std::string& path);
 
 }  // namespace gpilqg

@@ -34,7 +34,9 @@ bool is_diagnosis_model_file(const std::string& name);
 
 /// The files a config names, resolved against its folder (TomlFields::file_path): each field of
 /// `fields` that is given and names a file (a MuJoCo model or URDF, or a model file of the diagnosis),
-/// as {"the config's <field>", path}. What a command that reads the config must not overwrite.
+/// as {"the config's <field>", path}, and after a MuJoCo model the files it includes and its assets
+/// (mujoco_model_dependencies), as {"the config's <field>'s mesh file", path}. What a command that
+/// reads the config must not overwrite, and what a run depends on.
 std::vector<NamedInput> config_files(const TomlFields& fields, const std::vector<std::string>& paths);
 
 /// The line that starts each file's text in config_files_text: "# <name> = <path>".
@@ -43,7 +45,8 @@ std::string config_file_header(const NamedInput& file);
 /// "<name> = <path>" when `line` is a header of config_files_text, nothing otherwise.
 std::optional<std::string> config_file_of_header(const std::string& line);
 
-/// The text of each of `files`, each after its header (config_file_header): what a run read from them,
+/// The text of each of `files` (an asset, a file not ending in .xml, .urdf or .toml: its size and
+/// FNV-1a hash), each after its header (config_file_header): what a run read from them,
 /// part of its identity (a resumed run and the parts of a merge must have read the same texts).
 /// Throws InputError naming a file that cannot be read.
 std::string config_files_text(const std::vector<NamedInput>& files);
