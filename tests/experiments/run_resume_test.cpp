@@ -8,6 +8,7 @@
 #include <chrono>
 #include <csignal>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <thread>
 
@@ -22,6 +23,7 @@
 #include "gpilqg/core/atomic_file.hpp"
 #include "gpilqg/experiments/config_model.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
+#include "finite_checks.hpp"
 #include "result_files.hpp"
 #include "same_run_results.hpp"
 #include "test_support.hpp"
@@ -198,6 +200,58 @@ TEST(RunResume, AFileTheMujocoModelIncludesThatWasEditedSinceIsRefused) {
   EXPECT_EQ(config_files_text({{"the config's system.name's mesh file", mesh}}),
             "# the config's system.name's mesh file = " + mesh.string() + "\n1 bytes, FNV-1a 64 hash af63dc4c8601ec8c\n");
   std::filesystem::remove_all(dir);
+}
+
+/// A journal that hands a checkpoint every run with its first solve diverged: cost and gradient norm
+/// not finite, as DdpSolver reports a backward pass that met a NaN.
+class DivergedSolves : public RunJournal {
+ public:
+  explicit DivergedSolves(RunCheckpoint& checkpoint) : checkpoint_(checkpoint) {}
+  std::optional<AlgorithmRun> restore(const TaskContext& context, std::uint64_t seed, const std::string& name) const override {
+    return checkpoint_.restore(context, seed, name);
+  }
+  void save(const TaskContext& context, std::uint64_t seed, const AlgorithmRun& run) override {
+    AlgorithmRun diverged = run;
+    IterationRecord& first = diverged.iterations.front();
+    first.plan.summary.final_gradient_norm = std::numeric_limits<double>::infinity();
+    first.plan.summary.final_cost = std::numeric_limits<double>::infinity();
+    first.plan.predicted_cost = std::numeric_limits<double>::infinity();
+    checkpoint_.save(context, seed, diverged);
+    ++saves;
+    const std::optional<AlgorithmRun> back = checkpoint_.restore(context, seed, run.name);
+    restored_infinite = restored_infinite && back && std::isinf(back->iterations.front().plan.summary.final_gradient_norm) &&
+                        std::isinf(back->iterations.front().plan.summary.final_cost) &&
+                        std::isinf(back->iterations.front().plan.predicted_cost);
+  }
+  int saves = 0;
+  bool restored_infinite = true;
+
+ private:
+  RunCheckpoint& checkpoint_;
+};
+
+// Every number of a checkpoint file is finite: a diverged solve's cost and gradient norm are left out
+// and read back as not finite.
+TEST(RunResume, ACheckpointHoldsFiniteNumbersOnlyAndReadsADivergedSolveBack) {
+  const RunConfig config = test::tiny_run_config();
+  const auto folder = test::temporary_dir("run_resume_finite") / "run.h5.checkpoint";
+  RunOptions options;
+  options.seeds = {3};
+  RunCheckpoint checkpoint = RunCheckpoint::create(folder, config, options);
+  DivergedSolves journal(checkpoint);
+  options.journal = &journal;
+  run_experiment(config, options);
+  ASSERT_GT(journal.saves, 0);
+  int files = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder))
+    if (entry.path().extension() == ".h5" && entry.path().filename() != "manifest.h5") {  // attributes only
+      ++files;
+      EXPECT_TRUE(test::hdf5_datasets_finite(entry.path())) << entry.path();
+    }
+  EXPECT_GT(files, 0);
+  EXPECT_TRUE(journal.restored_infinite);
+  checkpoint.remove();
+  std::filesystem::remove_all(folder.parent_path());
 }
 
 TEST(RunResume, ADamagedManifestIsReportedAsADamagedCheckpointWithTheWayToStartOver) {
