@@ -25,12 +25,14 @@ CompactBackend::CompactBackend(CompactOptions options) : options_(options) { opt
 std::unique_ptr<MarginalLikelihoodObjective> CompactBackend::objective(const TrainingSet& data,
                                                                        const FitOptions& options) const {
   validate_training_set(data, "CompactBackend::objective");
+  refuse_known_noise(data, name());
   options.validate();
   return detail::make_compact_objective(data, options, options_);
 }
 
 std::unique_ptr<FittedGp> CompactBackend::condition(TrainingSet data, const VectorCRef& parameters,
                                                     const JitterSchedule& jitter) const {
+  refuse_known_noise(data, name());
   validate_training_set(data, "CompactBackend::condition");
   jitter.validate();
   return detail::make_compact_fitted_gp(std::move(data), parameters, jitter, options_);

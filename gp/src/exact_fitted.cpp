@@ -33,10 +33,13 @@ class ExactFittedGp final : public FittedGp {
     const double sf2 = predictor_.signal_variance();
     const Eigen::Index n = data_.size();
     Matrix factor;
-    auto fill = [this, threads, sf2](Matrix& k) {
+    const Vector& known = data_.noise_variance;  // K = Kf + diag(sn^2 + v_i) (TrainingSet::noise_variance)
+    auto fill = [this, threads, sf2, &known](Matrix& k) {
       kernel_lower(data_.inputs, predictor_.inverse_squared_lengthscales(), sf2, k, threads);
+      if (known.size() > 0) k.diagonal() += known;
     };
-    const FactorOutcome outcome = cholesky_with_jitter(n, fill, sf2, h.noise_variance(), jitter, factor, threads);
+    const FactorOutcome outcome = cholesky_with_jitter(n, fill, sf2 + (known.size() > 0 ? known.mean() : 0.0),
+                                                       h.noise_variance(), jitter, factor, threads);
     if (outcome.status == FactorStatus::Failed)
       throw std::runtime_error("ExactGpBackend::condition: K is not positive definite even with jitter " +
                                std::to_string(outcome.jitter) + " on " + std::to_string(n) + " points");

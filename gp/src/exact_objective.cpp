@@ -31,7 +31,8 @@ class ExactObjective final : public MarginalLikelihoodObjective {
   ParameterBounds bounds() const override { return hyperparameter_bounds(data_, min_noise_std_, min_noise_ratio_); }
   Vector initial_parameters() const override { return initial_hyperparameters(data_).pack(); }
 
-  /// nlml (GPML eq. 2.30) and its gradient (GPML eq. 5.9) with W = K^-1 - alpha alpha':
+  /// nlml (GPML eq. 2.30) and its gradient (GPML eq. 5.9) with W = K^-1 - alpha alpha', K = Kf +
+  /// diag(sn^2 + v_i) (v_i known, fixed: they add no term to the gradient):
   ///   d/d log l_d = 0.5 sum_ij W_ij Kf_ij (x_id - x_jd)^2 / l_d^2
   ///   d/d log sf  = sum_ij W_ij Kf_ij,     d/d log sn = sn^2 tr(W)
   /// Only the lower triangle is touched (W and Kf are symmetric, the diagonal of (x_i - x_j)^2 is 0).
@@ -44,8 +45,15 @@ class ExactObjective final : public MarginalLikelihoodObjective {
     const double noise_variance = std::exp(2.0 * theta(d + 1));
     if (kernel_.rows() != n) kernel_.resize(n, n);
     kernel_lower(data_.inputs, inverse_squared_lengthscales, signal_variance, kernel_, threads_);
-    const FactorOutcome outcome =
-        cholesky_with_jitter(kernel_, noise_variance, jitter_, factor_, threads_);
+    // K = Kf + diag(sn^2 + v_i): v the known noise variances (TrainingSet::noise_variance), if any.
+    const Vector& known = data_.noise_variance;
+    const auto fill = [this, n, &known](Matrix& target) {
+      for (Eigen::Index j = 0; j < n; ++j) target.col(j).tail(n - j) = kernel_.col(j).tail(n - j);
+      if (known.size() > 0) target.diagonal() += known;
+    };
+    const FactorOutcome outcome = cholesky_with_jitter(
+        n, fill, kernel_.diagonal().mean() + (known.size() > 0 ? known.mean() : 0.0), noise_variance, jitter_, factor_,
+        threads_);
     NlmlEvaluation result{0.0, outcome.status, outcome.jitter};
     if (outcome.status == FactorStatus::Failed) {
       result.value = std::numeric_limits<double>::infinity();

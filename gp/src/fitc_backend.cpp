@@ -85,6 +85,7 @@ FitcBackend::FitcBackend(FitcOptions options) : options_(std::move(options)) { o
 std::unique_ptr<MarginalLikelihoodObjective> FitcBackend::objective(const TrainingSet& data,
                                                                     const FitOptions& options) const {
   validate_training_set(data, "FitcBackend::objective");
+  refuse_known_noise(data, name());
   options.validate();
   FitcLikelihood likelihood(data.inputs, data.targets, std::min(options_.inducing, data.size()), options_.jitter,
                             options.jitter, options_.threads);
@@ -95,6 +96,7 @@ std::unique_ptr<MarginalLikelihoodObjective> FitcBackend::objective(const Traini
 
 std::unique_ptr<FittedGp> FitcBackend::condition(TrainingSet data, const VectorCRef& parameters,
                                                  const JitterSchedule& jitter) const {
+  refuse_known_noise(data, name());
   return sparse_detail::condition<FitcTraits>(
       std::move(data), parameters, jitter, [&](const FitcLayout& layout, const TrainingSet& d) {
         return FitcLikelihood(d.inputs, d.targets, layout.inducing, options_.jitter, jitter, options_.threads);

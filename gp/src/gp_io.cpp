@@ -148,6 +148,8 @@ void write_fitted_gp(H5::H5File& h5, const std::string& group_path, const Fitted
   write_dataset(group, "parameters", model.parameters().transpose(), true);
   write_dataset(group, "inputs", model.training_set().inputs, false);
   write_dataset(group, "targets", model.training_set().targets.transpose(), true);
+  if (model.training_set().noise_variance.size() > 0)
+    write_dataset(group, "noise_variance", model.training_set().noise_variance.transpose(), true);
 }
 
 /// Runs `edit` on `file` opened for writing (created when missing) as one atomic update: the edit
@@ -230,6 +232,13 @@ std::unique_ptr<FittedGp> load_fitted_gp(const std::filesystem::path& file, cons
   if (data.targets.size() != data.inputs.rows())
     throw fail(group_path + "/targets", "has " + std::to_string(data.targets.size()) + " entries; expected " +
                                             std::to_string(data.inputs.rows()) + " (one per input row)");
+  if (group.nameExists("noise_variance")) {  // known noise variances (TrainingSet::noise_variance)
+    data.noise_variance = read("noise_variance", 1).col(0);
+    if (data.noise_variance.size() != data.targets.size())
+      throw fail(group_path + "/noise_variance", "has " + std::to_string(data.noise_variance.size()) +
+                                                     " entries; expected " + std::to_string(data.targets.size()) +
+                                                     " (one per target)");
+  }
   return naming_the_file(file, group_path, [&] { return backend.condition(std::move(data), parameters.col(0)); });
 }
 

@@ -82,6 +82,7 @@ SsgpBackend::SsgpBackend(SsgpOptions options) : options_(std::move(options)) { o
 std::unique_ptr<MarginalLikelihoodObjective> SsgpBackend::objective(const TrainingSet& data,
                                                                     const FitOptions& options) const {
   validate_training_set(data, "SsgpBackend::objective");
+  refuse_known_noise(data, name());
   options.validate();
   SsgpLikelihood likelihood(data.inputs, data.targets, options_.frequencies, options.jitter, options_.threads);
   auto [initial, bounds] = ssgp_start(likelihood, data, options_, options);
@@ -91,6 +92,7 @@ std::unique_ptr<MarginalLikelihoodObjective> SsgpBackend::objective(const Traini
 
 std::unique_ptr<FittedGp> SsgpBackend::condition(TrainingSet data, const VectorCRef& parameters,
                                                  const JitterSchedule& jitter) const {
+  refuse_known_noise(data, name());
   return sparse_detail::condition<SsgpTraits>(
       std::move(data), parameters, jitter, [&](const SsgpLayout& layout, const TrainingSet& d) {
         return SsgpLikelihood(d.inputs, d.targets, layout.frequencies, jitter, options_.threads);

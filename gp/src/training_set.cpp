@@ -10,6 +10,13 @@
 
 namespace gpilqg::gp {
 
+void refuse_known_noise(const TrainingSet& data, std::string_view backend) {
+  if (data.noise_variance.size() > 0)
+    throw std::invalid_argument("backend '" + std::string(backend) +
+                                "' does not take a known noise variance per point; expected the exact backend, or "
+                                "no known noise variances");
+}
+
 TrainingSet TrainingSet::subset(const std::vector<int>& indices) const {
   TrainingSet out;
   out.inputs.resize(static_cast<Eigen::Index>(indices.size()), inputs.cols());
@@ -21,6 +28,10 @@ TrainingSet TrainingSet::subset(const std::vector<int>& indices) const {
                                   std::to_string(size()) + ")");
     out.inputs.row(static_cast<Eigen::Index>(k)) = inputs.row(i);
     out.targets(static_cast<Eigen::Index>(k)) = targets(i);
+  }
+  if (noise_variance.size() > 0) {
+    out.noise_variance.resize(static_cast<Eigen::Index>(indices.size()));
+    for (std::size_t k = 0; k < indices.size(); ++k) out.noise_variance(static_cast<Eigen::Index>(k)) = noise_variance(indices[k]);
   }
   return out;
 }
@@ -45,6 +56,15 @@ void validate_training_set(const TrainingSet& data, std::string_view who) {
            << "; expected finite inputs";
         throw std::invalid_argument(os.str());
       }
+  if (data.noise_variance.size() != 0 && data.noise_variance.size() != data.targets.size())
+    throw std::invalid_argument(prefix + std::to_string(data.noise_variance.size()) + " known noise variances for " +
+                                std::to_string(data.targets.size()) + " targets; expected one per target, or none");
+  for (Eigen::Index i = 0; i < data.noise_variance.size(); ++i)
+    if (!(std::isfinite(data.noise_variance(i)) && data.noise_variance(i) >= 0.0)) {
+      std::ostringstream os;
+      os << prefix << "known noise variance " << i << " is " << data.noise_variance(i) << "; expected a finite value >= 0";
+      throw std::invalid_argument(os.str());
+    }
   for (Eigen::Index i = 0; i < data.targets.size(); ++i)
     if (!std::isfinite(data.targets(i))) {
       std::ostringstream os;

@@ -36,7 +36,7 @@ struct GaussianProcess {
 constexpr py::ssize_t kDouble = sizeof(double);
 
 py::object fit(GaussianProcess& self, const py::object& self_object, const py::handle& X, const py::handle& y,
-               const py::object& theta) {
+               const py::object& theta, const py::object& noise_variance) {
   const std::string who = "GaussianProcess.fit";
   const FortranArray inputs = checked_array(X, 2, who, "X", "(N, D)");
   const FortranArray targets = checked_array(y, 1, who, "y", "(N,)");
@@ -50,6 +50,13 @@ py::object fit(GaussianProcess& self, const py::object& self_object, const py::h
     parameters = Vector(as_vector(t));
   }
   gp::TrainingSet data{as_matrix(inputs), as_vector(targets)};  // the model owns its copy
+  if (!noise_variance.is_none()) {
+    const FortranArray v = checked_array(noise_variance, 1, who, "noise_variance", "(N,)");
+    if (v.shape(0) != targets.shape(0))
+      raise_input_error(who + ": noise_variance has " + std::to_string(v.shape(0)) + " entries but y has " +
+                        std::to_string(targets.shape(0)));
+    data.noise_variance = as_vector(v);
+  }
   std::shared_ptr<const GpState> state;
   {
     py::gil_scoped_release release;
@@ -226,10 +233,11 @@ Raises ValueError (the library's message) for an unknown backend or a bad settin
 
   cls.def(
       "fit",
-      [](py::object self_object, const py::object& X, const py::object& y, const py::object& theta) {
-        return fit(self_object.cast<GaussianProcess&>(), self_object, X, y, theta);
+      [](py::object self_object, const py::object& X, const py::object& y, const py::object& theta,
+         const py::object& noise_variance) {
+        return fit(self_object.cast<GaussianProcess&>(), self_object, X, y, theta, noise_variance);
       },
-      py::arg("X"), py::arg("y"), py::arg("theta") = py::none(), R"doc(
+      py::arg("X"), py::arg("y"), py::arg("theta") = py::none(), py::arg("noise_variance") = py::none(), R"doc(
 Fit the hyperparameters by maximising the log marginal likelihood (NLopt L-BFGS with restarts), or,
 with ``theta``, condition on the data with the given hyperparameters as they are (no optimisation).
 
@@ -242,6 +250,10 @@ y : array of shape (N,)
 theta : array of shape (P,), optional
     [log l (D); log sf; log sn; extras]: FITC's pseudo-inputs (M, D) or SSGP's spectral points
     (m, D), flattened column-major (``Z.ravel(order="F")``); their number is read from P.
+noise_variance : array of shape (N,), optional
+    A noise variance of each target known before the fit, v_i >= 0: the likelihood is
+    y ~ N(0, K + diag(sn^2 + v_i)) with sn learned (scikit-learn's per-sample ``alpha`` with a
+    ``WhiteKernel``). Exact backend only; the predictions' std stays the latent one.
 
 The model is conditioned on the points the backend selects (exact: a uniform subsample of
 ``exact_points`` drawn with ``seed``; ``X_train_`` shows them). Returns self. The GIL is released

@@ -222,6 +222,80 @@ def test_exact_log_marginal_likelihood_matches_sklearn():
     np.testing.assert_allclose(grad, expected, rtol=0, atol=TOL)
 
 
+def known_noise(n=40, seed=3):
+    """Known noise variances that grow along the data, as an actuator's noise grows with |u|: from 0 to
+    16 times the learned part sn^2 = 0.01."""
+    return np.linspace(0.0, 0.16, n) * np.random.default_rng(seed).uniform(0.5, 1.0, n)
+
+
+def test_known_noise_likelihood_matches_sklearn_with_per_sample_alpha():
+    """y ~ N(0, K + diag(sn^2 + v_i)) with v known: value and gradient against scikit-learn with
+    alpha = v and the learned part as a WhiteKernel, at a theta other than the conditioned one."""
+    X, y = data()
+    v = known_noise()
+    gp = gpilqg.GaussianProcess("exact").fit(X, y, theta=shared_theta(), noise_variance=v)
+    theta = shared_theta(length=np.array([0.5, 2.0]), sf=0.9, sn=0.2)
+    lml, grad = gp.log_marginal_likelihood(theta, eval_gradient=True)
+
+    kernel = ConstantKernel(1.0) * RBF([1.0, 1.0]) + WhiteKernel(1.0)
+    sk = GaussianProcessRegressor(kernel, alpha=v, optimizer=None).fit(X, y)
+    sk_theta = np.log(np.concatenate([[0.9**2], [0.5, 2.0], [0.2**2]]))
+    ref_lml, ref_grad = sk.log_marginal_likelihood(sk_theta, eval_gradient=True)
+    expected = np.concatenate([ref_grad[1:3], [2 * ref_grad[0], 2 * ref_grad[3]]])
+    assert abs(lml - ref_lml) < TOL
+    np.testing.assert_allclose(grad, expected, rtol=0, atol=TOL)
+    # The known noise changes the likelihood: the comparison could fail.
+    assert abs(lml - gpilqg.GaussianProcess("exact").fit(X, y, theta=theta).log_marginal_likelihood()) > 1.0
+
+
+def test_known_noise_predictions_match_sklearn_and_its_gradient_finite_differences():
+    """Mean and latent std against scikit-learn with alpha = sn^2 + v; d lml / d theta against central
+    differences; a fit with known noise learns a smaller homoscedastic part than one without."""
+    X, y = data()
+    v = known_noise()
+    gp = gpilqg.GaussianProcess("exact").fit(X, y, theta=shared_theta(), noise_variance=v)
+    Xs = np.vstack([query_points(), X[:5]])
+    mean, std = gp.predict(Xs, return_std=True)
+    ref = GaussianProcessRegressor(ConstantKernel(SF**2, "fixed") * RBF(LENGTH, "fixed"), alpha=SN**2 + v,
+                                   optimizer=None).fit(X, y)
+    ref_mean, ref_std = ref.predict(Xs, return_std=True)
+    assert np.max(np.abs(mean - ref_mean)) < TOL
+    assert np.max(np.abs(std - ref_std)) < TOL
+
+    theta = shared_theta() + 0.05
+    _, grad = gp.log_marginal_likelihood(theta, eval_gradient=True)
+    h = 1e-6
+    fd = np.array([(gp.log_marginal_likelihood(theta + h * e) - gp.log_marginal_likelihood(theta - h * e)) / (2 * h)
+                   for e in np.eye(theta.size)])
+    np.testing.assert_allclose(grad, fd, rtol=1e-5, atol=1e-5)
+
+    # Targets whose noise is the known one plus white noise of std 0.05: the learned sn is near 0.05
+    # with the known part, and takes the known part's average in too without it.
+    rng = np.random.default_rng(5)
+    Xn = rng.uniform(-2.0, 2.0, size=(200, 2))
+    vn = np.linspace(0.0, 0.25, 200)
+    yn = np.sin(Xn[:, 0]) + np.sqrt(vn + 0.05**2) * rng.standard_normal(200)
+    with_known = gpilqg.GaussianProcess("exact", restarts=0).fit(Xn, yn, noise_variance=vn)
+    without = gpilqg.GaussianProcess("exact", restarts=0).fit(Xn, yn)
+    assert np.exp(with_known.theta_[3]) < 0.5 * np.exp(without.theta_[3])
+
+
+@pytest.mark.parametrize("backend", ["fitc", "ssgp", "compact"])
+def test_known_noise_is_refused_by_the_backends_that_do_not_take_it(backend):
+    X, y = data()
+    with pytest.raises(ValueError, match=f"backend '{backend}' does not take a known noise variance per point"):
+        gpilqg.GaussianProcess(backend, inducing=8, frequencies=10).fit(X, y, theta=backend_theta(backend),
+                                                                        noise_variance=known_noise())
+
+
+def test_known_noise_of_the_wrong_size_or_negative_is_refused():
+    X, y = data()
+    with pytest.raises(gpilqg.InputError, match="noise_variance has 3 entries but y has 40"):
+        gpilqg.GaussianProcess().fit(X, y, noise_variance=np.ones(3))
+    with pytest.raises(ValueError, match="known noise variance 2 is -1; expected a finite value >= 0"):
+        gpilqg.GaussianProcess().fit(X, y, noise_variance=np.where(np.arange(40) == 2, -1.0, 0.1))
+
+
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_log_marginal_likelihood_matches_sklearn(backend):
     """The value at the conditioned theta, for every backend, against scikit-learn's with the same kernel."""

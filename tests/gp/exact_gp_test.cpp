@@ -11,6 +11,7 @@
 #include "../../gp/src/dense_cholesky.hpp"
 #include "gp_test_support.hpp"
 #include "gpilqg/gp/fit.hpp"
+#include "gpilqg/gp/gp_io.hpp"
 #include "gpilqg/gp/resample.hpp"
 
 namespace gpilqg::gp::test {
@@ -141,6 +142,39 @@ TEST(ExactGp, ResampleRuleRetriesWhenTheNewLearnerIsWorse) {
   EXPECT_EQ(report.validation_mse.size(), 1u) << report.one_line();
   EXPECT_TRUE(report.improved);
   EXPECT_LE(report.validation_mse[0], report.previous_validation_mse);
+}
+
+// A known noise variance c at every point is a homoscedastic noise sn'^2 = sn^2 + c: the same NLML,
+// the same length-scale and signal gradients, and a noise gradient in the ratio sn^2 / sn'^2 (the
+// learned part's share); with known variances that vary, the subsample and a saved model keep them.
+TEST(ExactGp, AConstantKnownNoiseIsAHomoscedasticNoiseOfTheSumAndSubsetsAndFilesKeepIt) {
+  const ExactGpBackend backend(ExactGpOptions{ExactGpOptions::kAllPoints, 1});
+  const TrainingSet plain = smooth_data(60, 11);
+  TrainingSet known = plain;
+  const double c = 0.03, sn = 0.1;
+  known.noise_variance = Vector::Constant(plain.size(), c);
+  Vector theta(4), theta_sum(4);
+  theta << std::log(0.6), std::log(0.9), std::log(1.1), std::log(sn);
+  theta_sum = theta;
+  theta_sum(3) = 0.5 * std::log(sn * sn + c);
+  Vector g_known, g_sum;
+  const double nlml_known = backend.objective(known, FitOptions{})->evaluate(theta, &g_known).value;
+  const double nlml_sum = backend.objective(plain, FitOptions{})->evaluate(theta_sum, &g_sum).value;
+  EXPECT_NEAR(nlml_known, nlml_sum, 1e-10 * std::abs(nlml_sum));
+  EXPECT_MATRIX_NEAR(g_known.head(3), g_sum.head(3), 1e-9);
+  EXPECT_NEAR(g_known(3), g_sum(3) * sn * sn / (sn * sn + c), 1e-9);
+  EXPECT_GT(std::abs(g_sum(3)), 0.1);  // a noise gradient that can tell
+
+  // Varying known noise: a subset keeps each point's own, and so does a saved model.
+  for (int i = 0; i < known.size(); ++i) known.noise_variance(i) = 0.001 * i;
+  const TrainingSet some = known.subset({5, 17, 42});
+  EXPECT_EQ(some.noise_variance, (Vector(3) << 0.005, 0.017, 0.042).finished());
+  const auto model = backend.condition(known, theta);
+  const auto file = ::gpilqg::test::temporary_dir("exact_known_noise") / "gp.h5";
+  save_fitted_gp(file, "/gp", *model);
+  const auto loaded = load_fitted_gp(file, "/gp", backend);
+  EXPECT_EQ(loaded->training_set().noise_variance, known.noise_variance);
+  EXPECT_DOUBLE_EQ(loaded->negative_log_marginal_likelihood(), model->negative_log_marginal_likelihood());
 }
 
 TEST(DenseCholesky, InverseFromFactorEqualsEigensInverse) {

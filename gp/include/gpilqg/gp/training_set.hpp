@@ -15,6 +15,12 @@ namespace gpilqg::gp {
 struct TrainingSet {
   Matrix inputs;   ///< N x D, one point per row
   Vector targets;  ///< N
+  /// N, or empty: a noise variance of each target known before the fit (for a residual GP, the noise
+  /// the model itself predicts at that point). The likelihood is then y ~ N(0, K + diag(sn^2 + v_i)):
+  /// v_i is known and fixed, sn^2 the learned homoscedastic part (GPyTorch's
+  /// FixedNoiseGaussianLikelihood with learn_additional_noise; scikit-learn's per-sample alpha with a
+  /// WhiteKernel). Taken by the exact backend; the others refuse it (refuse_known_noise).
+  Vector noise_variance = Vector();
 
   int size() const { return static_cast<int>(inputs.rows()); }
   int input_dim() const { return static_cast<int>(inputs.cols()); }
@@ -25,8 +31,13 @@ struct TrainingSet {
 
 /// Throws std::invalid_argument, with `who` and the offending values in the message, when the data
 /// cannot be regressed on: inputs/targets size mismatch, no input dimensions, fewer points than
-/// inputs (N < D), a non-finite input or target (naming row and column), or constant targets.
+/// inputs (N < D), a non-finite input or target (naming row and column), constant targets, or known
+/// noise variances (noise_variance) that are not N finite values >= 0.
 void validate_training_set(const TrainingSet& data, std::string_view who);
+
+/// Throws std::invalid_argument naming `backend` when `data` has known noise variances, which that
+/// backend does not take.
+void refuse_known_noise(const TrainingSet& data, std::string_view backend);
 
 /// `count` distinct row indices drawn uniformly without replacement from [0, size), sorted; all rows
 /// when count >= size. Deterministic for a given seed.
