@@ -158,6 +158,7 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     inputs.variant = c.config.gp_variant;
     inputs.threads = c.threads;
     inputs.observation_std = c.config.observation_std;
+    inputs.known_noise = c.config.gp.known_noise;
     GpRound round = plan_gp_ilqg_round(task, simulator, inputs);
     record.fit_seconds = round.fit_seconds;
     record.hyperparameters = std::move(round.hyperparameters);

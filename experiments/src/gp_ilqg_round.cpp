@@ -18,14 +18,14 @@ namespace {
 /// states that carry the sensor noise. Where that step is not finite (the noise put a measured state
 /// where the simulator diverges) there is nothing to learn; the culprit is the config's sensor noise,
 /// `noise.observation` (of `gpilqg run` and `gpilqg plan` alike), named with its values.
-void check_finite_at_measurements(const gp::ResidualData& all, const Vector& floor, const Vector& observation_std) {
+void check_finite_at_measurements(const gp::ResidualData& all, const Matrix& noise_variance, const Vector& observation_std) {
   int bad = 0, first = -1;
   for (int r = 0; r < all.size(); ++r)
     if (!all.residuals.row(r).allFinite()) {
       if (first < 0) first = r;
       ++bad;
     }
-  if (bad == 0 && floor.allFinite()) return;
+  if (bad == 0 && noise_variance.allFinite()) return;
   const std::string where =
       bad > 0 ? fmt::format("the simulator's step is not finite at {} of {} measured inputs (the first: z = [{:.3g}])",
                             bad, all.size(), fmt::join(all.inputs.row(first), ", "))
@@ -54,19 +54,26 @@ GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const Step
     return round;
   }
   const auto start = std::chrono::steady_clock::now();
-  const gp::ResidualData all = gp::make_residual_data(*simulator, data.x, data.u, data.x_next);
+  gp::ResidualData all = gp::make_residual_data(*simulator, data.x, data.u, data.x_next);
+  gp::ResidualModelOptions options;
+  options.fit = in.fit;
+  options.threads = std::max(1, in.threads);
+  Matrix noise_variance = gp::residual_noise_variance(*simulator, all, in.observation_std);
+  check_finite_at_measurements(all, noise_variance, in.observation_std);
+  if (in.known_noise) {
+    // The known part is each transition's own; the learned part needs no floor of it.
+    all.noise_variance = std::move(noise_variance);
+    round.noise_floor = Vector::Zero(simulator->state_dim());
+  } else {
+    options.noise_floor = gp::least_noise_std(noise_variance);
+    round.noise_floor = options.noise_floor;
+  }
   const int newest = *std::max_element(data.iteration.begin(), data.iteration.end());
   std::vector<int> recent;
   for (int i = 0; i < data.size(); ++i)
     if (data.iteration[static_cast<std::size_t>(i)] == newest) recent.push_back(i);
   const gp::ResidualData validation = all.subset(recent);
   const gp::ResidualModel* previous = in.previous_model.get();
-  gp::ResidualModelOptions options;
-  options.fit = in.fit;
-  options.threads = std::max(1, in.threads);
-  options.noise_floor = gp::sensor_noise_floor(*simulator, all, in.observation_std);
-  check_finite_at_measurements(all, options.noise_floor, in.observation_std);
-  round.noise_floor = options.noise_floor;
   auto model = std::make_shared<const gp::ResidualModel>(gp::ResidualModel::fit(
       simulator, all, *in.backend, options, nullptr, previous != nullptr ? &validation : nullptr, previous));
   round.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

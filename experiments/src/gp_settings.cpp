@@ -8,7 +8,7 @@
 namespace gpilqg {
 
 GpSettings read_gp_settings(const TomlFields& f, const GpSettings& defaults) {
-  f.only_keys("gp", {"backend", "exact_points", "inducing", "frequencies", "restarts", "max_evaluations"});
+  f.only_keys("gp", {"backend", "exact_points", "inducing", "frequencies", "restarts", "max_evaluations", "known_noise"});
   GpSettings s = defaults;
   s.backend = f.string("gp.backend", defaults.backend);
   s.backend_settings.exact_points = f.integer_in("gp.exact_points", 2, limits::kMaxExactPoints, defaults.backend_settings.exact_points);
@@ -21,6 +21,11 @@ GpSettings read_gp_settings(const TomlFields& f, const GpSettings& defaults) {
   }
   s.restarts = f.integer_in("gp.restarts", 0, limits::kMaxRestarts, defaults.restarts);
   s.max_evaluations = f.integer_in("gp.max_evaluations", 1, limits::kMaxEvaluations, defaults.max_evaluations);
+  s.known_noise = f.boolean("gp.known_noise", defaults.known_noise);
+  if (s.known_noise && s.backend != "exact")
+    f.fail("gp.known_noise", fmt::format("is true with backend '{}', which does not take a known noise variance per "
+                                         "point; expected the exact backend, or known_noise = false",
+                                         s.backend));
   return s;
 }
 

@@ -92,6 +92,7 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   inputs.backend = backend.get();
   inputs.variant = c.solver.variant;
   inputs.observation_std = request.config.observation_std;
+  inputs.known_noise = gp_settings.known_noise;
   inputs.fit.restarts = gp_settings.restarts;
   inputs.fit.max_evaluations = gp_settings.max_evaluations;
   inputs.fit.seed = gp_fit_seed(request.seed, 0, kAlgorithm, data.size());

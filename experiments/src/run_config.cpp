@@ -82,12 +82,7 @@ bool same_system(const std::string& a, const std::string& b) {
   return !ea && !eb && ca == cb;
 }
 
-bool boolean(const TomlFields& f, const toml::table& root, const std::string& path) {
-  const toml::node* node = root.at_path(path).node();
-  if (node == nullptr) f.fail(path, "missing; expected true or false");
-  if (!node->is_boolean()) f.fail(path, "is not a boolean; expected true or false");
-  return node->as_boolean()->get();
-}
+bool boolean(const TomlFields& f, const toml::table&, const std::string& path) { return f.boolean(path); }
 
 Vector non_negative(const TomlFields& f, const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) {
   Vector v = f.vector(path, size, std::move(fallback));

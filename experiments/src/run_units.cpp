@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 
 namespace gpilqg {
@@ -32,6 +33,12 @@ TransitionData carried(const TransitionData& data) {
 std::vector<RunUnit> plan_run_units(const RunConfig& config, const RunOptions& options) {
   std::vector<RunUnit> units;
   const std::vector<std::string> backends = backends_of(config, options);
+  if (config.gp.known_noise)
+    for (const std::string& backend : backends)
+      if (backend != "exact")
+        throw InputError(fmt::format("--backends: '{}' with the config's gp.known_noise = true, which only the exact "
+                                     "backend takes; expected --backends exact, or gp.known_noise = false",
+                                     backend));
   for (std::size_t s = 0; s < options.seeds.size(); ++s) {
     for (int t = 0; t < static_cast<int>(config.tasks.size()); ++t) {
       const bool transfer = config.tasks[static_cast<std::size_t>(t)].transfer && t > 0;

@@ -149,6 +149,16 @@ std::string TomlFields::string(const std::string& path, std::optional<std::strin
   fail(path, "is not a string");
 }
 
+bool TomlFields::boolean(const std::string& path, std::optional<bool> fallback) const {
+  const toml::node* node = find(path);
+  if (node == nullptr) {
+    if (fallback) return *fallback;
+    fail(path, "missing; expected true or false");
+  }
+  if (const auto* b = node->as_boolean()) return b->get();
+  fail(path, "is not a boolean; expected true or false");
+}
+
 double TomlFields::number(const std::string& path, std::optional<double> fallback) const {
   const toml::node* node = find(path);
   if (node == nullptr) {

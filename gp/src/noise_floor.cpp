@@ -1,12 +1,11 @@
 #include "gpilqg/gp/noise_floor.hpp"
 
-#include <limits>
 #include <stdexcept>
 #include <string>
 
 namespace gpilqg::gp {
 
-Vector sensor_noise_floor(const StepModel& simulator, const ResidualData& data, const VectorCRef& observation_std) {
+Matrix residual_noise_variance(const StepModel& simulator, const ResidualData& data, const VectorCRef& observation_std) {
   const int n = simulator.state_dim(), m = simulator.control_dim();
   if (data.inputs.cols() != n + m)
     throw std::invalid_argument("sensor_noise_floor: data has " + std::to_string(data.inputs.cols()) +
@@ -16,7 +15,6 @@ Vector sensor_noise_floor(const StepModel& simulator, const ResidualData& data, 
                                 " entries; expected " + std::to_string(n) + " (one per state) or none");
   if (observation_std.size() != 0 && !((observation_std.array() >= 0.0).all() && observation_std.allFinite()))
     throw std::invalid_argument("sensor_noise_floor: observation_std must be finite and >= 0");
-  if (data.size() == 0) return Vector::Zero(n);
 
   const Vector sensor_variance =
       observation_std.size() != 0 ? Vector(observation_std.array().square()) : Vector(Vector::Zero(n));
@@ -25,7 +23,7 @@ Vector sensor_noise_floor(const StepModel& simulator, const ResidualData& data, 
   jacobians.resize(n, m);
   DiffusionColumns columns;
   Vector x_next(n);
-  Vector smallest = Vector::Constant(n, std::numeric_limits<double>::infinity());
+  Matrix out(data.size(), n);
   for (int r = 0; r < data.size(); ++r) {
     const Vector z = data.inputs.row(r).transpose();
     Vector variance = sensor_variance;
@@ -37,9 +35,18 @@ Vector sensor_noise_floor(const StepModel& simulator, const ResidualData& data, 
       simulator.noise(z.head(n), z.tail(m), columns, false, *workspace);
       variance += simulator.dt() * columns.columns.cwiseAbs2().rowwise().sum();
     }
-    smallest = smallest.cwiseMin(variance);
+    out.row(r) = variance.transpose();
   }
-  return smallest.cwiseSqrt();
+  return out;
+}
+
+Vector least_noise_std(const Matrix& noise_variance) {
+  if (noise_variance.rows() == 0) return Vector::Zero(noise_variance.cols());
+  return noise_variance.colwise().minCoeff().transpose().cwiseSqrt();
+}
+
+Vector sensor_noise_floor(const StepModel& simulator, const ResidualData& data, const VectorCRef& observation_std) {
+  return least_noise_std(residual_noise_variance(simulator, data, observation_std));
 }
 
 }  // namespace gpilqg::gp

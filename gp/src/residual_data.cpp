@@ -10,7 +10,9 @@ TrainingSet ResidualData::output(int i) const {
   if (i < 0 || i >= residuals.cols())
     throw std::invalid_argument("ResidualData::output: index " + std::to_string(i) + " outside [0, " +
                                 std::to_string(residuals.cols()) + ")");
-  return TrainingSet{inputs, residuals.col(i)};
+  TrainingSet out{inputs, residuals.col(i)};
+  if (noise_variance.size() > 0) out.noise_variance = noise_variance.col(i);
+  return out;
 }
 
 ResidualData ResidualData::subset(const std::vector<int>& indices) const {
@@ -24,6 +26,10 @@ ResidualData ResidualData::subset(const std::vector<int>& indices) const {
                                   std::to_string(size()) + ")");
     out.inputs.row(static_cast<Eigen::Index>(k)) = inputs.row(i);
     out.residuals.row(static_cast<Eigen::Index>(k)) = residuals.row(i);
+  }
+  if (noise_variance.size() > 0) {
+    out.noise_variance.resize(static_cast<Eigen::Index>(indices.size()), noise_variance.cols());
+    for (std::size_t k = 0; k < indices.size(); ++k) out.noise_variance.row(static_cast<Eigen::Index>(k)) = noise_variance.row(indices[k]);
   }
   return out;
 }

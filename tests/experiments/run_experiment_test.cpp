@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "gpilqg/experiments/algorithm_runs.hpp"
+#include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/plot_script.hpp"
 #include "gpilqg/experiments/run_results_io.hpp"
 #include "gpilqg/gp/residual_model.hpp"
@@ -203,6 +204,50 @@ TEST(RunExperiment, ComparesGpBackendsOnTheSameSeedsAndLinksTheFirstAsGpIlqg) {
   h5.openDataSet("/first/gp_ilqg/cost").read(linked.data(), H5::PredType::NATIVE_DOUBLE);
   h5.openDataSet("/first/gp_ilqg_exact/cost").read(direct.data(), H5::PredType::NATIVE_DOUBLE);
   EXPECT_EQ(linked, direct);
+}
+
+// gp.known_noise: every GP takes the noise the simulator predicts at each transition as known and
+// learns the rest; its learned noise then falls below the floor the same data give without it (the
+// floor is the least of that noise), and no floor is recorded. Only the exact backend takes it.
+TEST(RunExperiment, KnownNoiseGpsLearnOnlyTheRestAndOtherBackendsAreRefused) {
+  RunConfig config = parse_run_config("cartpole", kTinyRun, "tiny.toml");
+  config.tasks.resize(1);
+  config.iterations = 2;
+  config.pddp = false;
+  RunOptions options;
+  options.seeds = {7};
+  const RunResults floor = run_experiment(config, options);
+  config.gp.known_noise = true;
+  const RunResults known = run_experiment(config, options);
+  const IterationRecord& with_floor = find(floor.tasks[0], 0, "gp_ilqg").iterations[1];
+  const IterationRecord& with_known = find(known.tasks[0], 0, "gp_ilqg").iterations[1];
+  ASSERT_EQ(with_known.hyperparameters.size(), 4u);
+  EXPECT_EQ(with_known.noise_floor, Vector::Zero(4));
+  EXPECT_GT(with_floor.noise_floor.minCoeff(), 0.0);
+  const int D = 5;
+  for (int i = 0; i < 4; ++i) {
+    const double learned = std::exp(with_known.hyperparameters[static_cast<std::size_t>(i)](D + 1));
+    EXPECT_LT(learned, with_floor.noise_floor(i)) << "state " << i;
+  }
+  EXPECT_TRUE(std::isfinite(find(known.tasks[0], 0, "gp_ilqg").iterations[1].evaluation.mean_cost));
+
+  options.backends = {"exact", "fitc"};
+  try {
+    (void)run_experiment(config, options);
+    ADD_FAILURE() << "known noise with fitc was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--backends: 'fitc' with the config's gp.known_noise = true"), std::string::npos)
+        << e.what();
+  }
+  std::string fitc = kTinyRun;
+  fitc.replace(fitc.find("[gp]\n"), 5, "[gp]\nbackend = \"fitc\"\nknown_noise = true\n");
+  try {
+    (void)parse_run_config("cartpole", fitc, "fitc.toml");
+    ADD_FAILURE() << "a config with fitc and known noise was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'gp.known_noise': is true with backend 'fitc'"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(RunCli, AStartThatDivergesIsRecordedAndTheResultStaysFinite) {

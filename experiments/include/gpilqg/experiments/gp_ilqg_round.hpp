@@ -35,6 +35,9 @@ struct GpRoundInputs {
   /// The sensors' noise std per state (empty: none). With the simulator's process noise it sets every
   /// output's floor on the fitted noise std (gp/noise_floor.hpp).
   Vector observation_std;
+  /// GpSettings::known_noise: the sensors' and the simulator's process noise at each transition as a
+  /// known noise variance per point (the exact backend only); false: their least value as a floor.
+  bool known_noise = false;
 };
 
 struct GpRound {

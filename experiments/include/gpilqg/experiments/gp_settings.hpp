@@ -5,7 +5,7 @@
 /// docs/real-robot.md#the-plan-config).
 ///
 ///   [gp]  backend ("exact"|"fitc"|"ssgp"|"compact"), exact_points, inducing, frequencies,
-///         restarts, max_evaluations
+///         restarts, max_evaluations, known_noise
 
 #include <string>
 
@@ -20,6 +20,11 @@ struct GpSettings {
   gp::BackendSettings backend_settings;  ///< sizes of the backends (exact_points, inducing, frequencies)
   int restarts = 1;                      ///< random restarts of the hyperparameter fit, beside the data-driven start
   int max_evaluations = 150;             ///< NLopt evaluations per start
+  /// Each residual GP takes the noise the simulator itself predicts at each transition (the sensors'
+  /// and its process noise, gp/noise_floor.hpp) as a known noise variance per point and learns only
+  /// the rest (TrainingSet::noise_variance); false: one learned noise level per output with that
+  /// noise's least value as its floor. The exact backend only.
+  bool known_noise = false;
 };
 
 /// Reads [gp] through `f` (errors name the file, line and field); a field the table lacks takes its

@@ -44,6 +44,7 @@ class TomlFields {
   void require_section(const std::string& section) const;
 
   std::string string(const std::string& path, std::optional<std::string> fallback = std::nullopt) const;
+  bool boolean(const std::string& path, std::optional<bool> fallback = std::nullopt) const;
   double number(const std::string& path, std::optional<double> fallback = std::nullopt) const;
   long integer(const std::string& path, std::optional<long> fallback = std::nullopt) const;
   /// An integer within [min, max], as int (min and max must fit an int): a value outside fails naming

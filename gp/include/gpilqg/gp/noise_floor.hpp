@@ -25,6 +25,15 @@
 
 namespace gpilqg::gp {
 
+/// v_i(z) above at every row of `data.inputs`: N x n, row r the variances at z_r (what
+/// ResidualData::noise_variance holds when the GPs are given the noise the model already predicts).
+/// `observation_std` as below. Throws std::invalid_argument like sensor_noise_floor.
+Matrix residual_noise_variance(const StepModel& simulator, const ResidualData& data, const VectorCRef& observation_std);
+
+/// sqrt of each column's least value of `noise_variance` (residual_noise_variance): the floor below;
+/// zeros for no rows.
+Vector least_noise_std(const Matrix& noise_variance);
+
 /// The per-output floor sqrt(min_z v_i(z)) above, one entry per state. `observation_std` has n
 /// entries (zeros allowed) or is empty (no sensor noise); the process noise is `simulator.noise` at
 /// each row of `data.inputs`. An empty data set gives the floor at no row: zeros. Throws

@@ -39,6 +39,10 @@ class SharedExactPrediction;
 struct ResidualData {
   Matrix inputs;     ///< N x (n + m), z = [x; u]
   Matrix residuals;  ///< N x n, x'_measured - phi_sim(x, u)
+  /// N x n, or empty: the noise variance of each residual known before the fit, the sensors' and the
+  /// simulator's own process noise at that transition (residual_noise_variance, noise_floor.hpp);
+  /// output(i) hands column i to its GP (TrainingSet::noise_variance).
+  Matrix noise_variance = Matrix();
   int size() const { return static_cast<int>(inputs.rows()); }
   /// The training set of output i.
   TrainingSet output(int i) const;
