@@ -1,7 +1,5 @@
 #include "gpilqg/experiments/config_model.hpp"
 
-#include <algorithm>
-#include <cctype>
 #include <cstdint>
 #include <fstream>
 #include <iterator>
@@ -86,9 +84,7 @@ namespace {
 /// A file kept in a run's identity by its text: a model's own text (MJCF, URDF, a model file of the
 /// diagnosis), not an asset such as a mesh.
 bool kept_as_text(const std::filesystem::path& file) {
-  std::string extension = file.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
-  return extension == ".xml" || extension == ".urdf" || extension == ".toml";
+  return is_model_file_name(file.string()) || is_diagnosis_model_file(file.string());
 }
 
 }  // namespace

@@ -82,8 +82,6 @@ bool same_system(const std::string& a, const std::string& b) {
   return !ea && !eb && ca == cb;
 }
 
-bool boolean(const TomlFields& f, const toml::table&, const std::string& path) { return f.boolean(path); }
-
 Vector non_negative(const TomlFields& f, const std::string& path, int size, std::optional<Vector> fallback = std::nullopt) {
   Vector v = f.vector(path, size, std::move(fallback));
   if ((v.array() < 0.0).any()) f.fail(path, "has negative entries; expected standard deviations >= 0");
@@ -205,14 +203,14 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
     f.fail("solver", e.what());
   }
 
-  c.mpc = boolean(f, root, "mpc.enabled");
+  c.mpc = f.boolean("mpc.enabled");
   if (c.mpc) {
     c.mpc_options.horizon = f.integer_in("mpc.horizon", 1, limits::kMaxHorizon);
     c.mpc_options.first_solve_iterations = f.integer_in("mpc.first_solve_iterations", 1, limits::kMaxSolverIterations);
     c.mpc_options.iterations_per_step = f.integer_in("mpc.iterations_per_step", 1, limits::kMaxSolverIterations);
   }
 
-  c.pddp = boolean(f, root, "pddp.enabled");
+  c.pddp = f.boolean("pddp.enabled");
   c.pddp_max_iterations = f.integer_in("pddp.max_iterations", 1, limits::kMaxSolverIterations);
   c.pddp_backend = f.string("pddp.backend");
   try {
@@ -220,7 +218,7 @@ RunConfig read_run_config(const toml::table& root, const std::string& source, co
   } catch (const std::invalid_argument& e) {
     f.fail("pddp.backend", e.what());
   }
-  c.pddp_own = boolean(f, root, "pddp.own");
+  c.pddp_own = f.boolean("pddp.own");
   c.pddp_own_initial_rollouts = f.integer_in("pddp.own_initial_rollouts", 1, limits::kMaxRollouts);
   c.pddp_own_amplitude = non_negative(f, "pddp.own_amplitude", m);
 

@@ -8,13 +8,13 @@ namespace gpilqg::gp {
 Matrix residual_noise_variance(const StepModel& simulator, const ResidualData& data, const VectorCRef& observation_std) {
   const int n = simulator.state_dim(), m = simulator.control_dim();
   if (data.inputs.cols() != n + m)
-    throw std::invalid_argument("sensor_noise_floor: data has " + std::to_string(data.inputs.cols()) +
+    throw std::invalid_argument("residual_noise_variance: data has " + std::to_string(data.inputs.cols()) +
                                 " inputs; expected n + m = " + std::to_string(n + m));
   if (observation_std.size() != 0 && observation_std.size() != n)
-    throw std::invalid_argument("sensor_noise_floor: observation_std has " + std::to_string(observation_std.size()) +
+    throw std::invalid_argument("residual_noise_variance: observation_std has " + std::to_string(observation_std.size()) +
                                 " entries; expected " + std::to_string(n) + " (one per state) or none");
   if (observation_std.size() != 0 && !((observation_std.array() >= 0.0).all() && observation_std.allFinite()))
-    throw std::invalid_argument("sensor_noise_floor: observation_std must be finite and >= 0");
+    throw std::invalid_argument("residual_noise_variance: observation_std must be finite and >= 0");
 
   const Vector sensor_variance =
       observation_std.size() != 0 ? Vector(observation_std.array().square()) : Vector(Vector::Zero(n));

@@ -27,7 +27,8 @@ namespace gpilqg::gp {
 
 /// v_i(z) above at every row of `data.inputs`: N x n, row r the variances at z_r (what
 /// ResidualData::noise_variance holds when the GPs are given the noise the model already predicts).
-/// `observation_std` as below. Throws std::invalid_argument like sensor_noise_floor.
+/// `observation_std` as below. Throws std::invalid_argument for mismatched sizes or negative /
+/// non-finite standard deviations.
 Matrix residual_noise_variance(const StepModel& simulator, const ResidualData& data, const VectorCRef& observation_std);
 
 /// sqrt of each column's least value of `noise_variance` (residual_noise_variance): the floor below;
