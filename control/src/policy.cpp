@@ -40,4 +40,11 @@ PolicyRollout rollout_policy(const StepModel& world, const AffinePolicy& policy,
   return closed_loop_rollout(world, x0, policy.horizon(), feedback, settings.noise(), settings.observation_std, &rng);
 }
 
+Matrix closed_loop_controls(const StepModel& model, const AffinePolicy& policy, const VectorCRef& x0) {
+  PolicyRolloutSettings mean_step;
+  mean_step.process_noise = false;
+  std::mt19937_64 unused;  // no noise is drawn
+  return rollout_policy(model, policy, x0, mean_step, unused).trajectory.u;
+}
+
 }  // namespace gpilqg

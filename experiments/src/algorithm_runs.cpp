@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <map>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "gpilqg/control/belief_space.hpp"
 #include "gpilqg/experiments/gp_ilqg_round.hpp"
+#include "gpilqg/experiments/reference_plans.hpp"
 #include "gpilqg/gp/gp_belief_dynamics.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 
@@ -141,6 +143,17 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     if (!diagnosed) diagnosed = planning_simulator(loop_model(c.config), c.config.noise, c.models.simulator, run.diagnosis);
     return diagnosed;
   };
+  std::map<bool, std::vector<AffinePolicy>> kept;  // reference_plans, by whether a diagnosed model is planned on
+  const auto plans_to_keep = [&](const AlgorithmRun& run) -> const std::vector<AffinePolicy>& {
+    const bool on_diagnosed = run.diagnosis && run.diagnosis->adopted;
+    auto found = kept.find(on_diagnosed);
+    if (found == kept.end())
+      found = kept.emplace(on_diagnosed, reference_plans(task, DdpVariant::ILQG, loop_model(c.config), c.config.noise,
+                                                          on_diagnosed ? run.diagnosis->model : c.config.simulator)
+                                             .policies)
+                  .first;
+    return found->second;
+  };
   const DataPlanner planner = [&](const TransitionData& data, const Plan* previous, IterationRecord& record,
                                   const AlgorithmRun& run) {
     const std::shared_ptr<const StepModel> simulator = simulator_of(run);
@@ -159,6 +172,7 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     inputs.threads = c.threads;
     inputs.observation_std = c.config.observation_std;
     inputs.known_noise = c.config.gp.known_noise;
+    inputs.plans_to_keep = plans_to_keep(run);
     GpRound round = plan_gp_ilqg_round(task, simulator, inputs);
     record.fit_seconds = round.fit_seconds;
     record.hyperparameters = std::move(round.hyperparameters);

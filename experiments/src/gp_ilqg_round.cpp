@@ -50,7 +50,7 @@ GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const Step
   const TransitionData& data = *in.data;
   GpRound round;
   if (data.size() == 0) {
-    round.plan = plan_with_ddp(task, simulator, DdpVariant::ILQG, in.previous_u_bar);
+    round.plan = plan_with_ddp(task, simulator, DdpVariant::ILQG, in.previous_u_bar, in.plans_to_keep);
     return round;
   }
   const auto start = std::chrono::steady_clock::now();
@@ -79,7 +79,7 @@ GpRound plan_gp_ilqg_round(const DdpTask& task, const std::shared_ptr<const Step
   round.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const int D = static_cast<int>(all.inputs.cols());
   for (int i = 0; i < model->state_dim(); ++i) round.hyperparameters.push_back(model->output(i).parameters().head(D + 2));
-  round.plan = plan_with_ddp(task, model, in.variant, in.previous_u_bar);
+  round.plan = plan_with_ddp(task, model, in.variant, in.previous_u_bar, in.plans_to_keep);
   return round;
 }
 

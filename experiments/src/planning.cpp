@@ -12,6 +12,7 @@
 #include "gpilqg/core/version.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
 #include "gpilqg/experiments/diagnosis/model_file.hpp"
+#include "gpilqg/experiments/reference_plans.hpp"
 #include "gpilqg/experiments/run_setup.hpp"
 
 namespace gpilqg {
@@ -93,6 +94,9 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   inputs.variant = c.solver.variant;
   inputs.observation_std = request.config.observation_std;
   inputs.known_noise = gp_settings.known_noise;
+  const ReferencePlans references =
+      reference_plans(task, DdpVariant::ILQG, LoopModel{c.simulator, c.integrator, c.substeps, c.dt}, c.noise, planned_on);
+  inputs.plans_to_keep = references.policies;
   inputs.fit.restarts = gp_settings.restarts;
   inputs.fit.max_evaluations = gp_settings.max_evaluations;
   inputs.fit.seed = gp_fit_seed(request.seed, 0, kAlgorithm, data.size());
@@ -116,6 +120,7 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   GpRound result = plan_gp_ilqg_round(task, simulator, inputs);
   out.model = std::dynamic_pointer_cast<const gp::ResidualModel>(result.plan.model);
   out.summary = result.plan.summary;
+  out.start = references.start_name(result.plan.start);
   out.data_rows = data.size();
   out.fit_seconds = result.fit_seconds;
   out.warm_started_gp = inputs.previous_model != nullptr && data.size() > 0;

@@ -4,10 +4,12 @@
 
 #include <fmt/format.h>
 
+#include "gpilqg/control/best_start.hpp"
 #include "gpilqg/control/rollout.hpp"
 #include "gpilqg/core/limits.hpp"
 #include "gpilqg/experiments/config_model.hpp"
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/experiments/reference_plans.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
 
 namespace gpilqg {
@@ -100,9 +102,8 @@ QuadraticCost make_solve_cost(const SolveConfig& c) {
   return QuadraticCost(c.dt, c.Q.asDiagonal(), c.R.asDiagonal(), c.Qf.asDiagonal(), c.goal);
 }
 
-DdpResult solve_config(const SolveConfig& c) {
+SolvedConfig solve_config(const SolveConfig& c) {
   const auto step_model = make_solve_model(c);
-  const StepModel& model = *step_model;
   const QuadraticCost cost = make_solve_cost(c);
   DdpProblem problem;
   problem.model = step_model.get();
@@ -111,10 +112,21 @@ DdpResult solve_config(const SolveConfig& c) {
   problem.horizon = c.horizon;
   problem.u_min = c.u_min;
   problem.u_max = c.u_max;
-  const int m = model.control_dim();
-  const Matrix u0 = c.u_init.size() ? Matrix(c.u_init.replicate(1, c.horizon)) : Matrix(Matrix::Zero(m, c.horizon));
+  DdpTask task;
+  task.cost = &cost;
+  task.x0 = c.x0;
+  task.horizon = c.horizon;
+  task.u_min = c.u_min;
+  task.u_max = c.u_max;
+  task.u_init = c.u_init.size() ? c.u_init : Vector(Vector::Zero(step_model->control_dim()));
+  task.solver = c.solver;
+  const ReferencePlans references =
+      reference_plans(task, c.solver.variant, LoopModel{c.simulator, c.integrator, c.substeps, c.dt}, c.noise, c.simulator);
+  std::vector<Matrix> starts{task.u_init.replicate(1, c.horizon)};
+  for (const AffinePolicy& kept : references.policies) starts.push_back(closed_loop_controls(*step_model, kept, c.x0));
   DdpSolver solver(c.solver);
-  return solver.solve(problem, u0);
+  BestStart best = solve_from_best_start(solver, problem, starts);
+  return {std::move(best.result), references.start_name(best.start)};
 }
 
 std::string initial_rollout_failure(double cost) {

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "gpilqg/control/best_start.hpp"
 #include "gpilqg/control/rollout.hpp"
 
 #include "elapsed_seconds.hpp"
@@ -34,7 +35,7 @@ DdpTask ddp_task(const TaskContext& c) {
 }
 
 Plan plan_with_ddp(const DdpTask& task, std::shared_ptr<const StepModel> model, DdpVariant variant,
-                   const Matrix& u_start) {
+                   const Matrix& u_start, const std::vector<AffinePolicy>& plans_to_keep) {
   DdpProblem problem;
   problem.model = model.get();
   problem.cost = task.cost;
@@ -46,16 +47,19 @@ Plan plan_with_ddp(const DdpTask& task, std::shared_ptr<const StepModel> model, 
   options.variant = variant;
   DdpSolver solver(options);
   const auto start = std::chrono::steady_clock::now();
-  DdpResult result = solver.solve(problem, u_start.size() ? u_start : Matrix(task.u_init.replicate(1, task.horizon)));
+  std::vector<Matrix> starts{u_start.size() ? u_start : Matrix(task.u_init.replicate(1, task.horizon))};
+  for (const AffinePolicy& kept : plans_to_keep) starts.push_back(closed_loop_controls(*model, kept, task.x0));
+  BestStart best = solve_from_best_start(solver, problem, starts);
   Plan plan;
   plan.solve_seconds = seconds_since(start);
-  plan.policy = std::move(result.policy);
-  plan.predicted_cost = result.expected_cost;
-  plan.nominal_cost = result.nominal_cost;
-  plan.summary = std::move(result.summary);
+  plan.start = best.start;
+  plan.policy = std::move(best.result.policy);
+  plan.predicted_cost = best.result.expected_cost;
+  plan.nominal_cost = best.result.nominal_cost;
+  plan.summary = std::move(best.result.summary);
   plan.model = std::move(model);
   plan.variant = variant;
-  score_diverged_solve(plan, *task.cost, result.trajectory);
+  score_diverged_solve(plan, *task.cost, best.result.trajectory);
   return plan;
 }
 

@@ -111,11 +111,13 @@ py::dict solve(const ConfigSource& source, const py::object& progress) {
   SolveConfig config = solve_config_of(source);
   LongCall call(progress);
   watch_iterations(config.solver, call);
-  const DdpResult r = call.run<DdpResult>([&] { return solve_config(config); });
+  const SolvedConfig solved = call.run<SolvedConfig>([&] { return solve_config(config); });
+  const DdpResult& r = solved.result;
   py::dict out = summary_dict(r.summary);
   out["cost"] = r.nominal_cost;
   out["expected_cost"] = r.expected_cost;
   out["algorithm"] = std::string(to_string(config.solver.variant));
+  out["start"] = solved.start;
   out["x"] = rows(r.trajectory.x);
   out["u"] = rows(r.trajectory.u);
   Policy policy;

@@ -82,7 +82,8 @@ int run_plan(const PlanOptions& o) {
                      {"termination", std::string(to_string(s.termination))},
                      {"converged", converged(s.termination)},
                      {"iterations", s.iterations},
-                     {"solve_time_s", s.timings.total_s}};
+                     {"solve_time_s", s.timings.total_s},
+                     {"start", planned.start}};
     out["data_rows"] = planned.data_rows;
     out["fit_time_s"] = planned.fit_seconds;
     out["gp_warm_start"] = planned.warm_started_gp;
@@ -112,6 +113,8 @@ int run_plan(const PlanOptions& o) {
     else
       std::cout << fmt::format("round {}: no data; planned on the simulator alone\n", f.round);
     std::cout << s.report(to_string(planned.model ? request.config.problem.solver.variant : DdpVariant::ILQG)) << '\n';
+    if (planned.start != "the usual start")
+      std::cout << fmt::format("kept the solve started from {}: it costs less on the model planned on\n", planned.start);
     std::cout << fmt::format("predicted cost {:.6g}, expected cost {:.6g}; wrote {} (horizon {}, dt {} s)\n",
                              f.predicted_cost, f.expected_cost, o.out, f.policy.horizon(), f.dt);
   }

@@ -18,7 +18,8 @@ std::vector<double> as_list(const VectorCRef& v) { return {v.data(), v.data() + 
 
 int run_solve(const std::string& file, bool json) {
   const SolveConfig config = read_solve_config(file);
-  DdpResult r = solve_config(config);
+  SolvedConfig solved = solve_config(config);
+  DdpResult& r = solved.result;
   if (!std::isfinite(r.nominal_cost) || !std::isfinite(r.expected_cost)) {
     // The initial rollout diverged (costs +infinity): scored like a diverged rollout, the cost of the
     // states reached with the last one repeated (trajectory.hpp); the termination says why.
@@ -41,9 +42,12 @@ int run_solve(const std::string& file, bool json) {
     out["u"] = u;
     out["solve_time_s"] = s.timings.total_s;
     out["algorithm"] = std::string(to_string(config.solver.variant));
+    out["start"] = solved.start;
     std::cout << out.dump() << '\n';
   } else {
     std::cout << s.report(to_string(config.solver.variant)) << '\n';
+    if (solved.start != "the usual start")
+      std::cout << fmt::format("kept the solve started from {}: it costs less on the config's model\n", solved.start);
     std::cout << fmt::format("cost {:.12g} (expected {:.12g}), final state [{}]\n", r.nominal_cost, r.expected_cost,
                              fmt::join(as_list(x_final), ", "));
   }
@@ -68,7 +72,7 @@ void add_solve_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("CONFIG", *file,
                   "TOML problem description (docs/formats.md#problem-config-gpilqg-solve-and-gpilqg-plan)")
       ->required();
-  cmd->add_flag("--json", *json, "Print one JSON document: cost, iterations, termination, x_final, u, solve_time_s");
+  cmd->add_flag("--json", *json, "Print one JSON document: cost, iterations, termination, x_final, u, solve_time_s, start");
   cmd->callback([&action, file, json] { action = [file, json] { return run_solve(*file, *json); }; });
 }
 

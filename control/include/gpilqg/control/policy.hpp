@@ -46,4 +46,11 @@ using PolicyRollout = RolloutResult;
 PolicyRollout rollout_policy(const StepModel& world, const AffinePolicy& policy, const VectorCRef& x0,
                              const PolicyRolloutSettings& settings, std::mt19937_64& rng);
 
+/// The controls `policy` applies in closed loop on `model`'s mean step from x0 (m x T, within the
+/// policy's limits): replayed open loop on the same model they give the same trajectory, so they are
+/// how a policy made on one model becomes a start of a solve on another (a plan's feedback keeps it
+/// near its nominal path where its open-loop controls would not). After a divergence the controls are
+/// zero (rollout()).
+Matrix closed_loop_controls(const StepModel& model, const AffinePolicy& policy, const VectorCRef& x0);
+
 }  // namespace gpilqg

@@ -12,6 +12,8 @@
 ///    (gp/resample.hpp). No output may fit a noise std below what the sensors and the process noise
 ///    put into its targets (gp/noise_floor.hpp). Then Robust-iLQG (F and G = diag(sigma(z))) or, as an ablation, iLQG on the
 ///    GP mean solves the task on simulator + GP, warm-started from the previous round's controls.
+///  - Either way each of `plans_to_keep` (plans on simpler models, reference_plans.hpp) is a further
+///    start of the solve, and the plan of least expected cost on the round's model is kept.
 
 #include <memory>
 #include <vector>
@@ -38,6 +40,9 @@ struct GpRoundInputs {
   /// GpSettings::known_noise: the sensors' and the simulator's process noise at each transition as a
   /// known noise variance per point (the exact backend only); false: their least value as a floor.
   bool known_noise = false;
+  /// Plans on simpler models (reference_plans.hpp) that this round's plan must not lose to: each is
+  /// a further start of the solve, and the plan of least expected cost on the round's model is kept.
+  std::vector<AffinePolicy> plans_to_keep;
 };
 
 struct GpRound {

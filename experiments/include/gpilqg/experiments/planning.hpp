@@ -36,6 +36,9 @@ struct PlannedPolicy {
   PolicyFile file;                                   ///< what write_policy_file writes
   std::shared_ptr<const gp::ResidualModel> model;    ///< the fitted GP (null: planned on the simulator)
   DdpSummary summary;                                ///< the solver's termination, iterations, timings
+  /// Where the kept solve started (ReferencePlans::start_name): "the usual start" (the previous
+  /// policy's or u_init's controls) or "the plan on ..." a simpler model (reference_plans.hpp).
+  std::string start;
   int data_rows = 0;                                 ///< transitions the GP was fitted on
   double fit_seconds = 0.0;
   bool warm_started_gp = false;                      ///< the previous file's GP was the fit's start

@@ -62,8 +62,16 @@ std::shared_ptr<const StepModel> make_solve_model(const SolveConfig& config);
 /// The config's cost: dt (0.5 e'Qe + 0.5 u'Ru) per step and 0.5 e'Qf e at the end, e = x - goal.
 QuadraticCost make_solve_cost(const SolveConfig& config);
 
-/// Builds the model and cost of the config and solves it.
-DdpResult solve_config(const SolveConfig& config);
+/// A solved config and where its kept solve started.
+struct SolvedConfig {
+  DdpResult result;
+  std::string start;  ///< ReferencePlans::start_name: "the usual start" (u_init) or "the plan on ..."
+};
+
+/// Builds the model and cost of the config and solves it from u_init; when [system] model is not the
+/// preset alone, also from the preset's plan replayed on the model (reference_plans.hpp), keeping the
+/// solve of least expected cost.
+SolvedConfig solve_config(const SolveConfig& config);
 
 /// Why the initial rollout of a solve ended with termination InitialRolloutDiverged, given `cost`,
 /// the config's cost of the trajectory the solver returns: the states reached before the divergence

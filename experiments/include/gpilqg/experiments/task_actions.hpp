@@ -31,6 +31,9 @@ struct Plan {
   DdpSummary summary;
   std::shared_ptr<const StepModel> model;  ///< what MPC re-plans on (null: the policy only, e.g. PDDP's)
   DdpVariant variant = DdpVariant::ILQG;
+  /// The start the solve kept (plan_with_ddp): 0 the usual one, i >= 1 the closed-loop controls of
+  /// plans_to_keep[i - 1].
+  int start = 0;
 };
 
 /// A solve whose costs are not finite (its initial rollout diverged, summary.termination
@@ -73,9 +76,11 @@ DdpTask ddp_task(const TaskContext& context);
 
 /// DDP on `model` (kept alive by the plan, for MPC) from the controls `u_start` (m x T; empty:
 /// task.u_init repeated), within the task's limits; `variant` ILQG (process noise F) or RobustILQG (F
-/// and the GP's G).
+/// and the GP's G). Each of `plans_to_keep` (plans made on other models, reference_plans.hpp) is a
+/// further start, its closed-loop controls on `model`; the plan of least expected cost on `model` is
+/// kept (control/best_start.hpp), and solve_seconds counts every solve.
 Plan plan_with_ddp(const DdpTask& task, std::shared_ptr<const StepModel> model, DdpVariant variant,
-                   const Matrix& u_start);
+                   const Matrix& u_start, const std::vector<AffinePolicy>& plans_to_keep = {});
 /// The same for a task of `gpilqg run`.
 Plan plan_with_ddp(const TaskContext& context, std::shared_ptr<const StepModel> model, DdpVariant variant,
                    const Matrix& u_start);

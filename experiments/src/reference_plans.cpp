@@ -1,0 +1,44 @@
+#include "gpilqg/experiments/reference_plans.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "gpilqg/experiments/diagnosis/model_file.hpp"
+
+namespace gpilqg {
+
+std::vector<SimplerModel> simpler_models(const LoopModel& config, const ActuatorNoise& noise, const ModelSpec& planned_on) {
+  ModelSpec preset;
+  preset.system = config.simulator.system;
+  preset.preset = config.simulator.preset;
+  const std::pair<std::string, ModelSpec> candidates[] = {
+      {fmt::format("the system's preset '{}' alone", to_string(preset.preset)), preset},
+      {"the config's simulator", config.simulator}};
+  std::vector<std::string> seen{diagnosis::model_file_text(planned_on)};
+  std::vector<SimplerModel> models;
+  for (const auto& [name, spec] : candidates) {
+    std::string text = diagnosis::model_file_text(spec);
+    if (std::find(seen.begin(), seen.end(), text) != seen.end()) continue;
+    seen.push_back(std::move(text));
+    models.push_back({name, make_step_model(spec.build(noise), config.integrator, config.dt, config.substeps)});
+  }
+  return models;
+}
+
+std::string ReferencePlans::start_name(int start) const {
+  if (start <= 0 || start > static_cast<int>(models.size())) return "the usual start";
+  return "the plan on " + models[static_cast<std::size_t>(start - 1)];
+}
+
+ReferencePlans reference_plans(const DdpTask& task, DdpVariant variant, const LoopModel& config,
+                               const ActuatorNoise& noise, const ModelSpec& planned_on) {
+  ReferencePlans plans;
+  for (const SimplerModel& simpler : simpler_models(config, noise, planned_on)) {
+    plans.models.push_back(simpler.name);
+    plans.policies.push_back(plan_with_ddp(task, simpler.model, variant, Matrix()).policy);
+  }
+  return plans;
+}
+
+}  // namespace gpilqg
