@@ -1,8 +1,10 @@
 #include "gpilqg/experiments/gp_settings.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gpilqg/core/limits.hpp"
+#include "gpilqg/gp/backend_registry.hpp"
 #include "gpilqg/experiments/toml_fields.hpp"
 
 namespace gpilqg {
@@ -22,10 +24,10 @@ GpSettings read_gp_settings(const TomlFields& f, const GpSettings& defaults) {
   s.restarts = f.integer_in("gp.restarts", 0, limits::kMaxRestarts, defaults.restarts);
   s.max_evaluations = f.integer_in("gp.max_evaluations", 1, limits::kMaxEvaluations, defaults.max_evaluations);
   s.known_noise = f.boolean("gp.known_noise", defaults.known_noise);
-  if (s.known_noise && s.backend != "exact")
+  if (s.known_noise && !gp::make_backend(s.backend, s.backend_settings)->takes_known_noise())
     f.fail("gp.known_noise", fmt::format("is true with backend '{}', which does not take a known noise variance per "
-                                         "point; expected the exact backend, or known_noise = false",
-                                         s.backend));
+                                         "point; expected a backend that does ({}), or known_noise = false",
+                                         s.backend, fmt::join(gp::backends_taking_known_noise(), ", ")));
   return s;
 }
 

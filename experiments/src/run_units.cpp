@@ -1,8 +1,10 @@
 #include "gpilqg/experiments/run_units.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gpilqg/experiments/cli_errors.hpp"
+#include "gpilqg/gp/backend_registry.hpp"
 #include "gpilqg/gp/residual_model.hpp"
 
 namespace gpilqg {
@@ -35,10 +37,10 @@ std::vector<RunUnit> plan_run_units(const RunConfig& config, const RunOptions& o
   const std::vector<std::string> backends = backends_of(config, options);
   if (config.gp.known_noise)
     for (const std::string& backend : backends)
-      if (backend != "exact")
-        throw InputError(fmt::format("--backends: '{}' with the config's gp.known_noise = true, which only the exact "
-                                     "backend takes; expected --backends exact, or gp.known_noise = false",
-                                     backend));
+      if (!gp::make_backend(backend, config.gp.backend_settings)->takes_known_noise())
+        throw InputError(fmt::format("--backends: '{}' with the config's gp.known_noise = true, which it does not take; "
+                                     "expected backends among {}, or gp.known_noise = false",
+                                     backend, fmt::join(gp::backends_taking_known_noise(), ", ")));
   for (std::size_t s = 0; s < options.seeds.size(); ++s) {
     for (int t = 0; t < static_cast<int>(config.tasks.size()); ++t) {
       const bool transfer = config.tasks[static_cast<std::size_t>(t)].transfer && t > 0;

@@ -86,6 +86,13 @@ std::vector<std::string> backend_names() {
   return names;
 }
 
+std::vector<std::string> backends_taking_known_noise() {
+  std::vector<std::string> names;
+  for (const auto& entry : registry())
+    if (entry.make(BackendSettings{})->takes_known_noise()) names.emplace_back(entry.name);
+  return names;
+}
+
 std::unique_ptr<GpBackend> make_backend(std::string_view name, const BackendSettings& settings) {
   settings.validate();
   for (const auto& entry : registry())

@@ -85,10 +85,9 @@ FitcBackend::FitcBackend(FitcOptions options) : options_(std::move(options)) { o
 std::unique_ptr<MarginalLikelihoodObjective> FitcBackend::objective(const TrainingSet& data,
                                                                     const FitOptions& options) const {
   validate_training_set(data, "FitcBackend::objective");
-  refuse_known_noise(data, name());
   options.validate();
   FitcLikelihood likelihood(data.inputs, data.targets, std::min(options_.inducing, data.size()), options_.jitter,
-                            options.jitter, options_.threads);
+                            options.jitter, options_.threads, data.noise_variance);
   auto [initial, bounds] = fitc_start(likelihood.layout(), data, options_, options);
   return std::make_unique<sparse_detail::LikelihoodObjective<FitcLikelihood>>(std::move(likelihood),
                                                                               std::move(initial), std::move(bounds));
@@ -96,10 +95,10 @@ std::unique_ptr<MarginalLikelihoodObjective> FitcBackend::objective(const Traini
 
 std::unique_ptr<FittedGp> FitcBackend::condition(TrainingSet data, const VectorCRef& parameters,
                                                  const JitterSchedule& jitter) const {
-  refuse_known_noise(data, name());
   return sparse_detail::condition<FitcTraits>(
       std::move(data), parameters, jitter, [&](const FitcLayout& layout, const TrainingSet& d) {
-        return FitcLikelihood(d.inputs, d.targets, layout.inducing, options_.jitter, jitter, options_.threads);
+        return FitcLikelihood(d.inputs, d.targets, layout.inducing, options_.jitter, jitter, options_.threads,
+                              d.noise_variance);
       });
 }
 

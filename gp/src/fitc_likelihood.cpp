@@ -2,7 +2,8 @@
 ///
 /// Derivation of the gradient (our own, in the notation of fitc.hpp; it agrees with GPML infFITC's
 /// and Snelson's spgp_lik but is arranged as six O(N M^2) matrix products and no per-parameter
-/// N x M temporaries). With C = Qff + Lambda, alpha = C^-1 r and G = C^-1 - alpha alpha',
+/// N x M temporaries). With C = Qff + Lambda, Lambda = diag(max(Kff - Qff, 0)) + sn2 I + diag(v) (v the
+/// known noise variances, constant), alpha = C^-1 r and G = C^-1 - alpha alpha',
 ///
 ///   dnlZ = 0.5 tr(G dC),   dC = dQ + dLambda,   dQ = dKuf' B + B' dKuf - B' dKuu B,  B = Kuu^-1 Kuf,
 ///   dLambda = diag(mask .* (ddiag(Kff) - diag(dQ))) + dsn2 I,   mask_i = [Kff_ii - Qff_ii > 0].
@@ -87,13 +88,17 @@ struct FitcLikelihood::Workspace final : LikelihoodWorkspace {
 };
 
 FitcLikelihood::FitcLikelihood(const MatrixCRef& X, const VectorCRef& r, int inducing, FitcJitter jitter,
-                               JitterSchedule schedule, int threads)
+                               JitterSchedule schedule, int threads, const Vector& known_noise)
     : X_(X),
       r_(r),
+      known_noise_(known_noise.size() ? known_noise : Vector(Vector::Zero(X.rows()))),
       jitter_(jitter),
       schedule_(schedule),
       threads_(threads) {
   sparse_detail::validate_likelihood_inputs("FitcLikelihood", X, r, inducing, "pseudo-inputs", threads);
+  if (known_noise_.size() != X.rows() || !known_noise_.allFinite() || (known_noise_.array() < 0.0).any())
+    throw std::invalid_argument("FitcLikelihood: the known noise variances must be " + std::to_string(X.rows()) +
+                                " finite numbers >= 0, one per training point");
   jitter.validate();
   schedule.validate();
   layout_ = FitcLayout{static_cast<int>(X.cols()), inducing};
@@ -159,7 +164,7 @@ NlmlEvaluation FitcLikelihood::factorise(const VectorCRef& theta, Workspace& w) 
     for (Eigen::Index i = begin; i < end; ++i) {
       const double d = w.sf2 - w.V.col(i).squaredNorm();
       w.mask(i) = d > 0.0 ? 1.0 : 0.0;
-      w.g(i) = std::max(d, 0.0) + w.sn2;
+      w.g(i) = std::max(d, 0.0) + w.sn2 + known_noise_(i);
     }
     Y = V * w.g.segment(begin, n).cwiseSqrt().cwiseInverse().asDiagonal();
     Matrix& A = w.partial_mm[static_cast<std::size_t>(worker)];

@@ -82,9 +82,9 @@ SsgpBackend::SsgpBackend(SsgpOptions options) : options_(std::move(options)) { o
 std::unique_ptr<MarginalLikelihoodObjective> SsgpBackend::objective(const TrainingSet& data,
                                                                     const FitOptions& options) const {
   validate_training_set(data, "SsgpBackend::objective");
-  refuse_known_noise(data, name());
   options.validate();
-  SsgpLikelihood likelihood(data.inputs, data.targets, options_.frequencies, options.jitter, options_.threads);
+  SsgpLikelihood likelihood(data.inputs, data.targets, options_.frequencies, options.jitter, options_.threads,
+                            data.noise_variance);
   auto [initial, bounds] = ssgp_start(likelihood, data, options_, options);
   return std::make_unique<sparse_detail::LikelihoodObjective<SsgpLikelihood>>(std::move(likelihood),
                                                                               std::move(initial), std::move(bounds));
@@ -92,10 +92,9 @@ std::unique_ptr<MarginalLikelihoodObjective> SsgpBackend::objective(const Traini
 
 std::unique_ptr<FittedGp> SsgpBackend::condition(TrainingSet data, const VectorCRef& parameters,
                                                  const JitterSchedule& jitter) const {
-  refuse_known_noise(data, name());
   return sparse_detail::condition<SsgpTraits>(
       std::move(data), parameters, jitter, [&](const SsgpLayout& layout, const TrainingSet& d) {
-        return SsgpLikelihood(d.inputs, d.targets, layout.frequencies, jitter, options_.threads);
+        return SsgpLikelihood(d.inputs, d.targets, layout.frequencies, jitter, options_.threads, d.noise_variance);
       });
 }
 

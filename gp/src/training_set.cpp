@@ -8,13 +8,18 @@
 #include <stdexcept>
 #include <string>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "gpilqg/gp/backend_registry.hpp"
+
 namespace gpilqg::gp {
 
 void refuse_known_noise(const TrainingSet& data, std::string_view backend) {
   if (data.noise_variance.size() > 0)
-    throw std::invalid_argument("backend '" + std::string(backend) +
-                                "' does not take a known noise variance per point; expected the exact backend, or "
-                                "no known noise variances");
+    throw std::invalid_argument(fmt::format("backend '{}' does not take a known noise variance per point; expected "
+                                            "a backend that does ({}), or no known noise variances",
+                                            backend, fmt::join(backends_taking_known_noise(), ", ")));
 }
 
 TrainingSet TrainingSet::subset(const std::vector<int>& indices) const {

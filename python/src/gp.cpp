@@ -253,7 +253,8 @@ theta : array of shape (P,), optional
 noise_variance : array of shape (N,), optional
     A noise variance of each target known before the fit, v_i >= 0: the likelihood is
     y ~ N(0, K + diag(sn^2 + v_i)) with sn learned (scikit-learn's per-sample ``alpha`` with a
-    ``WhiteKernel``). Exact backend only; the predictions' std stays the latent one.
+    ``WhiteKernel``). A backend that does not take it raises ValueError naming those that do; the
+    predictions' std stays the latent one.
 
 The model is conditioned on the points the backend selects (exact: a uniform subsample of
 ``exact_points`` drawn with ``seed``; ``X_train_`` shows them). Returns self. The GIL is released

@@ -280,7 +280,27 @@ def test_known_noise_predictions_match_sklearn_and_its_gradient_finite_differenc
     assert np.exp(with_known.theta_[3]) < 0.5 * np.exp(without.theta_[3])
 
 
-@pytest.mark.parametrize("backend", ["fitc", "ssgp", "compact"])
+@pytest.mark.parametrize("backend", ["fitc", "ssgp"])
+def test_known_noise_of_the_sparse_backends_matches_sklearn_with_their_kernels(backend):
+    """FITC's Lambda and SSGP's weighted features take v as the exact GP does: the value, mean and latent
+    std against scikit-learn with the backend's own kernel and alpha = sn^2 + v, to 1e-8."""
+    X, y = data()
+    v = known_noise()
+    theta = backend_theta(backend)
+    gp = gpilqg.GaussianProcess(backend).fit(X, y, theta=theta, noise_variance=v)
+    ref = GaussianProcessRegressor(sklearn_kernel(backend, theta), alpha=np.exp(2 * theta[3]) + v, optimizer=None,
+                                   normalize_y=False).fit(X, y)
+    assert abs(gp.log_marginal_likelihood() - ref.log_marginal_likelihood_value_) < TOL
+    Xs = np.vstack([query_points(), X[:5]])
+    mean, std = gp.predict(Xs, return_std=True)
+    ref_mean, ref_std = ref.predict(Xs, return_std=True)
+    assert np.max(np.abs(mean - ref_mean)) < TOL
+    assert np.max(np.abs(std - ref_std)) < TOL
+    # The known noise changes the likelihood: the comparison could fail.
+    assert abs(gp.log_marginal_likelihood() - conditioned(backend, X, y).log_marginal_likelihood()) > 1.0
+
+
+@pytest.mark.parametrize("backend", ["compact"])
 def test_known_noise_is_refused_by_the_backends_that_do_not_take_it(backend):
     X, y = data()
     with pytest.raises(ValueError, match=f"backend '{backend}' does not take a known noise variance per point"):

@@ -208,7 +208,7 @@ TEST(RunExperiment, ComparesGpBackendsOnTheSameSeedsAndLinksTheFirstAsGpIlqg) {
 
 // gp.known_noise: every GP takes the noise the simulator predicts at each transition as known and
 // learns the rest; its learned noise then falls below the floor the same data give without it (the
-// floor is the least of that noise), and no floor is recorded. Only the exact backend takes it.
+// floor is the least of that noise), and no floor is recorded. A backend that does not take it is refused.
 TEST(RunExperiment, KnownNoiseGpsLearnOnlyTheRestAndOtherBackendsAreRefused) {
   RunConfig config = parse_run_config("cartpole", kTinyRun, "tiny.toml");
   config.tasks.resize(1);
@@ -231,23 +231,27 @@ TEST(RunExperiment, KnownNoiseGpsLearnOnlyTheRestAndOtherBackendsAreRefused) {
   }
   EXPECT_TRUE(std::isfinite(find(known.tasks[0], 0, "gp_ilqg").iterations[1].evaluation.mean_cost));
 
-  options.backends = {"exact", "fitc"};
+  // The compact-support backend does not take it (GpBackend::takes_known_noise): refused by name.
+  options.backends = {"exact", "compact"};
   try {
     (void)run_experiment(config, options);
-    ADD_FAILURE() << "known noise with fitc was accepted";
+    ADD_FAILURE() << "known noise with compact was accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("--backends: 'fitc' with the config's gp.known_noise = true"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("--backends: 'compact' with the config's gp.known_noise = true"), std::string::npos)
+        << e.what();
+  }
+  std::string compact = kTinyRun;
+  compact.replace(compact.find("[gp]\n"), 5, "[gp]\nbackend = \"compact\"\nknown_noise = true\n");
+  try {
+    (void)parse_run_config("cartpole", compact, "compact.toml");
+    ADD_FAILURE() << "a config with compact and known noise was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'gp.known_noise': is true with backend 'compact'"), std::string::npos)
         << e.what();
   }
   std::string fitc = kTinyRun;
   fitc.replace(fitc.find("[gp]\n"), 5, "[gp]\nbackend = \"fitc\"\nknown_noise = true\n");
-  try {
-    (void)parse_run_config("cartpole", fitc, "fitc.toml");
-    ADD_FAILURE() << "a config with fitc and known noise was accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("field 'gp.known_noise': is true with backend 'fitc'"), std::string::npos)
-        << e.what();
-  }
+  EXPECT_TRUE(parse_run_config("cartpole", fitc, "fitc.toml").gp.known_noise);
 }
 
 TEST(RunCli, AStartThatDivergesIsRecordedAndTheResultStaysFinite) {

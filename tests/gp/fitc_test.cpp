@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+
 #include <cmath>
 #include <limits>
 #include <atomic>
@@ -264,6 +266,103 @@ TEST(FitcReduction, PseudoInputsAtTheTrainingInputsGiveTheExactGp) {
     EXPECT_TRUE(matrices_near(a.mean_gradient, b.mean_gradient, 1e-5));
     EXPECT_TRUE(matrices_near(a.variance_gradient, b.variance_gradient, 1e-5));
   }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// A noise variance known per point: Lambda = diag(max(Kff - Qff, 0)) + sn2 I + diag(v)
+
+/// FITC's nlZ written densely: C = Qff + Lambda, 0.5 r'C^-1 r + 0.5 log|C| + N/2 log(2 pi).
+double dense_fitc_nlml(const Matrix& X, const Vector& r, const Vector& theta, int M, double snu2, const Vector& v) {
+  const int D = static_cast<int>(X.cols());
+  const FitcLayout layout{D, M};
+  const Vector ell = theta.head(D).array().exp();
+  const double sf2 = std::exp(2.0 * theta(D)), sn2 = std::exp(2.0 * theta(D + 1));
+  const Matrix Xu = layout.inducing_inputs(theta);
+  const auto k = [&](const Matrix& A, const Matrix& B) {
+    Matrix K(A.rows(), B.rows());
+    for (Eigen::Index i = 0; i < A.rows(); ++i)
+      for (Eigen::Index j = 0; j < B.rows(); ++j)
+        K(i, j) = sf2 * std::exp(-0.5 * ((A.row(i) - B.row(j)).transpose().cwiseQuotient(ell)).squaredNorm());
+    return K;
+  };
+  const Matrix Kuu = k(Xu, Xu) + snu2 * Matrix::Identity(M, M);
+  const Matrix Kuf = k(Xu, X);
+  const Matrix Qff = Kuf.transpose() * Kuu.llt().solve(Kuf);
+  const Vector lambda = (sf2 - Qff.diagonal().array()).max(0.0) + sn2 + v.array();
+  const Matrix C = Qff + Matrix(lambda.asDiagonal());
+  const Eigen::LLT<Matrix> llt(C);
+  const Matrix L = llt.matrixL();
+  return 0.5 * r.dot(llt.solve(r)) + L.diagonal().array().log().sum() + 0.5 * X.rows() * std::log(2.0 * M_PI);
+}
+
+TEST(FitcKnownNoise, TheNlmlAndItsGradientMatchADenseFitcAndCentralDifferences) {
+  const int N = 50, D = 3, M = 9;
+  const Matrix X = 2.0 * Matrix::Random(N, D);
+  const Vector r = X.array().sin().rowwise().sum().matrix() + 0.1 * Vector::Random(N);
+  const Vector v = (0.1 * (Vector::Random(N).array() + 1.05)).matrix();  // in [0.005, 0.205]
+  Vector hyper(D + 2);
+  hyper << 0.2, -0.1, 0.4, 0.1, std::log(0.05);
+  const Vector theta = FitcLayout{D, M}.pack(hyper, 2.0 * Matrix::Random(M, D));
+  const FitcLikelihood lik(X, r, M, FitcJitter::fixed(1e-8), {}, 1, v);
+  Vector grad;
+  const NlmlEvaluation e = lik.evaluate(theta, &grad);
+  ASSERT_EQ(e.status, FactorStatus::Ok);
+  EXPECT_NEAR(e.value, dense_fitc_nlml(X, r, theta, M, 1e-8, v), 1e-9 * std::abs(e.value));
+  EXPECT_TRUE(gradient_near(grad, numeric_gradient(lik, theta)));
+  // The known noise matters: without it the value differs.
+  EXPECT_GT(std::abs(FitcLikelihood(X, r, M, FitcJitter::fixed(1e-8)).evaluate(theta).value - e.value), 1.0);
+}
+
+TEST(FitcKnownNoise, AConstantKnownNoiseIsTheSameAsALargerLearnedOne) {
+  const int N = 40, D = 2, M = 8;
+  const Matrix X = 2.0 * Matrix::Random(N, D);
+  const Vector r = X.col(0).array().sin().matrix() + 0.1 * Vector::Random(N);
+  const double sn2 = 0.01, c = 0.03;
+  Vector hyper(D + 2);
+  hyper << 0.1, -0.2, 0.0, 0.5 * std::log(sn2);
+  const Matrix Xu = 2.0 * Matrix::Random(M, D);
+  const Vector theta = FitcLayout{D, M}.pack(hyper, Xu);
+  hyper(D + 1) = 0.5 * std::log(sn2 + c);
+  const Vector larger = FitcLayout{D, M}.pack(hyper, Xu);
+  const double known = FitcLikelihood(X, r, M, FitcJitter::fixed(1e-8), {}, 1, Vector::Constant(N, c)).evaluate(theta).value;
+  const double learned = FitcLikelihood(X, r, M, FitcJitter::fixed(1e-8)).evaluate(larger).value;
+  EXPECT_NEAR(known, learned, 1e-11 * std::abs(learned));
+}
+
+TEST(FitcKnownNoise, PseudoInputsAtTheTrainingInputsGiveTheExactGpWithTheSameKnownNoise) {
+  // The reduction of FitcReduction above, with v: Qff + Lambda = Kff + diag(sn2 + v) up to the jitter,
+  // against the exact backend's known noise (itself checked against scikit-learn's per-sample alpha).
+  const int N = 60, D = 2;
+  TrainingSet data{3.0 * Matrix::Random(N, D), Vector(N)};
+  data.targets = data.inputs.col(0).array().sin() * data.inputs.col(1).array().cos();
+  data.noise_variance = (0.02 * (Vector::Random(N).array() + 1.5)).matrix();
+  Vector hyper(D + 2);
+  hyper << std::log(1.2), std::log(0.9), std::log(0.8), std::log(0.05);
+  FitcOptions options;
+  options.jitter = FitcJitter::fixed(1e-10);
+  const auto fitc = FitcBackend(options).condition(data, FitcLayout{D, N}.pack(hyper, data.inputs));
+  const auto reference = ExactGpBackend(ExactGpOptions{ExactGpOptions::kAllPoints}).condition(data, hyper);
+  EXPECT_NEAR(fitc->negative_log_marginal_likelihood(), reference->negative_log_marginal_likelihood(),
+              1e-6 * std::abs(reference->negative_log_marginal_likelihood()));
+  Prediction a, b;
+  for (int i = 0; i < 10; ++i) {
+    const Vector z = 3.5 * Vector::Random(D);
+    fitc->predict(z, a, PredictionRequest{true, true});
+    reference->predict(z, b, PredictionRequest{true, true});
+    EXPECT_NEAR(a.mean, b.mean, 1e-6);
+    EXPECT_NEAR(a.variance, b.variance, 1e-6);
+    EXPECT_TRUE(matrices_near(a.mean_gradient, b.mean_gradient, 1e-5));
+    EXPECT_TRUE(matrices_near(a.variance_gradient, b.variance_gradient, 1e-5));
+  }
+  // A fit through the backend takes the known noise (no longer refused).
+  FitcOptions fit_options;
+  fit_options.inducing = 10;
+  FitOptions fit;
+  fit.restarts = 0;
+  fit.max_evaluations = 40;
+  const FitResult result = FitcBackend(fit_options).fit(data, fit);
+  EXPECT_TRUE(std::isfinite(result.summary.nlml));
+  EXPECT_THROW(FitcLikelihood(data.inputs, data.targets, 5, {}, {}, 1, Vector::Constant(N, -1.0)), std::invalid_argument);
 }
 
 // ---------------------------------------------------------------------------------------------------

@@ -228,6 +228,10 @@ class GpBackend {
   /// Registry name, e.g. "exact".
   virtual std::string_view name() const = 0;
 
+  /// Whether objective() and condition() take TrainingSet::noise_variance, a noise variance known per
+  /// point; a backend that does not refuses it (refuse_known_noise).
+  virtual bool takes_known_noise() const { return false; }
+
   /// The points one fit uses out of `data`: default all of them; the exact backend draws a uniform
   /// subsample. A different `seed` gives a fresh draw (the paper's re-sample rule).
   virtual TrainingSet select_training_points(const TrainingSet& data, std::uint64_t seed) const;

@@ -28,6 +28,10 @@ struct BackendSettings {
 /// The registry names, in a fixed order: "exact", "fitc", "ssgp", "compact".
 std::vector<std::string> backend_names();
 
+/// The registry names of the backends that take a noise variance known per point
+/// (GpBackend::takes_known_noise), in the order of backend_names().
+std::vector<std::string> backends_taking_known_noise();
+
 /// The backend called `name`. Throws std::invalid_argument naming `name` and listing the known names.
 std::unique_ptr<GpBackend> make_backend(std::string_view name, const BackendSettings& settings = {});
 

@@ -34,6 +34,7 @@ class ExactGpBackend final : public GpBackend {
  public:
   explicit ExactGpBackend(ExactGpOptions options = {});
   std::string_view name() const override { return "exact"; }
+  bool takes_known_noise() const override { return true; }
   const ExactGpOptions& options() const { return options_; }
 
   TrainingSet select_training_points(const TrainingSet& data, std::uint64_t seed) const override;

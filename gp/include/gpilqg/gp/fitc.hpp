@@ -6,7 +6,8 @@
 /// Model (Snelson & Ghahramani 2006, eqs. 5-9; Quinonero-Candela & Rasmussen 2005, sec. 6):
 ///
 ///   Kuu = k(Xu, Xu) + snu2 I (M x M),  Kuf = k(Xu, X) (M x N),  Qff = Kfu Kuu^-1 Kuf,
-///   Lambda = diag( max(diag(Kff - Qff), 0) ) + sn2 I,          r ~ N(0, Qff + Lambda),
+///   Lambda = diag( max(diag(Kff - Qff), 0) ) + sn2 I + diag(v),  r ~ N(0, Qff + Lambda),
+///   (v: the noise variances known per training point, TrainingSet::noise_variance; zero when none),
 ///
 /// where r are the targets (the GP layer is zero-mean: a prior mean has been subtracted, see
 /// prior_mean.hpp). The jitter snu2 follows GPML's rule snu2 = 1e-6 trace(Kuu)/M = 1e-6 sf2, which
@@ -90,8 +91,13 @@ class FitcLikelihood {
   /// work over blocks of training points (at least 500 points per thread; same results up to the
   /// order of a few sums). Throws std::invalid_argument on empty or non-finite data, mismatched
   /// sizes, M < 1, threads < 1, or an invalid jitter rule or schedule.
+  ///
+  /// `known_noise` (N entries, or empty for none): a noise variance v_i known at each training point
+  /// (TrainingSet::noise_variance), added to the learned sn2 in Lambda_ii = max(Kff_ii - Qff_ii, 0) +
+  /// sn2 + v_i. FITC's Lambda is diagonal already, so the known part changes neither the structure nor
+  /// the gradient's formulas: d Lambda_ii / d sn2 = 1 as before, and v is constant.
   FitcLikelihood(const MatrixCRef& X, const VectorCRef& r, int inducing, FitcJitter jitter = {},
-                 JitterSchedule schedule = {}, int threads = 1);
+                 JitterSchedule schedule = {}, int threads = 1, const Vector& known_noise = {});
 
   const FitcLayout& layout() const { return layout_; }
   int parameter_count() const { return layout_.size(); }
@@ -117,6 +123,7 @@ class FitcLikelihood {
 
   Matrix X_;
   Vector r_;
+  Vector known_noise_;  ///< v_i, N entries (zeros when none was given)
   Vector centre_;  ///< mean of X: inputs are centred internally (the kernel is stationary)
   FitcLayout layout_;
   FitcJitter jitter_;
@@ -200,6 +207,7 @@ class FitcBackend final : public GpBackend {
  public:
   explicit FitcBackend(FitcOptions options = {});
   std::string_view name() const override { return "fitc"; }
+  bool takes_known_noise() const override { return true; }
   const FitcOptions& options() const { return options_; }
 
   std::unique_ptr<MarginalLikelihoodObjective> objective(const TrainingSet& data,

@@ -14,7 +14,9 @@
 ///
 ///   m_a(z) = phi_a(z)' alpha_a,   v_a(z) = phi_a(z)' C_a phi_a(z),   C_a = sn_a^2 A_a^-1 (2m_a x 2m_a),
 ///
-/// alpha_a = [alpha_c; alpha_s] (the sf^2/m scaling of SSGP lives in A, so phi is unscaled).
+/// alpha_a = [alpha_c; alpha_s] and C_a the posterior mean and covariance of the weights (the sf^2/m
+/// scaling of SSGP lives in A, so phi is unscaled; with known noise variances A_a = Phi'U Phi + a I,
+/// ssgp.hpp). Nothing below depends on how alpha_a and C_a were obtained.
 ///
 /// Per frequency (output a; theta_r = s_r' mu, c_r = cos theta_r, n_r = sin theta_r):
 ///
@@ -98,7 +100,7 @@ namespace gpilqg::gp {
 struct SsgpOutput {
   Matrix frequencies;  ///< S = W ./ l' (m x D): rows s_r, the scaled spectral points
   Vector weights;      ///< alpha = [alpha_c; alpha_s] (2m): m(z) = phi(z)' alpha
-  Matrix variance;     ///< C = sn^2 A^-1 (2m x 2m), symmetric: v(z) = phi(z)' C phi(z)
+  Matrix variance;     ///< C = sn^2 A^-1 = Sigma_w (2m x 2m), symmetric: v(z) = phi(z)' C phi(z)
 };
 
 /// Moment matching of E SSGP outputs (each with its own frequencies). See the file comment.

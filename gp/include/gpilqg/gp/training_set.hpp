@@ -19,7 +19,8 @@ struct TrainingSet {
   /// the model itself predicts at that point). The likelihood is then y ~ N(0, K + diag(sn^2 + v_i)):
   /// v_i is known and fixed, sn^2 the learned homoscedastic part (GPyTorch's
   /// FixedNoiseGaussianLikelihood with learn_additional_noise; scikit-learn's per-sample alpha with a
-  /// WhiteKernel). Taken by the exact backend; the others refuse it (refuse_known_noise).
+  /// WhiteKernel). Taken by the backends whose GpBackend::takes_known_noise() is true; the others
+  /// refuse it (refuse_known_noise).
   Vector noise_variance = Vector();
 
   int size() const { return static_cast<int>(inputs.rows()); }
