@@ -64,7 +64,9 @@ def solve(config, progress=None):
 
     config: a TOML file or a dict of its tables, e.g. ``{"system": {...}, "problem": {...}}``.
     Returns a dict: cost, expected_cost, termination, converged, iterations, gradient_norm,
-    solve_time_s, x (T+1, n), u (T, m), and policy (a Policy).
+    solve_time_s, x (T+1, n), u (T, m), policy (a Policy), and start: "the usual start", or the
+    plan on the system's preset when [system] model is a richer model and the solve from that
+    plan cost less (docs/solvers.md, "Plans that never lose").
     """
     return _gpilqg._solve(_config_source("solve", config), progress)
 
