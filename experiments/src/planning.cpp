@@ -63,17 +63,8 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
                      "Python's data=[...])");
   const SystemSignature signature = system_signature(c.system);
   std::shared_ptr<const StepModel> simulator = make_solve_model(c);
-  const int m = simulator->control_dim();
   const QuadraticCost cost = make_solve_cost(c);
-
-  DdpTask task;
-  task.cost = &cost;
-  task.x0 = c.x0;
-  task.horizon = c.horizon;
-  task.u_min = c.u_min;
-  task.u_max = c.u_max;
-  task.u_init = c.u_init.size() ? c.u_init : Vector(Vector::Zero(m));
-  task.solver = c.solver;
+  const DdpTask task = ddp_task(c, cost);
 
   const TransitionData data = read_data(request.data_files, signature, c.dt);
   PlannedPolicy out;

@@ -112,14 +112,7 @@ SolvedConfig solve_config(const SolveConfig& c) {
   problem.horizon = c.horizon;
   problem.u_min = c.u_min;
   problem.u_max = c.u_max;
-  DdpTask task;
-  task.cost = &cost;
-  task.x0 = c.x0;
-  task.horizon = c.horizon;
-  task.u_min = c.u_min;
-  task.u_max = c.u_max;
-  task.u_init = c.u_init.size() ? c.u_init : Vector(Vector::Zero(step_model->control_dim()));
-  task.solver = c.solver;
+  const DdpTask task = ddp_task(c, cost);
   const ReferencePlans references =
       reference_plans(task, c.solver.variant, LoopModel{c.simulator, c.integrator, c.substeps, c.dt}, c.noise, c.simulator);
   std::vector<Matrix> starts{task.u_init.replicate(1, c.horizon)};

@@ -6,6 +6,8 @@
 #include "gpilqg/control/best_start.hpp"
 #include "gpilqg/control/rollout.hpp"
 
+#include "gpilqg/experiments/solve_config.hpp"
+
 #include "elapsed_seconds.hpp"
 
 namespace gpilqg {
@@ -31,6 +33,18 @@ DdpTask ddp_task(const TaskContext& c) {
   task.u_max = c.config.u_max;
   task.u_init = c.config.u_init;
   task.solver = c.config.solver;
+  return task;
+}
+
+DdpTask ddp_task(const SolveConfig& c, const Cost& cost) {
+  DdpTask task;
+  task.cost = &cost;
+  task.x0 = c.x0;
+  task.horizon = c.horizon;
+  task.u_min = c.u_min;
+  task.u_max = c.u_max;
+  task.u_init = c.u_init.size() ? c.u_init : Vector(Vector::Zero(c.R.size()));
+  task.solver = c.solver;
   return task;
 }
 

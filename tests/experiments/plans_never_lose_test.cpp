@@ -83,15 +83,7 @@ cart_coulomb_friction = { mu = 3.0, v0 = 0.05 }
   const auto world = make_solve_model(c);
   const QuadraticCost cost = make_solve_cost(c);
   // The trap: iLQG from u_init alone on the friction model (no plan kept).
-  DdpTask task;
-  task.cost = &cost;
-  task.x0 = c.x0;
-  task.horizon = c.horizon;
-  task.u_min = c.u_min;
-  task.u_max = c.u_max;
-  task.u_init = Vector::Zero(1);
-  task.solver = c.solver;
-  const Plan alone = plan_with_ddp(task, world, DdpVariant::ILQG, Matrix());
+  const Plan alone = plan_with_ddp(ddp_task(c, cost), world, DdpVariant::ILQG, Matrix());
 
   constexpr int kEpisodes = 16;
   const double simulator_plan = world_cost(*world, cost, simulators.file.policy, c.x0, kEpisodes);

@@ -224,6 +224,24 @@ TEST(FitcGradient, PredictionGradientsMatchCentralDifferencesFarAndNear) {
 // ---------------------------------------------------------------------------------------------------
 // Reduction: pseudo-inputs on the training inputs give the exact GP
 
+/// `fitc` (pseudo-inputs at the training inputs) against the exact GP on `data` at `hyper`: the NLML,
+/// and mean, variance and their input gradients at random points.
+void expect_the_exact_gp(const FittedGp& fitc, const TrainingSet& data, const Vector& hyper) {
+  const auto reference = ExactGpBackend(ExactGpOptions{ExactGpOptions::kAllPoints}).condition(data, hyper);
+  EXPECT_NEAR(fitc.negative_log_marginal_likelihood(), reference->negative_log_marginal_likelihood(),
+              1e-6 * std::abs(reference->negative_log_marginal_likelihood()));
+  Prediction a, b;
+  for (int i = 0; i < 10; ++i) {
+    const Vector z = 3.5 * Vector::Random(data.input_dim());
+    fitc.predict(z, a, PredictionRequest{true, true});
+    reference->predict(z, b, PredictionRequest{true, true});
+    EXPECT_NEAR(a.mean, b.mean, 1e-6);
+    EXPECT_NEAR(a.variance, b.variance, 1e-6);
+    EXPECT_TRUE(matrices_near(a.mean_gradient, b.mean_gradient, 1e-5));
+    EXPECT_TRUE(matrices_near(a.variance_gradient, b.variance_gradient, 1e-5));
+  }
+}
+
 TEST(FitcReduction, PseudoInputsAtTheTrainingInputsGiveTheExactGp) {
   // With Xu = X, Qff = Kff Kuu^-1 Kff = Kff - snu2 I + O(snu2^2) and Lambda = (snu2 + sn2) I, so
   // Qff + Lambda = Kff + sn2 I up to snu2^2 / lambda_min(Kff): FITC equals the exact GP.
@@ -253,19 +271,7 @@ TEST(FitcReduction, PseudoInputsAtTheTrainingInputsGiveTheExactGp) {
   FitcOptions options;
   options.jitter = FitcJitter::fixed(1e-10);
   const auto fitc = FitcBackend(options).condition(data, FitcLayout{D, N}.pack(hyper, data.inputs));
-  const auto reference = ExactGpBackend(ExactGpOptions{ExactGpOptions::kAllPoints}).condition(data, hyper);
-  EXPECT_NEAR(fitc->negative_log_marginal_likelihood(), reference->negative_log_marginal_likelihood(),
-              1e-6 * std::abs(reference->negative_log_marginal_likelihood()));
-  Prediction a, b;
-  for (int i = 0; i < 10; ++i) {
-    const Vector z = 3.5 * Vector::Random(D);
-    fitc->predict(z, a, PredictionRequest{true, true});
-    reference->predict(z, b, PredictionRequest{true, true});
-    EXPECT_NEAR(a.mean, b.mean, 1e-6);
-    EXPECT_NEAR(a.variance, b.variance, 1e-6);
-    EXPECT_TRUE(matrices_near(a.mean_gradient, b.mean_gradient, 1e-5));
-    EXPECT_TRUE(matrices_near(a.variance_gradient, b.variance_gradient, 1e-5));
-  }
+  expect_the_exact_gp(*fitc, data, hyper);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -341,19 +347,7 @@ TEST(FitcKnownNoise, PseudoInputsAtTheTrainingInputsGiveTheExactGpWithTheSameKno
   FitcOptions options;
   options.jitter = FitcJitter::fixed(1e-10);
   const auto fitc = FitcBackend(options).condition(data, FitcLayout{D, N}.pack(hyper, data.inputs));
-  const auto reference = ExactGpBackend(ExactGpOptions{ExactGpOptions::kAllPoints}).condition(data, hyper);
-  EXPECT_NEAR(fitc->negative_log_marginal_likelihood(), reference->negative_log_marginal_likelihood(),
-              1e-6 * std::abs(reference->negative_log_marginal_likelihood()));
-  Prediction a, b;
-  for (int i = 0; i < 10; ++i) {
-    const Vector z = 3.5 * Vector::Random(D);
-    fitc->predict(z, a, PredictionRequest{true, true});
-    reference->predict(z, b, PredictionRequest{true, true});
-    EXPECT_NEAR(a.mean, b.mean, 1e-6);
-    EXPECT_NEAR(a.variance, b.variance, 1e-6);
-    EXPECT_TRUE(matrices_near(a.mean_gradient, b.mean_gradient, 1e-5));
-    EXPECT_TRUE(matrices_near(a.variance_gradient, b.variance_gradient, 1e-5));
-  }
+  expect_the_exact_gp(*fitc, data, hyper);
   // A fit through the backend takes the known noise (no longer refused).
   FitcOptions fit_options;
   fit_options.inducing = 10;

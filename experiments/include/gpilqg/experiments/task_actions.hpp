@@ -46,6 +46,7 @@ void score_diverged_solve(Plan& plan, const Cost& cost, const Trajectory& reache
 /// The context of one task: config, task, models and cost (all outlive the actions), and where
 /// progress lines go (may be empty).
 class RunJournal;
+struct SolveConfig;
 
 struct TaskContext {
   const RunConfig& config;
@@ -73,6 +74,9 @@ struct DdpTask {
 
 /// The DdpTask of a task of `gpilqg run`: its cost, x0 and horizon, [control] and [solver].
 DdpTask ddp_task(const TaskContext& context);
+/// The DdpTask of a `gpilqg solve` or `gpilqg plan` config with its `cost` (make_solve_cost): [problem]
+/// (u_init zero when absent) and [solver].
+DdpTask ddp_task(const SolveConfig& config, const Cost& cost);
 
 /// DDP on `model` (kept alive by the plan, for MPC) from the controls `u_start` (m x T; empty:
 /// task.u_init repeated), within the task's limits; `variant` ILQG (process noise F) or RobustILQG (F
