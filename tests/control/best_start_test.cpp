@@ -1,9 +1,10 @@
 // The pieces of "plans that never lose" (best_start.hpp): the controls a policy applies in closed loop
-// replay its trajectory open loop on the same model, and the solve from several starts keeps the one of
-// least expected cost.
+// replay its trajectory open loop on the same model, and of several starts the solve begins at the
+// cheapest on the model and ends no dearer than it.
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -49,7 +50,7 @@ TEST(BestStart, ClosedLoopControlsReplayThePoliciesTrajectoryOpenLoop) {
   EXPECT_GT((drifted.col(kHorizon) - closed.col(kHorizon)).norm(), 0.1);
 }
 
-TEST(BestStart, KeepsTheSolveOfLeastExpectedCostAndTheFirstOnTies) {
+TEST(BestStart, SolvesFromTheCheapestStartAndEndsNoDearerThanIt) {
   const auto model = make_step_model(make_system("cartpole", Preset::Simulator), Integrator::RK4, kDt, 5);
   const QuadraticCost cost = test::cartpole_swingup_cost(kDt, Matrix::Zero(4, 4));
   DdpOptions options;
@@ -62,8 +63,14 @@ TEST(BestStart, KeepsTheSolveOfLeastExpectedCostAndTheFirstOnTies) {
   const Matrix diverging = Matrix::Constant(1, kHorizon, 1e9);
 
   const BestStart best = solve_from_best_start(solver, problem, {zero, diverging, good});
+  ASSERT_EQ(best.start_costs.size(), 3u);
+  EXPECT_TRUE(std::isinf(best.start_costs[1]));
+  EXPECT_LT(best.start_costs[2], best.start_costs[0]);
+  // The start's cost is its rollout's: the same as the trajectory cost of an open-loop rollout.
+  EXPECT_DOUBLE_EQ(best.start_costs[0], trajectory_cost(cost, rollout(*model, problem.x0, zero).trajectory));
   EXPECT_EQ(best.start, 2);
   EXPECT_DOUBLE_EQ(best.result.expected_cost, solver.solve(problem, good).expected_cost);
+  EXPECT_LE(best.result.expected_cost, best.start_costs[2]);
   EXPECT_LT(best.result.expected_cost, solver.solve(problem, zero).expected_cost);
   EXPECT_EQ(solve_from_best_start(solver, problem, {good, good}).start, 0);
   EXPECT_THROW(solve_from_best_start(solver, problem, {}), std::invalid_argument);

@@ -114,7 +114,7 @@ int run_plan(const PlanOptions& o) {
       std::cout << fmt::format("round {}: no data; planned on the simulator alone\n", f.round);
     std::cout << s.report(to_string(planned.model ? request.config.problem.solver.variant : DdpVariant::ILQG)) << '\n';
     if (planned.start != "the usual start")
-      std::cout << fmt::format("kept the solve started from {}: it costs less on the model planned on\n", planned.start);
+      std::cout << fmt::format("started the solve from {}: it costs less on the model planned on than the usual start\n", planned.start);
     std::cout << fmt::format("predicted cost {:.6g}, expected cost {:.6g}; wrote {} (horizon {}, dt {} s)\n",
                              f.predicted_cost, f.expected_cost, o.out, f.policy.horizon(), f.dt);
   }

@@ -47,7 +47,7 @@ int run_solve(const std::string& file, bool json) {
   } else {
     std::cout << s.report(to_string(config.solver.variant)) << '\n';
     if (solved.start != "the usual start")
-      std::cout << fmt::format("kept the solve started from {}: it costs less on the config's model\n", solved.start);
+      std::cout << fmt::format("started the solve from {}: it costs less on the config's model than u_init\n", solved.start);
     std::cout << fmt::format("cost {:.12g} (expected {:.12g}), final state [{}]\n", r.nominal_cost, r.expected_cost,
                              fmt::join(as_list(x_final), ", "));
   }

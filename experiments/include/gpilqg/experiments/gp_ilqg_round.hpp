@@ -13,7 +13,7 @@
 ///    put into its targets (gp/noise_floor.hpp). Then Robust-iLQG (F and G = diag(sigma(z))) or, as an ablation, iLQG on the
 ///    GP mean solves the task on simulator + GP, warm-started from the previous round's controls.
 ///  - Either way each of `plans_to_keep` (plans on simpler models, reference_plans.hpp) is a further
-///    start of the solve, and the plan of least expected cost on the round's model is kept.
+///    start of the solve, which begins at the start of least cost on the round's model.
 
 #include <memory>
 #include <vector>
@@ -41,7 +41,7 @@ struct GpRoundInputs {
   /// known noise variance per point (the exact backend only); false: their least value as a floor.
   bool known_noise = false;
   /// Plans on simpler models (reference_plans.hpp) that this round's plan must not lose to: each is
-  /// a further start of the solve, and the plan of least expected cost on the round's model is kept.
+  /// a further start of the solve, which begins at the start of least cost on the round's model.
   std::vector<AffinePolicy> plans_to_keep;
 };
 

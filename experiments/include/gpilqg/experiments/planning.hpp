@@ -36,7 +36,7 @@ struct PlannedPolicy {
   PolicyFile file;                                   ///< what write_policy_file writes
   std::shared_ptr<const gp::ResidualModel> model;    ///< the fitted GP (null: planned on the simulator)
   DdpSummary summary;                                ///< the solver's termination, iterations, timings
-  /// Where the kept solve started (ReferencePlans::start_name): "the usual start" (the previous
+  /// Where the solve started (ReferencePlans::start_name): "the usual start" (the previous
   /// policy's or u_init's controls) or "the plan on ..." a simpler model (reference_plans.hpp).
   std::string start;
   int data_rows = 0;                                 ///< transitions the GP was fitted on

@@ -62,7 +62,7 @@ std::shared_ptr<const StepModel> make_solve_model(const SolveConfig& config);
 /// The config's cost: dt (0.5 e'Qe + 0.5 u'Ru) per step and 0.5 e'Qf e at the end, e = x - goal.
 QuadraticCost make_solve_cost(const SolveConfig& config);
 
-/// A solved config and where its kept solve started.
+/// A solved config and where its solve started.
 struct SolvedConfig {
   DdpResult result;
   std::string start;  ///< ReferencePlans::start_name: "the usual start" (u_init) or "the plan on ..."
@@ -70,7 +70,7 @@ struct SolvedConfig {
 
 /// Builds the model and cost of the config and solves it from u_init; when [system] model is not the
 /// preset alone, also from the preset's plan replayed on the model (reference_plans.hpp), keeping the
-/// solve of least expected cost.
+/// cheaper start on the model (control/best_start.hpp).
 SolvedConfig solve_config(const SolveConfig& config);
 
 /// Why the initial rollout of a solve ended with termination InitialRolloutDiverged, given `cost`,

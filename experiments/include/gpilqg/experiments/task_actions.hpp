@@ -31,8 +31,8 @@ struct Plan {
   DdpSummary summary;
   std::shared_ptr<const StepModel> model;  ///< what MPC re-plans on (null: the policy only, e.g. PDDP's)
   DdpVariant variant = DdpVariant::ILQG;
-  /// The start the solve kept (plan_with_ddp): 0 the usual one, i >= 1 the closed-loop controls of
-  /// plans_to_keep[i - 1].
+  /// The start the solve began from (plan_with_ddp, the cheapest on the model): 0 the usual one,
+  /// i >= 1 the closed-loop controls of plans_to_keep[i - 1].
   int start = 0;
 };
 
@@ -81,8 +81,8 @@ DdpTask ddp_task(const SolveConfig& config, const Cost& cost);
 /// DDP on `model` (kept alive by the plan, for MPC) from the controls `u_start` (m x T; empty:
 /// task.u_init repeated), within the task's limits; `variant` ILQG (process noise F) or RobustILQG (F
 /// and the GP's G). Each of `plans_to_keep` (plans made on other models, reference_plans.hpp) is a
-/// further start, its closed-loop controls on `model`; the plan of least expected cost on `model` is
-/// kept (control/best_start.hpp), and solve_seconds counts every solve.
+/// further start, its closed-loop controls on `model`; the solve begins at the start of least cost on
+/// `model` (control/best_start.hpp), so it ends no dearer there than any of those plans.
 Plan plan_with_ddp(const DdpTask& task, std::shared_ptr<const StepModel> model, DdpVariant variant,
                    const Matrix& u_start, const std::vector<AffinePolicy>& plans_to_keep = {});
 /// The same for a task of `gpilqg run`.
