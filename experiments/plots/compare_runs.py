@@ -3,9 +3,10 @@ iteration, the mean normalised cost of an algorithm with its standard error over
 first iteration whose mean is at most a threshold (default 1.05).
 
     /usr/bin/python3 experiments/plots/compare_runs.py LABEL=A.h5 LABEL=B.h5 [--algorithm gp_ilqg]
-        [--threshold 1.05]
+        [--threshold 1.05] [--figures PREFIX]
 
-Prints Markdown. The standard error is the seeds' standard deviation over sqrt(S) (S seeds); the
+Prints Markdown; with --figures also one PNG per task, PREFIX_<task>.png: the mean normalised cost per
+iteration with its standard error as a band, one line per run, on a log axis. The standard error is the seeds' standard deviation over sqrt(S) (S seeds); the
 files must hold the same seeds and tasks, which the script checks.
 """
 import argparse
@@ -35,6 +36,7 @@ def main():
     parser.add_argument("runs", nargs="+", help="LABEL=FILE.h5")
     parser.add_argument("--algorithm", default="gp_ilqg")
     parser.add_argument("--threshold", type=float, default=1.05)
+    parser.add_argument("--figures", help="write PREFIX_<task>.png per task")
     args = parser.parse_args()
     runs = []
     for item in args.runs:
@@ -65,6 +67,33 @@ def main():
             if diagnosed is not None:
                 label += " (diagnosed from iteration " + ", ".join(str(d) for d in diagnosed) + ")"
             print(f"| {label} | " + " | ".join(cells) + f" | {first} | {last} of {S} |")
+        if args.figures:
+            figure(f"{args.figures}_{task}.png", f"{task}{transfer}", runs, task, S, args)
+
+
+def figure(path, title, runs, task, S, args):
+    """The mean normalised cost per iteration of every run, its standard error as a band."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    for label, _, _, run_tasks in runs:
+        cost = run_tasks[task][0]
+        mean = cost.mean(axis=1)
+        se = cost.std(axis=1, ddof=1) / np.sqrt(S) if S > 1 else np.zeros(len(mean))
+        k = np.arange(len(mean))
+        ax.plot(k, mean, marker="o", label=label)
+        ax.fill_between(k, np.maximum(mean - se, 1e-3), mean + se, alpha=0.2)
+    ax.axhline(args.threshold, color="grey", linestyle="--", linewidth=0.8)
+    ax.set_xticks(np.arange(runs[0][3][task][0].shape[0]))
+    ax.set_yscale("log")
+    ax.set_xlabel("iteration")
+    ax.set_ylabel(f"{args.algorithm}'s normalised cost (mean ± s.e., {S} seeds)")
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":
