@@ -22,11 +22,12 @@ namespace {
 void report(const TaskContext& c, const std::string& name, int k, const IterationRecord& r) {
   if (!c.progress) return;
   c.progress(fmt::format("{} {} iteration {}/{}: cost {:.4g}{} (data {}, fit {:.1f} s, solve {:.1f} s, rollouts {:.1f} s, "
-                         "evaluation {:.1f} s{})",
+                         "evaluation {:.1f} s{}{})",
                          c.task.name, name, k, c.config.iterations, r.evaluation.mean_cost,
                          r.evaluation.diverged ? fmt::format(", {} diverged", r.evaluation.diverged) : "", r.data_rows,
                          r.fit_seconds, r.plan.solve_seconds, r.rollout_seconds, r.evaluation.seconds,
-                         r.policy_change >= 0.0 ? fmt::format(", policy change {:.3g}", r.policy_change) : ""));
+                         r.policy_change >= 0.0 ? fmt::format(", policy change {:.3g}", r.policy_change) : "",
+                         r.start.empty() || r.start == "the usual start" ? "" : ", solve started from " + r.start));
 }
 
 /// Plans from data; fills the record's fit time and hyperparameters and may keep the plan's model.
@@ -143,16 +144,18 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     if (!diagnosed) diagnosed = planning_simulator(loop_model(c.config), c.config.noise, c.models.simulator, run.diagnosis);
     return diagnosed;
   };
-  std::map<bool, std::vector<AffinePolicy>> kept;  // reference_plans, by whether a diagnosed model is planned on
-  const auto plans_to_keep = [&](const AlgorithmRun& run) -> const std::vector<AffinePolicy>& {
+  std::map<bool, ReferencePlans> kept;  // reference_plans, by whether a diagnosed model is planned on
+  // The plans a round keeps as further starts: the simpler models' plans, then the previous round's policy.
+  const auto plans_to_keep = [&](const AlgorithmRun& run, const Plan* previous) {
     const bool on_diagnosed = run.diagnosis && run.diagnosis->adopted;
     auto found = kept.find(on_diagnosed);
     if (found == kept.end())
       found = kept.emplace(on_diagnosed, reference_plans(task, DdpVariant::ILQG, loop_model(c.config), c.config.noise,
-                                                          on_diagnosed ? run.diagnosis->model : c.config.simulator)
-                                             .policies)
+                                                          on_diagnosed ? run.diagnosis->model : c.config.simulator))
                   .first;
-    return found->second;
+    ReferencePlans plans = found->second;
+    if (previous != nullptr) plans.keep(kPreviousRoundsPolicy, previous->policy);
+    return plans;
   };
   const DataPlanner planner = [&](const TransitionData& data, const Plan* previous, IterationRecord& record,
                                   const AlgorithmRun& run) {
@@ -172,8 +175,10 @@ AlgorithmRun run_gp_ilqg(const TaskContext& c, const std::string& name, const gp
     inputs.threads = c.threads;
     inputs.observation_std = c.config.observation_std;
     inputs.known_noise = c.config.gp.known_noise;
-    inputs.plans_to_keep = plans_to_keep(run);
+    const ReferencePlans plans = plans_to_keep(run, previous);
+    inputs.plans_to_keep = plans.policies;
     GpRound round = plan_gp_ilqg_round(task, simulator, inputs);
+    record.start = plans.start_name(round.plan.start);
     record.fit_seconds = round.fit_seconds;
     record.hyperparameters = std::move(round.hyperparameters);
     record.noise_floor = std::move(round.noise_floor);

@@ -85,9 +85,8 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
   inputs.variant = c.solver.variant;
   inputs.observation_std = request.config.observation_std;
   inputs.known_noise = gp_settings.known_noise;
-  const ReferencePlans references =
+  ReferencePlans references =
       reference_plans(task, DdpVariant::ILQG, LoopModel{c.simulator, c.integrator, c.substeps, c.dt}, c.noise, planned_on);
-  inputs.plans_to_keep = references.policies;
   inputs.fit.restarts = gp_settings.restarts;
   inputs.fit.max_evaluations = gp_settings.max_evaluations;
   inputs.fit.seed = gp_fit_seed(request.seed, 0, kAlgorithm, data.size());
@@ -96,6 +95,7 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
     const PolicyFile previous = read_policy_file(*request.previous);
     check_previous(previous, *request.previous, c, signature);
     inputs.previous_u_bar = previous.policy.u_bar;
+    references.keep(kPreviousRoundsPolicy, previous.policy);
     round = previous.round + 1;
     if (!previous.model_backend.empty()) {
       if (previous.model_backend != gp_settings.backend)
@@ -108,6 +108,7 @@ PlannedPolicy plan_policy(const PlanRequest& request) {
     }
   }
 
+  inputs.plans_to_keep = references.policies;
   GpRound result = plan_gp_ilqg_round(task, simulator, inputs);
   out.model = std::dynamic_pointer_cast<const gp::ResidualModel>(result.plan.model);
   out.summary = result.plan.summary;

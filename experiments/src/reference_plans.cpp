@@ -1,6 +1,7 @@
 #include "gpilqg/experiments/reference_plans.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -26,17 +27,21 @@ std::vector<SimplerModel> simpler_models(const LoopModel& config, const Actuator
   return models;
 }
 
+void ReferencePlans::keep(std::string name, AffinePolicy policy) {
+  names.push_back(std::move(name));
+  policies.push_back(std::move(policy));
+}
+
 std::string ReferencePlans::start_name(int start) const {
-  if (start <= 0 || start > static_cast<int>(models.size())) return "the usual start";
-  return "the plan on " + models[static_cast<std::size_t>(start - 1)];
+  if (start <= 0 || start > static_cast<int>(names.size())) return "the usual start";
+  return names[static_cast<std::size_t>(start - 1)];
 }
 
 ReferencePlans reference_plans(const DdpTask& task, DdpVariant variant, const LoopModel& config,
                                const ActuatorNoise& noise, const ModelSpec& planned_on) {
   ReferencePlans plans;
   for (const SimplerModel& simpler : simpler_models(config, noise, planned_on)) {
-    plans.models.push_back(simpler.name);
-    plans.policies.push_back(plan_with_ddp(task, simpler.model, variant, Matrix()).policy);
+    plans.keep("the plan on " + simpler.name, plan_with_ddp(task, simpler.model, variant, Matrix()).policy);
   }
   return plans;
 }

@@ -3,13 +3,16 @@
 // model stops in a worse local optimum than the frictionless simulator's plan, run with its feedback on
 // the very same system. With the simulator's plan kept as a further start, the plan on the friction
 // model costs on that system at most what the simulator's plan costs, measured by Monte Carlo rollouts.
+// A new round keeps the previous round's policy the same way.
 
 #include <gtest/gtest.h>
 
 #include <random>
 
+#include "gpilqg/control/best_start.hpp"
 #include "gpilqg/control/policy.hpp"
 #include "gpilqg/experiments/planning.hpp"
+#include "gpilqg/experiments/policy_file.hpp"
 #include "gpilqg/experiments/reference_plans.hpp"
 #include "gpilqg/experiments/solve_config.hpp"
 #include "test_support.hpp"
@@ -18,6 +21,17 @@ namespace gpilqg {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// The friction system: the simulator preset with 3 N of Coulomb friction on the cart (smoothed at
+/// 0.05 m/s), in dir/friction.toml.
+void write_friction_model(const fs::path& dir) {
+  test::write_text(dir / "friction.toml", R"([model]
+system = "cartpole"
+preset = "sim"
+[effects]
+cart_coulomb_friction = { mu = 3.0, v0 = 0.05 }
+)");
+}
 
 /// The swing-up of `gpilqg run cartpole`'s first task (examples/robot_loop/cartpole_swingup.toml) with
 /// iLQG, planned on `system`'s line ("preset = ..." or "model = ...").
@@ -62,13 +76,7 @@ double world_cost(const StepModel& world, const Cost& cost, const AffinePolicy& 
 
 TEST(PlansNeverLose, APlanOnAFrictionModelCostsNoMoreThanTheSimulatorsPlanOnThatSystem) {
   const fs::path dir = test::temporary_dir("plans_never_lose");
-  // The system: the simulator preset with 3 N of Coulomb friction on the cart (smoothed at 0.05 m/s).
-  test::write_text(dir / "friction.toml", R"([model]
-system = "cartpole"
-preset = "sim"
-[effects]
-cart_coulomb_friction = { mu = 3.0, v0 = 0.05 }
-)");
+  write_friction_model(dir);
   const fs::path on_model = test::write_text(dir / "on_model.toml", swing_up("model = \"friction.toml\""));
   const fs::path on_simulator = test::write_text(dir / "on_simulator.toml", swing_up("preset = \"sim\""));
 
@@ -100,6 +108,38 @@ cart_coulomb_friction = { mu = 3.0, v0 = 0.05 }
   const SolvedConfig solved = solve_config(c);
   EXPECT_EQ(solved.start, planned.start);
   EXPECT_NEAR(solved.result.expected_cost, planned.file.expected_cost, 1e-9 * planned.file.expected_cost);
+}
+
+// `gpilqg plan --previous P`: the round's model changed (here the previous round planned on the friction
+// model, this one on the simulator), and the previous round's policy, replayed with its feedback, is a
+// start beside its open-loop controls. The round's plan then costs on its own model no more than that
+// replay, checked by rolling both out there.
+TEST(PlansNeverLose, ANewRoundsPlanCostsNoMoreThanThePreviousRoundsPolicyOnTheNewModel) {
+  const fs::path dir = test::temporary_dir("plans_never_lose_previous");
+  write_friction_model(dir);
+  PlanRequest request;
+  request.config = read_plan_config(test::write_text(dir / "on_model.toml", swing_up("model = \"friction.toml\"")));
+  const PlannedPolicy previous = plan_policy(request);
+  write_policy_file(dir / "previous.h5", previous.file, nullptr);
+  request.config = read_plan_config(test::write_text(dir / "on_simulator.toml", swing_up("preset = \"sim\"")));
+  request.previous = dir / "previous.h5";
+  const PlannedPolicy next = plan_policy(request);
+
+  const SolveConfig& c = request.config.problem;
+  const auto model = make_solve_model(c);
+  const QuadraticCost cost = make_solve_cost(c);
+  DdpProblem problem;
+  problem.model = model.get();
+  problem.cost = &cost;
+  problem.x0 = c.x0;
+  problem.horizon = c.horizon;
+  problem.u_min = c.u_min;
+  problem.u_max = c.u_max;
+  const double open_loop = start_cost(problem, previous.file.policy.u_bar);
+  const double replayed = start_cost(problem, closed_loop_controls(*model, previous.file.policy, c.x0));
+  ASSERT_LT(replayed, open_loop) << "the feedback no longer helps the previous policy here; the case checks nothing";
+  EXPECT_EQ(next.start, kPreviousRoundsPolicy);
+  EXPECT_LE(start_cost(problem, closed_loop_controls(*model, next.file.policy, c.x0)), replayed);
 }
 
 }  // namespace

@@ -36,6 +36,7 @@ struct IterationRecord {
   std::vector<Vector> hyperparameters;  ///< per state output: [log l (n+m); log sf; log sn] (empty: no GP)
   Vector noise_floor;  ///< per state output: the lower bound on sn (gp/noise_floor.hpp; empty: no GP)
   bool repeated = false;        ///< a copy of the previous iteration (converged or fixed model)
+  std::string start;            ///< gp_ilqg: where the solve started (ReferencePlans::start_name; empty: not said)
 };
 
 struct AlgorithmRun {

@@ -12,8 +12,9 @@
 ///    (gp/resample.hpp). No output may fit a noise std below what the sensors and the process noise
 ///    put into its targets (gp/noise_floor.hpp). Then Robust-iLQG (F and G = diag(sigma(z))) or, as an ablation, iLQG on the
 ///    GP mean solves the task on simulator + GP, warm-started from the previous round's controls.
-///  - Either way each of `plans_to_keep` (plans on simpler models, reference_plans.hpp) is a further
-///    start of the solve, which begins at the start of least cost on the round's model.
+///  - Either way each of `plans_to_keep` (plans on simpler models and the previous round's policy,
+///    reference_plans.hpp) is a further start of the solve, which begins at the start of least cost on
+///    the round's model.
 
 #include <memory>
 #include <vector>
@@ -38,10 +39,11 @@ struct GpRoundInputs {
   /// output's floor on the fitted noise std (gp/noise_floor.hpp).
   Vector observation_std;
   /// GpSettings::known_noise: the sensors' and the simulator's process noise at each transition as a
-  /// known noise variance per point (the exact backend only); false: their least value as a floor.
+  /// known noise variance per point (gp::backends_taking_known_noise); false: their least value as a floor.
   bool known_noise = false;
-  /// Plans on simpler models (reference_plans.hpp) that this round's plan must not lose to: each is
-  /// a further start of the solve, which begins at the start of least cost on the round's model.
+  /// Plans that this round's plan must not lose to (reference_plans.hpp: simpler models' plans, the
+  /// previous round's policy): each is a further start of the solve, which begins at the start of
+  /// least cost on the round's model.
   std::vector<AffinePolicy> plans_to_keep;
 };
 

@@ -23,7 +23,7 @@ struct GpSettings {
   /// Each residual GP takes the noise the simulator itself predicts at each transition (the sensors'
   /// and its process noise, gp/noise_floor.hpp) as a known noise variance per point and learns only
   /// the rest (TrainingSet::noise_variance); false: one learned noise level per output with that
-  /// noise's least value as its floor. The exact backend only.
+  /// noise's least value as its floor. The backends of gp::backends_taking_known_noise (not compact).
   bool known_noise = false;
 };
 

@@ -37,7 +37,8 @@ struct PlannedPolicy {
   std::shared_ptr<const gp::ResidualModel> model;    ///< the fitted GP (null: planned on the simulator)
   DdpSummary summary;                                ///< the solver's termination, iterations, timings
   /// Where the solve started (ReferencePlans::start_name): "the usual start" (the previous
-  /// policy's or u_init's controls) or "the plan on ..." a simpler model (reference_plans.hpp).
+  /// policy's open-loop controls or u_init's), "the plan on ..." a simpler model, or "the previous
+  /// round's policy" replayed with its feedback (reference_plans.hpp).
   std::string start;
   int data_rows = 0;                                 ///< transitions the GP was fitted on
   double fit_seconds = 0.0;

@@ -32,13 +32,20 @@ struct SimplerModel {
 /// sub-steps, with `noise`).
 std::vector<SimplerModel> simpler_models(const LoopModel& config, const ActuatorNoise& noise, const ModelSpec& planned_on);
 
-/// The plans on the simpler models of `planned_on`, one per model, and the models' names.
+/// The plans a solve keeps as further starts (plan_with_ddp's plans_to_keep) and what each is called.
 struct ReferencePlans {
-  std::vector<std::string> models;
+  std::vector<std::string> names;  ///< "the plan on " + a simpler model's name, "the previous round's policy"
   std::vector<AffinePolicy> policies;
-  /// What Plan::start `start` means: "the usual start" (0) or "the plan on " + models[start - 1].
+  /// Keeps `policy` as a further start, called `name` in reports.
+  void keep(std::string name, AffinePolicy policy);
+  /// What Plan::start `start` means: "the usual start" (0) or names[start - 1].
   std::string start_name(int start) const;
 };
+
+/// What a new round's plan keeps of the previous round (a GP refitted on more data is a changed model
+/// too): its policy, replayed with its feedback on the new model, beside the usual start (the previous
+/// round's controls, open loop).
+inline constexpr const char* kPreviousRoundsPolicy = "the previous round's policy";
 
 /// `variant` (from task.u_init, the task's solver options) on each simpler model of `planned_on`:
 /// what a plan on `planned_on` keeps as further starts. Empty when `planned_on` is the preset itself.
