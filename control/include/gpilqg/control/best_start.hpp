@@ -19,7 +19,9 @@ namespace gpilqg {
 struct BestStart {
   DdpResult result;               ///< the solve from the cheapest start
   int start = 0;                  ///< its index in `starts` (the earliest on ties)
-  std::vector<double> start_costs;  ///< each start's nominal cost on the model (+infinity: diverged)
+  /// Each start's nominal cost on the model (+infinity: diverged). A single start is not rolled out
+  /// (there is nothing to choose): its entry is 0.
+  std::vector<double> start_costs;
 };
 
 /// The nominal cost of rolling `controls` (m x T, clamped to the problem's limits) out on the problem's
