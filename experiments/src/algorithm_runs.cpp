@@ -27,7 +27,7 @@ void report(const TaskContext& c, const std::string& name, int k, const Iteratio
                          r.evaluation.diverged ? fmt::format(", {} diverged", r.evaluation.diverged) : "", r.data_rows,
                          r.fit_seconds, r.plan.solve_seconds, r.rollout_seconds, r.evaluation.seconds,
                          r.policy_change >= 0.0 ? fmt::format(", policy change {:.3g}", r.policy_change) : "",
-                         r.start.empty() || r.start == "the usual start" ? "" : ", solve started from " + r.start));
+                         r.start.empty() || r.start == kUsualStart ? "" : ", solve started from " + r.start));
 }
 
 /// Plans from data; fills the record's fit time and hyperparameters and may keep the plan's model.

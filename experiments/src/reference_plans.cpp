@@ -33,7 +33,7 @@ void ReferencePlans::keep(std::string name, AffinePolicy policy) {
 }
 
 std::string ReferencePlans::start_name(int start) const {
-  if (start <= 0 || start > static_cast<int>(names.size())) return "the usual start";
+  if (start <= 0 || start > static_cast<int>(names.size())) return kUsualStart;
   return names[static_cast<std::size_t>(start - 1)];
 }
 

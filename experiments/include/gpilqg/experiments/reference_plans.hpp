@@ -42,6 +42,9 @@ struct ReferencePlans {
   std::string start_name(int start) const;
 };
 
+/// What Plan::start 0 is called: u_init, or the previous round's controls open loop.
+inline constexpr const char* kUsualStart = "the usual start";
+
 /// What a new round's plan keeps of the previous round (a GP refitted on more data is a changed model
 /// too): its policy, replayed with its feedback on the new model, beside the usual start (the previous
 /// round's controls, open loop).
