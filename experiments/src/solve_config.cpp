@@ -105,14 +105,8 @@ QuadraticCost make_solve_cost(const SolveConfig& c) {
 SolvedConfig solve_config(const SolveConfig& c) {
   const auto step_model = make_solve_model(c);
   const QuadraticCost cost = make_solve_cost(c);
-  DdpProblem problem;
-  problem.model = step_model.get();
-  problem.cost = &cost;
-  problem.x0 = c.x0;
-  problem.horizon = c.horizon;
-  problem.u_min = c.u_min;
-  problem.u_max = c.u_max;
   const DdpTask task = ddp_task(c, cost);
+  const DdpProblem problem = ddp_problem(task, *step_model);
   const ReferencePlans references =
       reference_plans(task, c.solver.variant, LoopModel{c.simulator, c.integrator, c.substeps, c.dt}, c.noise, c.simulator);
   std::vector<Matrix> starts{task.u_init.replicate(1, c.horizon)};

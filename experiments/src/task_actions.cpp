@@ -48,15 +48,20 @@ DdpTask ddp_task(const SolveConfig& c, const Cost& cost) {
   return task;
 }
 
-Plan plan_with_ddp(const DdpTask& task, std::shared_ptr<const StepModel> model, DdpVariant variant,
-                   const Matrix& u_start, const std::vector<AffinePolicy>& plans_to_keep) {
+DdpProblem ddp_problem(const DdpTask& task, const StepModel& model) {
   DdpProblem problem;
-  problem.model = model.get();
+  problem.model = &model;
   problem.cost = task.cost;
   problem.x0 = task.x0;
   problem.horizon = task.horizon;
   problem.u_min = task.u_min;
   problem.u_max = task.u_max;
+  return problem;
+}
+
+Plan plan_with_ddp(const DdpTask& task, std::shared_ptr<const StepModel> model, DdpVariant variant,
+                   const Matrix& u_start, const std::vector<AffinePolicy>& plans_to_keep) {
+  const DdpProblem problem = ddp_problem(task, *model);
   DdpOptions options = task.solver;
   options.variant = variant;
   DdpSolver solver(options);

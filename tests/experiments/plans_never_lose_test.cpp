@@ -128,13 +128,8 @@ TEST(PlansNeverLose, ANewRoundsPlanCostsNoMoreThanThePreviousRoundsPolicyOnTheNe
   const SolveConfig& c = request.config.problem;
   const auto model = make_solve_model(c);
   const QuadraticCost cost = make_solve_cost(c);
-  DdpProblem problem;
-  problem.model = model.get();
-  problem.cost = &cost;
-  problem.x0 = c.x0;
-  problem.horizon = c.horizon;
-  problem.u_min = c.u_min;
-  problem.u_max = c.u_max;
+  const DdpTask task = ddp_task(c, cost);
+  const DdpProblem problem = ddp_problem(task, *model);
   const double open_loop = start_cost(problem, previous.file.policy.u_bar);
   const double replayed = start_cost(problem, closed_loop_controls(*model, previous.file.policy, c.x0));
   ASSERT_LT(replayed, open_loop) << "the feedback no longer helps the previous policy here; the case checks nothing";

@@ -77,6 +77,8 @@ DdpTask ddp_task(const TaskContext& context);
 /// The DdpTask of a `gpilqg solve` or `gpilqg plan` config with its `cost` (make_solve_cost): [problem]
 /// (u_init zero when absent) and [solver].
 DdpTask ddp_task(const SolveConfig& config, const Cost& cost);
+/// The problem DDP solves for `task` on `model` (both must outlive it): cost, x0, horizon, limits.
+DdpProblem ddp_problem(const DdpTask& task, const StepModel& model);
 
 /// DDP on `model` (kept alive by the plan, for MPC) from the controls `u_start` (m x T; empty:
 /// task.u_init repeated), within the task's limits; `variant` ILQG (process noise F) or RobustILQG (F
