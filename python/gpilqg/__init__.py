@@ -75,7 +75,8 @@ def plan(config, data=(), previous=None, out=None, seed=1, diagnose=False, write
     """One round of Algorithm 1 on measurement files, as ``gpilqg plan`` (docs/real-robot.md).
 
     config: the plan config (file or dict; ``[system] model`` names a model file of ``diagnose`` as the
-    simulator); data: measurement files, oldest first; previous: the previous round's policy file;
+    simulator); data: measurement files, oldest first; previous: the previous round's policy file
+    (its controls and its policy replayed with its feedback are starts of the solve, its GP the fit's);
     out: where to write the policy file (optional); seed: the GP fit's; diagnose: diagnose the data
     first and, when the verdict is "explained", plan on the diagnosed model (``plan --diagnose``);
     write_model: with diagnose, where to write the diagnosed model file.
